@@ -1,0 +1,59 @@
+# CCNURBS build. `make test` and `make demo` install what they need (deps) and build first.
+CC      ?= cc
+CXX     ?= c++
+CFLAGS  ?= -O2 -g
+WARN     = -std=c11 -Wall -Wextra -Werror -pedantic
+CPPFLAGS = -Icsrc/include -D_POSIX_C_SOURCE=200809L
+LDLIBS   = -llapacke -llapack -lm -lpthread
+B        = build
+
+LIB_SRC  = $(sort $(wildcard csrc/*.c))
+LIB_OBJ  = $(LIB_SRC:csrc/%.c=$(B)/obj/%.o)
+PIC_OBJ  = $(LIB_SRC:csrc/%.c=$(B)/pic/%.o)
+TEST_SRC = $(sort $(wildcard tests/c/test_*.c))
+TEST_BIN = $(TEST_SRC:tests/c/%.c=$(B)/tests/%)
+HDRS     = $(wildcard csrc/*.h csrc/include/*.h tests/c/*.h)
+
+APT_PKGS = build-essential clang libclang-rt-14-dev libosd-dev liblapacke-dev liblapack-dev \
+           python3 python3-numpy zip
+
+.PHONY: all deps build test demo clean
+
+# Each tests/*/NAME.mk may add rules and append to TEST_DEPS (built before tests run).
+TEST_DEPS =
+-include $(wildcard tests/*/*.mk)
+
+all: build
+
+deps:
+	@./tests/deps.sh $(APT_PKGS)
+
+build: $(B)/libccnurbs.so $(B)/libccnurbs.a $(B)/ccnurbs
+
+$(B)/obj/%.o: csrc/%.c $(HDRS) | $(B)/obj
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/pic/%.o: csrc/%.c $(HDRS) | $(B)/pic
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -fPIC -c $< -o $@
+$(B)/libccnurbs.a: $(LIB_OBJ)
+	ar rcs $@ $^
+$(B)/libccnurbs.so: $(PIC_OBJ)
+	$(CC) -shared -o $@ $^ $(LDLIBS)
+$(B)/ccnurbs: $(wildcard csrc/tools/*.c) $(B)/libccnurbs.a $(HDRS)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $(wildcard csrc/tools/*.c) -o $@ $(B)/libccnurbs.a $(LDLIBS)
+
+$(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS) | $(B)/tests
+	$(CC) $(CPPFLAGS) -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
+
+$(B) $(B)/obj $(B)/pic $(B)/tests:
+	mkdir -p $@
+
+test: deps
+	@$(MAKE) --no-print-directory build $(TEST_BIN) $(TEST_DEPS)
+	@./tests/run_tests.sh
+
+demo: deps
+	@$(MAKE) --no-print-directory build
+	@./tests/demo.sh
+
+clean:
+	rm -rf $(B) out

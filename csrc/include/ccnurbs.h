@@ -1,0 +1,132 @@
+/* CCNURBS — non-uniform Catmull-Clark subdivision with G1 extraordinary points.
+ *
+ * One public header. C11, every symbol prefixed ccn_. Opaque handles, caller-owned
+ * buffers, every fallible call returns a ccn_status and fills a ccn_error (may be NULL).
+ * No globals: distinct handles may be used from distinct threads.
+ */
+#ifndef CCNURBS_H
+#define CCNURBS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CCN_VERSION_MAJOR 0
+#define CCN_VERSION_MINOR 1
+
+typedef enum {
+    CCN_OK = 0,
+    CCN_ERR_ARGUMENT,  /* bad argument: NULL, negative count, NaN/Inf coordinate, ... */
+    CCN_ERR_TOPOLOGY,  /* non-manifold edge/vertex, degenerate face, bad index, orientation */
+    CCN_ERR_KNOTS,     /* knot intervals that cannot be used */
+    CCN_ERR_MEMORY,    /* allocation failed or size would overflow */
+    CCN_ERR_INTERNAL,  /* a numerical failure the library could not recover from */
+    CCN_ERR_IO         /* file or parse error (OBJ reader, CLI) */
+} ccn_status;
+
+typedef enum { CCN_SCHEME_EIGEN = 0, CCN_SCHEME_NURSS, CCN_SCHEME_CATMULL_CLARK } ccn_scheme;
+typedef enum { CCN_CAP_GUIDED_BI5 = 0, CCN_CAP_REFINE } ccn_cap;
+/* Valence-2 boundary corners: smooth (OpenSubdiv EDGE_ONLY, Blender "All") or pinned
+ * (OpenSubdiv EDGE_AND_CORNER, Blender "Keep Corners"). */
+typedef enum { CCN_CORNERS_SMOOTH = 0, CCN_CORNERS_PINNED } ccn_corners;
+
+/* Which kind of element an error names (ccn_error.element_kind). */
+typedef enum {
+    CCN_ELEM_NONE = 0, CCN_ELEM_VERTEX, CCN_ELEM_EDGE, CCN_ELEM_FACE, CCN_ELEM_LINE
+} ccn_element_kind;
+
+typedef struct {
+    ccn_status status;
+    int32_t element_kind; /* ccn_element_kind */
+    int32_t element;      /* 0-based index of the offending element, -1 if none */
+    char message[256];    /* human-readable, names the element ("face 12 has ...") */
+} ccn_error;
+
+/* A polygon soup cage. Knot intervals are given per edge, an edge being identified by its
+ * two vertex indices (edge_verts). Values <= 0, NaN or Inf mean "unset". */
+typedef struct {
+    int32_t num_verts, num_faces, num_edges;
+    const double *positions;   /* 3 * num_verts */
+    const int32_t *face_sizes; /* num_faces */
+    const int32_t *face_verts; /* sum(face_sizes) */
+    const int32_t *edge_verts; /* 2 * num_edges, may be NULL (then num_edges = 0) */
+    const double *edge_knots;  /* num_edges, NULL = all unset (interval 1) */
+    const double *edge_creases;/* num_edges, may be NULL (reserved; not used yet) */
+} ccn_cage;
+
+typedef struct {
+    ccn_scheme scheme;        /* default EIGEN */
+    ccn_cap cap;              /* default GUIDED_BI5 */
+    int32_t levels;           /* refinement levels / samples 2^levels per cage-face side */
+    int32_t boundary_corners; /* ccn_corners, default SMOOTH */
+    int32_t threads;          /* 0 = default */
+} ccn_options;
+
+/* ---- control meshes ------------------------------------------------------------ */
+
+typedef struct ccn_mesh ccn_mesh; /* opaque: a validated polygon mesh with ring intervals */
+
+typedef struct {
+    int32_t num_verts, num_faces, num_edges;
+    int32_t num_face_verts;      /* sum of face sizes */
+    int32_t num_boundary_edges;
+    int32_t num_rings;           /* edge rings (quads only link edges into rings) */
+    int32_t num_ring_conflicts;  /* rings whose given edge values disagreed */
+    int32_t num_ignored_verts;   /* isolated vertices dropped from the cage */
+    int32_t num_ignored_edges;   /* loose edges (given in edge_verts, in no face) ignored */
+    int32_t num_extraordinary;   /* interior vertices of valence != 4 */
+    int32_t max_valence;
+    int32_t num_ev_fallbacks;    /* EVs that fell back from eigen to NURSS rules (refine) */
+    int32_t level;               /* refinement level of this mesh (0 = cage) */
+} ccn_mesh_info;
+
+/* Builds and validates a cage. Vertex indices of the resulting mesh are those of the cage
+ * (isolated vertices keep their slot but are counted in num_ignored_verts). */
+ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err);
+void ccn_mesh_destroy(ccn_mesh *mesh);
+ccn_status ccn_mesh_info_get(const ccn_mesh *mesh, ccn_mesh_info *info);
+/* Copies the mesh into caller-owned arrays; any pointer may be NULL.
+ * positions: 3*num_verts, face_sizes: num_faces, face_verts: num_face_verts,
+ * edge_verts: 2*num_edges, edge_knots: num_edges (the resolved ring interval). */
+ccn_status ccn_mesh_copy(const ccn_mesh *mesh, double *positions, int32_t *face_sizes,
+                         int32_t *face_verts, int32_t *edge_verts, double *edge_knots);
+/* Replaces the vertex positions (3*num_verts) keeping topology and intervals. */
+ccn_status ccn_mesh_set_positions(ccn_mesh *mesh, const double *positions, ccn_error *err);
+
+/* `levels` levels of refinement. Vertex order of each level: face points (face order),
+ * edge points (edge order), vertex points (vertex order); faces: each old face's sub-quads
+ * in corner order. Level 0 -> 1 splits non-quads. */
+ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opts,
+                      ccn_mesh **out, ccn_error *err);
+
+/* ---- extraordinary-vertex refinement matrix (Li, Finnigan, Sederberg 2016) ------ */
+
+typedef struct {
+    double lambda;    /* subdominant eigenvalue, eq (15) */
+    double T0[2];     /* translation of the eigen polyhedron, eq (28) */
+    int32_t fallback; /* 1 if the eigen rules failed and NURSS rules were used */
+    double residual;  /* max |M P0 - lambda P0 - 1 T0| on the eigen polyhedron */
+} ccn_ev_info;
+
+/* M ((2n+1) x (2n+1), row-major; rows F_0..F_{n-1}, E_0..E_{n-1}, V) for valence n >= 3
+ * and spoke intervals d[0..n-1] > 0. info may be NULL. */
+ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
+                         ccn_ev_info *info, ccn_error *err);
+
+/* ---- OBJ ------------------------------------------------------------------------ */
+
+typedef struct ccn_obj ccn_obj; /* parsed OBJ: v, f and "# knot i j d" lines */
+ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error *err);
+void ccn_obj_destroy(ccn_obj *obj);
+/* A view of the parsed data as a cage (valid while obj lives). */
+ccn_status ccn_obj_cage(const ccn_obj *obj, ccn_cage *cage);
+
+const char *ccn_status_name(ccn_status s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
