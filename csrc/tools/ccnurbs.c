@@ -1,0 +1,23 @@
+/* ccnurbs: command-line front end of the CCNURBS library (DESIGN §3).
+ * Errors: a message on stderr and exit code 2; no partial output files. */
+#include "cli.h"
+
+#include <string.h>
+
+static int usage(void) {
+    fprintf(stderr,
+            "usage:\n"
+            "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] in.obj out.obj\n"
+            "  ccnurbs matrix --valence N [--knots d0,d1,...] [--scheme eigen|nurss|cc]\n");
+    return 2;
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) return usage();
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "refine") == 0) return ccn_cmd_refine(argc - 1, argv + 1);
+    if (strcmp(cmd, "matrix") == 0) return ccn_cmd_matrix(argc - 1, argv + 1);
+    if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0) { usage(); return 0; }
+    fprintf(stderr, "ccnurbs: unknown command '%s'\n", cmd);
+    return usage();
+}

@@ -1,0 +1,118 @@
+/* Shared helpers of the ccnurbs command-line tool. */
+#include "cli.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+char *ccn_cli_read_file(const char *path, size_t *len) {
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "ccnurbs: cannot open %s: %s\n", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap + 1);
+    while (buf) {
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (n < cap) break;
+        char *nb = realloc(buf, 2 * cap + 1);
+        if (!nb) { free(buf); buf = NULL; break; }
+        buf = nb;
+        cap *= 2;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!buf || bad) {
+        fprintf(stderr, "ccnurbs: cannot read %s\n", path);
+        free(buf);
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+int ccn_cli_error(const char *what, const ccn_error *err) {
+    fprintf(stderr, "ccnurbs: %s: %s: %s\n", what, ccn_status_name(err->status), err->message);
+    return 2;
+}
+
+int ccn_cli_load_mesh(const char *path, ccn_mesh **out) {
+    size_t len = 0;
+    char *text = ccn_cli_read_file(path, &len);
+    if (!text) return 2;
+    ccn_obj *obj = NULL;
+    ccn_error err;
+    ccn_status st = ccn_obj_parse(text, len, &obj, &err);
+    free(text);
+    if (st) return ccn_cli_error(path, &err);
+    ccn_cage cage;
+    ccn_obj_cage(obj, &cage);
+    st = ccn_mesh_create(&cage, out, &err);
+    ccn_obj_destroy(obj);
+    if (st) return ccn_cli_error(path, &err);
+    return 0;
+}
+
+static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
+    ccn_mesh_info in;
+    ccn_mesh_info_get(m, &in);
+    double *pos = malloc(sizeof(double) * 3 * (size_t)(in.num_verts ? in.num_verts : 1));
+    int32_t *fs = malloc(sizeof(int32_t) * (size_t)(in.num_faces ? in.num_faces : 1));
+    int32_t *fv = malloc(sizeof(int32_t) * (size_t)(in.num_face_verts ? in.num_face_verts : 1));
+    int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)(in.num_edges ? in.num_edges : 1));
+    double *ek = malloc(sizeof(double) * (size_t)(in.num_edges ? in.num_edges : 1));
+    int rc = -1;
+    if (!pos || !fs || !fv || !ev || !ek) goto done;
+    ccn_mesh_copy(m, pos, fs, fv, ev, ek);
+    if (header) fprintf(f, "%s", header);
+    fprintf(f, "# ccnurbs level %d: %d vertices, %d faces, %d edges, %d ring conflicts, "
+               "%d EV fallbacks\n", (int)in.level, (int)in.num_verts, (int)in.num_faces,
+            (int)in.num_edges, (int)in.num_ring_conflicts, (int)in.num_ev_fallbacks);
+    for (int32_t v = 0; v < in.num_verts; v++)
+        fprintf(f, "v %.17g %.17g %.17g\n", pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
+    for (int32_t i = 0, k = 0; i < in.num_faces; i++) {
+        fputc('f', f);
+        for (int32_t j = 0; j < fs[i]; j++, k++) fprintf(f, " %d", (int)fv[k] + 1);
+        fputc('\n', f);
+    }
+    for (int32_t e = 0; e < in.num_edges; e++)
+        fprintf(f, "# knot %d %d %.17g\n", (int)ev[2 * e] + 1, (int)ev[2 * e + 1] + 1, ek[e]);
+    rc = ferror(f) ? -1 : 0;
+done:
+    free(pos); free(fs); free(fv); free(ev); free(ek);
+    return rc;
+}
+
+int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header) {
+    size_t n = strlen(path);
+    char *tmp = malloc(n + 16);
+    if (!tmp) return 2;
+    snprintf(tmp, n + 16, "%s.tmp%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        fprintf(stderr, "ccnurbs: cannot write %s: %s\n", path, strerror(errno));
+        free(tmp);
+        return 2;
+    }
+    int rc = write_body(f, m, header);
+    if (fclose(f) != 0) rc = -1;
+    if (rc == 0 && rename(tmp, path) != 0) rc = -1;
+    if (rc != 0) {
+        remove(tmp);
+        fprintf(stderr, "ccnurbs: cannot write %s\n", path);
+    }
+    free(tmp);
+    return rc ? 2 : 0;
+}
+
+int ccn_cli_int(const char *s, int lo, int hi, int *out) {
+    char *e;
+    long x = strtol(s, &e, 10);
+    if (e == s || *e || x < lo || x > hi) return -1;
+    *out = (int)x;
+    return 0;
+}

@@ -1,0 +1,24 @@
+/* Shared helpers of the ccnurbs command-line tool. */
+#ifndef CCN_CLI_H
+#define CCN_CLI_H
+#include "ccnurbs.h"
+#include <stdio.h>
+
+/* Subcommands: argv[0] is the subcommand name; return the process exit code. */
+int ccn_cmd_refine(int argc, char **argv);
+int ccn_cmd_matrix(int argc, char **argv);
+/* "eigen" / "nurss" / "cc" -> scheme; returns 0 on success. */
+int ccn_cli_scheme(const char *s, ccn_scheme *out);
+
+/* Reads a whole file (NUL-terminated); NULL on error with a message on stderr. */
+char *ccn_cli_read_file(const char *path, size_t *len);
+/* Parses an OBJ file and builds the mesh; prints the error and returns non-zero on failure. */
+int ccn_cli_load_mesh(const char *path, ccn_mesh **out);
+/* Writes a mesh as OBJ with "# knot" lines to path via a temporary file and rename, so no
+ * partial output is left behind on failure. Returns 0 on success. */
+int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header);
+/* Prints "ccnurbs: <what>: <message>" to stderr and returns 2. */
+int ccn_cli_error(const char *what, const ccn_error *err);
+/* Parses a non-negative int option value; returns 0 on success. */
+int ccn_cli_int(const char *s, int lo, int hi, int *out);
+#endif
