@@ -19,20 +19,22 @@ APT_PKGS = build-essential clang libclang-rt-14-dev libosd-dev liblapacke-dev li
 
 .PHONY: all deps build test demo clean
 
+all: build
+
 # Each tests/*/NAME.mk may add rules and append to TEST_DEPS (built before tests run).
 TEST_DEPS =
 -include $(wildcard tests/*/*.mk)
-
-all: build
 
 deps:
 	@./tests/deps.sh $(APT_PKGS)
 
 build: $(B)/libccnurbs.so $(B)/libccnurbs.a $(B)/ccnurbs
 
-$(B)/obj/%.o: csrc/%.c $(HDRS) | $(B)/obj
+$(B)/obj/%.o: csrc/%.c $(HDRS)
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/pic/%.o: csrc/%.c $(HDRS) | $(B)/pic
+$(B)/pic/%.o: csrc/%.c $(HDRS)
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -fPIC -c $< -o $@
 $(B)/libccnurbs.a: $(LIB_OBJ)
 	ar rcs $@ $^
@@ -41,11 +43,9 @@ $(B)/libccnurbs.so: $(PIC_OBJ)
 $(B)/ccnurbs: $(wildcard csrc/tools/*.c) $(B)/libccnurbs.a $(HDRS)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $(wildcard csrc/tools/*.c) -o $@ $(B)/libccnurbs.a $(LDLIBS)
 
-$(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS) | $(B)/tests
+$(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS)
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
-
-$(B) $(B)/obj $(B)/pic $(B)/tests:
-	mkdir -p $@
 
 test: deps
 	@$(MAKE) --no-print-directory build $(TEST_BIN) $(TEST_DEPS)

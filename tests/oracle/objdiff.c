@@ -1,0 +1,353 @@
+/* objdiff: compares two OBJ meshes whose vertex and face order may differ (test oracle).
+ *
+ *   objdiff [--tol-rel T] a.obj b.obj
+ *
+ * Needs equal vertex and face counts. Every vertex of a is matched to the nearest vertex of
+ * b (k-d tree); the match must be a bijection. The error is max |a_i - b_match(i)| divided
+ * by the bounding-box diagonal of a (1 if that is 0). Faces of a, renumbered through the
+ * match, must equal the faces of b as a multiset of cyclic sequences (any face order, any
+ * rotation, same orientation).
+ * Prints one line to stdout ("ok: ..." or "FAIL: ..."). Exit 0 if error <= T (default 1e-9)
+ * and faces match, 1 otherwise, 2 on usage/parse errors or count mismatch.
+ * Only `v` and `f` lines are read (1-based or negative indices, `a/b/c` tolerated).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    const char *path;
+    int nv, nf;
+    double *pos;  /* 3*nv */
+    int *fsize;   /* nf */
+    int *foff;    /* nf */
+    int *fverts;  /* sum fsize, 0-based */
+    long nfv;
+} Mesh;
+
+static _Noreturn void die(const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("objdiff: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    exit(2);
+}
+
+static void *xrealloc(void *p, size_t n) {
+    void *q = realloc(p, n ? n : 1);
+    if (!q) die("out of memory");
+    return q;
+}
+
+static char *read_file(const char *path, size_t *len) {
+    FILE *f = fopen(path, "rb");
+    if (!f) die("cannot open %s: %s", path, strerror(errno));
+    size_t cap = 1 << 16, n = 0;
+    char *buf = xrealloc(NULL, cap);
+    for (;;) {
+        if (n + 1 >= cap) buf = xrealloc(buf, cap *= 2);
+        size_t got = fread(buf + n, 1, cap - n - 1, f);
+        n += got;
+        if (got == 0) break;
+    }
+    if (ferror(f)) die("read error on %s", path);
+    fclose(f);
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+static int is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+static void parse_obj(const char *path, Mesh *m) {
+    size_t len;
+    char *text = read_file(path, &len);
+    int capv = 0, capf = 0;
+    long capfv = 0;
+    memset(m, 0, sizeof *m);
+    m->path = path;
+    long lineno = 0;
+    char *p = text;
+    while (*p) {
+        char *eol = strchr(p, '\n');
+        char *next = eol ? eol + 1 : p + strlen(p);
+        if (eol) *eol = '\0';
+        lineno++;
+        while (is_space(*p)) p++;
+        if (p[0] == 'v' && is_space(p[1])) {
+            if (m->nv == capv) {
+                capv = capv ? 2 * capv : 1024;
+                m->pos = xrealloc(m->pos, sizeof(double) * 3 * (size_t)capv);
+            }
+            char *s = p + 1;
+            for (int k = 0; k < 3; k++) {
+                char *end;
+                double x = strtod(s, &end);
+                if (end == s || !isfinite(x)) die("%s:%ld: bad vertex line", path, lineno);
+                m->pos[3 * m->nv + k] = x;
+                s = end;
+            }
+            m->nv++;
+        } else if (p[0] == 'f' && is_space(p[1])) {
+            if (m->nf == capf) {
+                capf = capf ? 2 * capf : 1024;
+                m->fsize = xrealloc(m->fsize, sizeof(int) * (size_t)capf);
+                m->foff = xrealloc(m->foff, sizeof(int) * (size_t)capf);
+            }
+            char *s = p + 1;
+            int n = 0;
+            for (;;) {
+                while (is_space(*s)) s++;
+                if (!*s) break;
+                char *end;
+                errno = 0;
+                long idx = strtol(s, &end, 10);
+                if (end == s || errno) die("%s:%ld: bad face index", path, lineno);
+                if (idx < 0) idx = m->nv + idx + 1;
+                if (idx < 1 || idx > 2000000000L) die("%s:%ld: face index out of range", path, lineno);
+                s = end;
+                while (*s && !is_space(*s)) s++; /* skip /vt/vn */
+                if (m->nfv == capfv) {
+                    capfv = capfv ? 2 * capfv : 4096;
+                    m->fverts = xrealloc(m->fverts, sizeof(int) * (size_t)capfv);
+                }
+                m->fverts[m->nfv++] = (int)(idx - 1);
+                n++;
+            }
+            if (n < 3) die("%s:%ld: face with fewer than 3 vertices", path, lineno);
+            m->fsize[m->nf] = n;
+            m->foff[m->nf] = (int)(m->nfv - n);
+            m->nf++;
+        }
+        p = next;
+    }
+    for (long i = 0; i < m->nfv; i++)
+        if (m->fverts[i] >= m->nv) die("%s: face index %ld beyond vertex count %d", path, (long)m->fverts[i] + 1, m->nv);
+    free(text);
+}
+
+/* ---- k-d tree over the vertices of b (implicit, balanced, median splits) ---- */
+typedef struct {
+    const double *pos;
+    int *idx;     /* permutation of points */
+    char *axis;   /* split axis at node (stored at the median slot) */
+} KdTree;
+
+static void kd_select(KdTree *t, int lo, int hi, int k, int ax) {
+    /* quickselect on idx[lo..hi) so that idx[k] is the k-th by coordinate ax */
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        double a = t->pos[3 * t->idx[lo] + ax], b = t->pos[3 * t->idx[mid] + ax],
+               c = t->pos[3 * t->idx[hi - 1] + ax];
+        double piv = (a < b) ? ((b < c) ? b : (a < c ? c : a)) : ((a < c) ? a : (b < c ? c : b));
+        int i = lo, j = hi - 1;
+        while (i <= j) {
+            while (t->pos[3 * t->idx[i] + ax] < piv) i++;
+            while (t->pos[3 * t->idx[j] + ax] > piv) j--;
+            if (i <= j) {
+                int tmp = t->idx[i];
+                t->idx[i] = t->idx[j];
+                t->idx[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j) hi = j + 1;
+        else if (k >= i) lo = i;
+        else return;
+    }
+}
+
+static void kd_build(KdTree *t, int lo, int hi) {
+    while (hi - lo > 1) {
+        double mn[3], mx[3];
+        for (int k = 0; k < 3; k++) mn[k] = mx[k] = t->pos[3 * t->idx[lo] + k];
+        for (int i = lo + 1; i < hi; i++)
+            for (int k = 0; k < 3; k++) {
+                double x = t->pos[3 * t->idx[i] + k];
+                if (x < mn[k]) mn[k] = x;
+                if (x > mx[k]) mx[k] = x;
+            }
+        int ax = 0;
+        for (int k = 1; k < 3; k++)
+            if (mx[k] - mn[k] > mx[ax] - mn[ax]) ax = k;
+        int mid = lo + (hi - lo) / 2;
+        kd_select(t, lo, hi, mid, ax);
+        t->axis[mid] = (char)ax;
+        kd_build(t, lo, mid);
+        lo = mid + 1;
+    }
+    if (hi - lo == 1) t->axis[lo] = 0;
+}
+
+static void kd_nearest(const KdTree *t, int lo, int hi, const double *q, int *best, double *bestd2) {
+    while (hi > lo) {
+        int mid = lo + (hi - lo) / 2;
+        const double *p = t->pos + 3 * t->idx[mid];
+        double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < *bestd2 || (d2 == *bestd2 && t->idx[mid] < *best)) {
+            *bestd2 = d2;
+            *best = t->idx[mid];
+        }
+        if (hi - lo == 1) return;
+        int ax = t->axis[mid];
+        double diff = q[ax] - p[ax];
+        int nlo, nhi, flo, fhi; /* near and far halves */
+        if (diff < 0) { nlo = lo; nhi = mid; flo = mid + 1; fhi = hi; }
+        else { nlo = mid + 1; nhi = hi; flo = lo; fhi = mid; }
+        kd_nearest(t, nlo, nhi, q, best, bestd2);
+        if (diff * diff > *bestd2) return;
+        lo = flo;
+        hi = fhi;
+    }
+}
+
+/* ---- faces as canonical cyclic sequences ---- */
+typedef struct {
+    int n;
+    const int *v; /* canonical rotation, n entries */
+} Face;
+
+static int face_cmp(const void *x, const void *y) {
+    const Face *a = x, *b = y;
+    if (a->n != b->n) return a->n < b->n ? -1 : 1;
+    for (int i = 0; i < a->n; i++)
+        if (a->v[i] != b->v[i]) return a->v[i] < b->v[i] ? -1 : 1;
+    return 0;
+}
+
+/* Writes each face (vertex ids through map, if given) rotated so its smallest id is first. */
+static Face *canon_faces(const Mesh *m, const int *map, int **store) {
+    Face *f = xrealloc(NULL, sizeof(Face) * (size_t)m->nf);
+    int *s = xrealloc(NULL, sizeof(int) * (size_t)m->nfv);
+    for (int i = 0; i < m->nf; i++) {
+        int n = m->fsize[i], off = m->foff[i], r = 0;
+        const int *src = m->fverts + off;
+        for (int k = 1; k < n; k++) {
+            int vk = map ? map[src[k]] : src[k], vr = map ? map[src[r]] : src[r];
+            if (vk < vr) r = k;
+        }
+        for (int k = 0; k < n; k++) {
+            int v = src[(r + k) % n];
+            s[off + k] = map ? map[v] : v;
+        }
+        f[i].n = n;
+        f[i].v = s + off;
+    }
+    *store = s;
+    return f;
+}
+
+int main(int argc, char **argv) {
+    double tol = 1e-9;
+    const char *pa = NULL, *pb = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--tol-rel") && i + 1 < argc) {
+            char *end;
+            tol = strtod(argv[++i], &end);
+            if (*end || !(tol >= 0)) die("bad --tol-rel '%s'", argv[i]);
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            die("usage: objdiff [--tol-rel T] a.obj b.obj (unknown option %s)", argv[i]);
+        } else if (!pa) pa = argv[i];
+        else if (!pb) pb = argv[i];
+        else die("usage: objdiff [--tol-rel T] a.obj b.obj");
+    }
+    if (!pa || !pb) die("usage: objdiff [--tol-rel T] a.obj b.obj");
+
+    Mesh a, b;
+    parse_obj(pa, &a);
+    parse_obj(pb, &b);
+    if (a.nv != b.nv || a.nf != b.nf) {
+        fprintf(stderr, "objdiff: count mismatch: %s has %d verts %d faces, %s has %d verts %d faces\n",
+                pa, a.nv, a.nf, pb, b.nv, b.nf);
+        printf("FAIL: count mismatch: %d/%d verts, %d/%d faces\n", a.nv, b.nv, a.nf, b.nf);
+        return 2;
+    }
+    if (a.nv == 0) {
+        printf("ok: empty meshes\n");
+        return 0;
+    }
+
+    /* bounding-box diagonal of a */
+    double mn[3], mx[3];
+    for (int k = 0; k < 3; k++) mn[k] = mx[k] = a.pos[k];
+    for (int i = 1; i < a.nv; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = a.pos[3 * i + k];
+            if (x < mn[k]) mn[k] = x;
+            if (x > mx[k]) mx[k] = x;
+        }
+    double diag = sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) +
+                       (mx[2] - mn[2]) * (mx[2] - mn[2]));
+    if (!(diag > 0)) diag = 1.0;
+
+    KdTree t;
+    t.pos = b.pos;
+    t.idx = xrealloc(NULL, sizeof(int) * (size_t)b.nv);
+    t.axis = xrealloc(NULL, (size_t)b.nv);
+    for (int i = 0; i < b.nv; i++) t.idx[i] = i;
+    kd_build(&t, 0, b.nv);
+
+    int *map = xrealloc(NULL, sizeof(int) * (size_t)a.nv);
+    int *used = calloc((size_t)b.nv, sizeof(int));
+    if (!used) die("out of memory");
+    double worst = -1.0;
+    int worst_i = 0, dup = 0, first_dup = -1;
+    for (int i = 0; i < a.nv; i++) {
+        int best = -1;
+        double bestd2 = INFINITY;
+        kd_nearest(&t, 0, b.nv, a.pos + 3 * i, &best, &bestd2);
+        map[i] = best;
+        if (used[best]++) {
+            dup++;
+            if (first_dup < 0) first_dup = i;
+        }
+        double d = sqrt(bestd2);
+        if (d > worst) {
+            worst = d;
+            worst_i = i;
+        }
+    }
+    double rel = worst / diag;
+
+    /* faces */
+    int *sa, *sb;
+    Face *fa = canon_faces(&a, map, &sa), *fb = canon_faces(&b, NULL, &sb);
+    qsort(fa, (size_t)a.nf, sizeof(Face), face_cmp);
+    qsort(fb, (size_t)b.nf, sizeof(Face), face_cmp);
+    int missing = 0, ia = 0, ib = 0;
+    const Face *first_missing = NULL;
+    while (ia < a.nf && ib < b.nf) {
+        int c = face_cmp(&fa[ia], &fb[ib]);
+        if (c == 0) { ia++; ib++; }
+        else if (c < 0) { if (!first_missing) first_missing = &fa[ia]; missing++; ia++; }
+        else ib++;
+    }
+    if (ia < a.nf && !first_missing) first_missing = &fa[ia];
+    missing += a.nf - ia;
+
+    int ok = rel <= tol && dup == 0 && missing == 0;
+    if (ok) {
+        printf("ok: %d verts, %d faces, max_rel %.3g\n", a.nv, a.nf, rel);
+        return 0;
+    }
+    const double *p = a.pos + 3 * worst_i, *q = b.pos + 3 * map[worst_i];
+    printf("FAIL: %d verts, %d faces, max_rel %.3g", a.nv, a.nf, rel);
+    if (!(rel <= tol))
+        printf(" > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
+               tol, worst_i + 1, p[0], p[1], p[2], map[worst_i] + 1, q[0], q[1], q[2]);
+    if (dup) printf("; not a bijection: %d b-vertices matched more than once (a-vertex %d)", dup, first_dup + 1);
+    if (missing) {
+        printf("; %d of %d faces of a not in b (e.g. b-vertices", missing, a.nf);
+        for (int k = 0; k < first_missing->n; k++) printf(" %d", first_missing->v[k] + 1);
+        printf(")");
+    }
+    printf("\n");
+    return 1;
+}

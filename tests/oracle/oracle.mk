@@ -1,0 +1,19 @@
+# OpenSubdiv oracle tools (included by the main Makefile; B = build dir).
+# Notes: the main Makefile's phony `build` target has the same name as $(B), so an
+# order-only `| $(B)` prerequisite would build the whole library; the recipes create the
+# directory themselves instead. .DEFAULT_GOAL is saved/restored so that this fragment,
+# included before `all:`, does not become the default goal.
+ORACLE_SAVED_GOAL := $(.DEFAULT_GOAL)
+ORACLE_CFLAGS      = -std=c11 -O2 -Wall -Wextra -Werror
+ORACLE_CXXFLAGS    = -std=c++14 -O2 -Wall -Wextra -Werror
+
+$(B)/osd_refine: tests/oracle/osd_refine.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(ORACLE_CXXFLAGS) $< -o $@ -losdCPU
+
+$(B)/objdiff: tests/oracle/objdiff.c
+	@mkdir -p $(@D)
+	$(CC) $(ORACLE_CFLAGS) $< -o $@ -lm
+
+TEST_DEPS += $(B)/osd_refine $(B)/objdiff
+.DEFAULT_GOAL := $(ORACLE_SAVED_GOAL)
