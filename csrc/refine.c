@@ -88,8 +88,12 @@ static ccn_status build_ev_matrices(level_ctx *c, ccn_error *err) {
         int32_t v = c->ev_list[i], n = ccn__valence(m, v);
         for (int32_t k = 0; k < n; k++) d[k] = m->eknot[ccn__fan_edge(m, v, k)];
         ccn_ev_info info;
-        ccn_status st = ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, c->M + c->Moff[i], &info, err);
-        if (st) { free(d); return st; }
+        ccn_status st = ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, c->M + c->Moff[i], &info, NULL);
+        if (st) {
+            free(d);
+            return ccn__fail(err, st, CCN_ELEM_VERTEX, v,
+                             "extraordinary vertex %d: refinement matrix failed", (int)v);
+        }
         c->fallbacks += info.fallback != 0;
     }
     free(d);
@@ -186,6 +190,7 @@ static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, cc
         for (int32_t e = 0; e < r->ne; e++) mx = r->eknot[e] > mx ? r->eknot[e] : mx;
         for (int32_t e = 0; e < r->ne; e++) r->eknot[e] /= mx;
         r->knot_scale = m->knot_scale * mx;
+        r->info.num_rings = 2 * m->info.num_rings; /* each ring splits in two */
         return CCN_OK;
     }
     for (int32_t e = 0; e < r->ne; e++) cand[e] *= m->knot_scale;
