@@ -1,0 +1,60 @@
+#!/bin/sh
+# CLI contract: errors print a message on stderr, exit 2 and write no output file;
+# a successful refine writes v/f lines and "# knot" lines with the refined intervals.
+cd "$(dirname "$0")/../.." || exit 2
+CLI=${CCNURBS:-build/ccnurbs}
+T=$(mktemp -d) || exit 2
+trap 'rm -rf "$T"' EXIT
+pass=0; fail=0
+ok()  { pass=$((pass+1)); echo "ok   $1"; }
+bad() { fail=$((fail+1)); echo "FAIL $1"; }
+
+# expect_error NAME EXPECTED-MESSAGE-FRAGMENT ARGS... : exit 2, message, no out file
+expect_error() {
+  name=$1; msg=$2; shift 2
+  rm -f "$T/out.obj"
+  "$CLI" "$@" > "$T/stdout" 2> "$T/stderr"; rc=$?
+  if [ "$rc" -ne 2 ]; then bad "$name: exit $rc, expected 2"; return; fi
+  if ! grep -q -- "$msg" "$T/stderr"; then bad "$name: stderr lacks '$msg': $(cat "$T/stderr")"; return; fi
+  if [ -e "$T/out.obj" ] || ls "$T"/out.obj.tmp* >/dev/null 2>&1; then bad "$name: output file left behind"; return; fi
+  ok "$name"
+}
+
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' > "$T/nonmanifold.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 3\nf 1 4 5\n' > "$T/bowtie.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n' > "$T/repeat.obj"
+printf 'v 0 0 0\nv 1 0 0\nf 1 2\n' > "$T/twogon.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n' > "$T/range.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 1 2 6 5\n' > "$T/orient.obj"
+printf 'v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n' > "$T/nan.obj"
+printf 'v 0 0 0\nv 1 0\n' > "$T/truncated.obj"
+printf '\001\002garbage\377\nf x y z\n' > "$T/garbage.obj"
+: > "$T/empty.obj"
+
+expect_error "non-manifold edge"  "edge 0-1 is shared by 3 faces" refine --levels 1 "$T/nonmanifold.obj" "$T/out.obj"
+expect_error "bowtie vertex"      "vertex 0 is non-manifold"      refine --levels 1 "$T/bowtie.obj" "$T/out.obj"
+expect_error "repeated vertex"    "face 0 repeats vertex 1"       refine --levels 1 "$T/repeat.obj" "$T/out.obj"
+expect_error "two-gon"            "face 0 has 2 vertices"         refine --levels 1 "$T/twogon.obj" "$T/out.obj"
+expect_error "index out of range" "vertex index 8"                refine --levels 1 "$T/range.obj" "$T/out.obj"
+expect_error "orientation"        "inconsistent orientation"      refine --levels 1 "$T/orient.obj" "$T/out.obj"
+expect_error "NaN coordinate"     "vertex 1 has a non-finite"     refine --levels 1 "$T/nan.obj" "$T/out.obj"
+expect_error "truncated OBJ"      "line 2"                        refine --levels 1 "$T/truncated.obj" "$T/out.obj"
+expect_error "garbage OBJ"        "line 2"                        refine --levels 1 "$T/garbage.obj" "$T/out.obj"
+expect_error "empty OBJ"          "no faces"                      refine --levels 1 "$T/empty.obj" "$T/out.obj"
+expect_error "missing file"       "cannot open"                   refine --levels 1 "$T/none.obj" "$T/out.obj"
+expect_error "bad scheme"         "bad --scheme"                  refine --scheme foo tests/data/cube.obj "$T/out.obj"
+expect_error "bad levels"         "levels"                        refine --levels -2 tests/data/cube.obj "$T/out.obj"
+expect_error "unknown command"    "unknown command"               frobnicate
+expect_error "matrix valence"     "valence"                       matrix --valence 2
+
+# A successful refine: intervals come back halved, as "# knot" lines.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n# knot 1 2 3.0\n' > "$T/quad.obj"
+if "$CLI" refine --scheme eigen --levels 2 "$T/quad.obj" "$T/out.obj" 2> "$T/stderr"; then
+  nv=$(grep -c '^v ' "$T/out.obj"); nf=$(grep -c '^f ' "$T/out.obj")
+  k=$(awk '/^# knot/ {print $5}' "$T/out.obj" | sort -u | tr '\n' ' ')
+  if [ "$nv" = 25 ] && [ "$nf" = 16 ] && [ "$k" = "0.25 0.75 " ]; then ok "refine writes halved intervals"
+  else bad "refine output: $nv verts, $nf faces, knots '$k'"; fi
+else bad "refine of a quad failed: $(cat "$T/stderr")"; fi
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
