@@ -397,6 +397,8 @@ CAGES = [
     ("ngon_prism.obj", ngon_prism,
      "closed hexagonal prism, caps: hexagon / pentagon + triangle"),
     ("flip35.obj", flip35, "open 6x6 grid with a rotated edge: interior valence 3 and 5"),
+    ("fan64.obj", lambda: fan(64, 1, center_z=0.5)[:2],
+     "open fan, interior valence-64 center, 1 quad per sector (high-valence EV)"),
     ("fan3.obj", lambda: fan_cage(3), "open fan, interior valence-3 center, 2x2 quads per sector"),
     ("fan5.obj", lambda: fan_cage(5), "open fan, interior valence-5 center, 2x2 quads per sector"),
     ("fan6.obj", lambda: fan_cage(6), "open fan, interior valence-6 center, 2x2 quads per sector"),
