@@ -79,4 +79,23 @@ ccn_status ccn__resolve_rings(ccn_mesh *m, const double *edge_values, const int3
 
 #define CCN_KNOT_MIN_RATIO 1e-6
 
+/* ---- refine.c: one refinement level, split so a plan can re-run only the points ---- */
+typedef struct {
+    const ccn_mesh *m;   /* the level's topology, intervals and (input) positions */
+    int pinned, red;     /* red: eigen matrices at the EVs */
+    int32_t *erep;       /* a half-edge per edge */
+    int32_t nev, *ev_list;
+    double *M;           /* concatenated EV matrices ((2n+1)^2 each) */
+    size_t *Moff;
+    double *H;           /* scratch: 3*ne curve edge points */
+    int32_t fallbacks;
+} ccn__level;
+ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                              ccn_error *err);
+/* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
+void ccn__level_points(const ccn__level *c, double *out);
+/* Topology and intervals of the next level (positions uninitialised). */
+ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
+void ccn__level_free(ccn__level *c);
+
 #endif

@@ -21,54 +21,41 @@
 #include <math.h>
 #include <string.h>
 
-typedef struct {
-    const ccn_mesh *m;
-    int pinned, red;    /* red: use the eigen matrix M at EVs */
-    double *H;          /* 3*ne curve edge points */
-    double *fp, *ep, *vp; /* new points, slices of the new mesh's positions */
-    int32_t *erep;      /* a half-edge per edge */
-    int32_t *ev_list;   /* interior EVs */
-    int32_t nev;
-    double *M;          /* concatenated EV matrices */
-    size_t *Moff;
-    int32_t fallbacks;
-} level_ctx;
-
 /* ---- points ----------------------------------------------------------------------- */
 
-static void face_points(level_ctx *c) {
+static void face_points(const ccn__level *c, double *fp) {
     const ccn_mesh *m = c->m;
     for (int32_t f = 0; f < m->nf; f++) {
-        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, c->fp + 3 * (size_t)f);
-        else ccn__ngon_face_point(m, f, c->fp + 3 * (size_t)f);
+        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
+        else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
     }
 }
 
-static void edge_points(level_ctx *c) {
+static void edge_points(const ccn__level *c, const double *fp, double *ep) {
     const ccn_mesh *m = c->m;
     for (int32_t e = 0; e < m->ne; e++)
         ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
     for (int32_t e = 0; e < m->ne; e++)
-        ccn__edge_point(m, c->erep[e], c->H, c->fp, c->ep + 3 * (size_t)e);
+        ccn__edge_point(m, c->erep[e], c->H, fp, ep + 3 * (size_t)e);
 }
 
-static void vertex_points(level_ctx *c) {
+static void vertex_points(const ccn__level *c, const double *fp, double *vp) {
     const ccn_mesh *m = c->m;
     for (int32_t v = 0; v < m->nv; v++) {
-        double *out = c->vp + 3 * (size_t)v;
+        double *out = vp + 3 * (size_t)v;
         if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
             memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
         } else if (m->vboundary[v]) {
             ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
         } else {
-            ccn__nurss_vertex_point(m, v, c->H, c->fp, out);
+            ccn__nurss_vertex_point(m, v, c->H, fp, out);
         }
     }
 }
 
 /* ---- red points: the eigen matrix M at each EV ------------------------------------ */
 
-static ccn_status build_ev_matrices(level_ctx *c, ccn_error *err) {
+static ccn_status build_ev_matrices(ccn__level *c, ccn_error *err) {
     const ccn_mesh *m = c->m;
     size_t total = 0;
     int32_t maxn = 0;
@@ -109,7 +96,7 @@ static int32_t ring_point(const ccn_mesh *m, int32_t v, int32_t n, int32_t j) {
 }
 
 /* Overwrites the red points of kind `which` (0 faces, 1 spokes, 2 vertex). */
-static void apply_red(level_ctx *c, int which) {
+static void apply_red(const ccn__level *c, int which, double *fp, double *ep, double *vp) {
     const ccn_mesh *m = c->m;
     for (int32_t i = 0; i < c->nev; i++) {
         int32_t v = c->ev_list[i], n = ccn__valence(m, v), sz = 2 * n + 1;
@@ -123,9 +110,9 @@ static void apply_red(level_ctx *c, int which) {
                 acc[0] += w * p[0]; acc[1] += w * p[1]; acc[2] += w * p[2];
             }
             int32_t h = m->vfan[m->vfan_start[v] + (r % n)];
-            double *out = which == 0 ? c->fp + 3 * (size_t)m->hface[h]
-                        : which == 1 ? c->ep + 3 * (size_t)m->hedge[h]
-                                     : c->vp + 3 * (size_t)v;
+            double *out = which == 0 ? fp + 3 * (size_t)m->hface[h]
+                        : which == 1 ? ep + 3 * (size_t)m->hedge[h]
+                                     : vp + 3 * (size_t)v;
             memcpy(out, acc, sizeof acc);
         }
     }
@@ -202,7 +189,7 @@ static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, cc
 
 /* ---- one level ---------------------------------------------------------------------- */
 
-static ccn_status collect_evs(level_ctx *c, ccn_error *err) {
+static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
     const ccn_mesh *m = c->m;
     c->nev = 0;
     if (!c->red) return CCN_OK;
@@ -211,40 +198,60 @@ static ccn_status collect_evs(level_ctx *c, ccn_error *err) {
     return build_ev_matrices(c, err);
 }
 
-static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, ccn_mesh **out,
-                               ccn_error *err) {
+void ccn__level_free(ccn__level *c) {
+    if (!c) return;
+    free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
+    memset(c, 0, sizeof *c);
+}
+
+ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                              ccn_error *err) {
+    memset(c, 0, sizeof *c);
+    c->m = m;
+    c->pinned = pinned;
+    c->red = scheme == CCN_SCHEME_EIGEN && m->info.level >= 1;
+    c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
+    c->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
+    c->ev_list = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    c->Moff = malloc(sizeof(size_t) * (size_t)(m->nv ? m->nv : 1));
+    if (!c->H || !c->erep || !c->ev_list || !c->Moff) {
+        ccn__level_free(c);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (refinement)");
+    }
+    for (int32_t e = 0; e < m->ne; e++) c->erep[e] = -1;
+    for (int32_t h = m->nh - 1; h >= 0; h--) c->erep[m->hedge[h]] = h;
+    ccn_status st = collect_evs(c, err);
+    if (st) ccn__level_free(c);
+    return st;
+}
+
+void ccn__level_points(const ccn__level *c, double *out) {
+    const ccn_mesh *m = c->m;
+    double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
+    face_points(c, fp);
+    apply_red(c, 0, fp, ep, vp);
+    edge_points(c, fp, ep);
+    apply_red(c, 1, fp, ep, vp);
+    vertex_points(c, fp, vp);
+    apply_red(c, 2, fp, ep, vp);
+}
+
+ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err) {
+    const ccn_mesh *m = c->m;
     int64_t nv2 = (int64_t)m->nf + m->ne + m->nv, nh2 = 4 * (int64_t)m->nh;
     int64_t ne2 = 2 * (int64_t)m->ne + m->nh;
+    *out = NULL;
     if (nh2 > INT32_MAX / 8 || nv2 > INT32_MAX / 8 || ne2 > INT32_MAX / 8)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
                          "refined mesh would have %lld face corners: too large", (long long)nh2);
     ccn_mesh *r = ccn__mesh_alloc((int32_t)nv2, m->nh, (int32_t)nh2, (int32_t)ne2);
-    level_ctx c = {0};
-    c.m = m;
-    c.pinned = pinned;
-    c.red = scheme == CCN_SCHEME_EIGEN && m->info.level >= 1;
-    c.H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
-    c.erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
-    c.ev_list = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
-    c.Moff = malloc(sizeof(size_t) * (size_t)(m->nv ? m->nv : 1));
     double *cand = malloc(sizeof(double) * (size_t)ne2);
     ccn_status st = CCN_OK;
-    if (!r || !c.H || !c.erep || !c.ev_list || !c.Moff || !cand) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (refinement)");
+    if (!r || !cand) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                       "out of memory for a refined mesh of %lld face corners", (long long)nh2);
         goto done;
     }
-    for (int32_t e = 0; e < m->ne; e++) c.erep[e] = -1;
-    for (int32_t h = m->nh - 1; h >= 0; h--) c.erep[m->hedge[h]] = h;
-    c.fp = r->pos;
-    c.ep = r->pos + 3 * (size_t)m->nf;
-    c.vp = r->pos + 3 * ((size_t)m->nf + m->ne);
-    if ((st = collect_evs(&c, err))) goto done;
-    face_points(&c);
-    apply_red(&c, 0);
-    edge_points(&c);
-    apply_red(&c, 1);
-    vertex_points(&c);
-    apply_red(&c, 2);
     refine_topology(m, r, cand);
     if (ccn__mesh_build_fans(r)) {
         st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
@@ -254,13 +261,24 @@ static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, ccn_me
     ccn__mesh_update_info(r);
     r->info.num_ring_conflicts = m->info.num_ring_conflicts;
     r->info.num_ignored_edges = m->info.num_ignored_edges;
-    r->info.num_ev_fallbacks = m->info.num_ev_fallbacks + c.fallbacks;
+    r->info.num_ev_fallbacks = m->info.num_ev_fallbacks + c->fallbacks;
     r->info.level = m->info.level + 1;
     *out = r;
     r = NULL;
 done:
-    free(c.H); free(c.erep); free(c.ev_list); free(c.Moff); free(c.M); free(cand);
+    free(cand);
     ccn_mesh_destroy(r);
+    return st;
+}
+
+static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, ccn_mesh **out,
+                               ccn_error *err) {
+    ccn__level c;
+    ccn_status st = ccn__level_prepare(&c, m, scheme, pinned, err);
+    if (st) return st;
+    st = ccn__level_topology(&c, out, err);
+    if (!st) ccn__level_points(&c, (*out)->pos);
+    ccn__level_free(&c);
     return st;
 }
 

@@ -116,6 +116,45 @@ typedef struct {
 ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
                          ccn_ev_info *info, ccn_error *err);
 
+/* ---- limit surface: plan once, evaluate many times ------------------------------ */
+
+typedef struct ccn_plan ccn_plan; /* opaque: topology, intervals, options, precomputed data */
+
+typedef struct {
+    int32_t num_verts;        /* output mesh vertices */
+    int32_t num_faces;        /* output mesh faces (all quads) */
+    int32_t num_cage_verts;   /* length/3 of the positions ccn_plan_evaluate expects */
+    int32_t levels;           /* effective output level (>= 1 when the cage has non-quads) */
+    int32_t refine_levels;    /* internal refinement depth */
+    int32_t num_extraordinary;/* interior EVs of the cage after the first split */
+    int32_t num_caps;         /* EVs filled by the guided bi-5 cap */
+    int32_t num_cap_fallbacks;/* EVs that use the refined limit instead of the cap */
+    int32_t num_ev_fallbacks; /* EVs whose eigen rules fell back to NURSS */
+    int32_t num_ring_conflicts, num_ignored_verts, num_ignored_edges;
+} ccn_sizes;
+
+/* Caller-owned output buffers; sizes from ccn_plan_sizes. */
+typedef struct {
+    double *positions;    /* 3 * num_verts (required) */
+    double *normals;      /* 3 * num_verts unit normals, may be NULL */
+    int32_t *face_verts;  /* 4 * num_faces, counter-clockwise, may be NULL */
+    int32_t *face_origin; /* num_faces: index of the cage face it lies on, may be NULL */
+} ccn_limit_mesh;
+
+/* Output topology: the level-L refinement of the cage, i.e. every cage quad sampled on a
+ * (2^L+1)^2 grid of its parameter domain (each quad of a split n-gon on (2^(L-1)+1)^2),
+ * shared samples along edges: watertight, no duplicate vertices. Positions are exact limit
+ * positions (cap = REFINE) or the guided bi-5 surface in the EV holes (cap = GUIDED_BI5);
+ * normals are exact (from derivatives). */
+ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
+                           ccn_error *err);
+ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);
+/* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs
+ * (face_verts, face_origin) are the same on every call. */
+ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
+                             ccn_error *err);
+void ccn_plan_destroy(ccn_plan *plan);
+
 /* ---- OBJ ------------------------------------------------------------------------ */
 
 typedef struct ccn_obj ccn_obj; /* parsed OBJ: v, f and "# knot i j d" lines */
