@@ -7,6 +7,10 @@
 /* Subcommands: argv[0] is the subcommand name; return the process exit code. */
 int ccn_cmd_refine(int argc, char **argv);
 int ccn_cmd_matrix(int argc, char **argv);
+int ccn_cmd_limit(int argc, char **argv);
+/* Parses an OBJ and creates a plan; prints the error and returns 2 on failure. */
+int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan);
+int ccn_cmd_experiment(int argc, char **argv);
 /* "eigen" / "nurss" / "cc" -> scheme; returns 0 on success. */
 int ccn_cli_scheme(const char *s, ccn_scheme *out);
 

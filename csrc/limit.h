@@ -1,0 +1,35 @@
+/* Exact limit stencils at refined vertices (limit.c). Internal. */
+#ifndef CCN_LIMIT_H
+#define CCN_LIMIT_H
+
+#include "internal.h"
+
+#define CCN_STENCIL_MAX 2049 /* 2n+1 for valence n <= 1024 */
+
+/* Weights over vertices of one mesh level: position (wp) and two tangents (wu, wv) whose
+ * cross product wu x wv points along the outward normal (except for EVs: see ev_limit). */
+typedef struct {
+    int n;
+    int32_t v[CCN_STENCIL_MAX];
+    double wp[CCN_STENCIL_MAX], wu[CCN_STENCIL_MAX], wv[CCN_STENCIL_MAX];
+} ccn__stencil;
+
+enum {
+    CCN_LIMIT_REGULAR = 0,     /* tensor B-spline limit (mirror ghosts on the boundary) */
+    CCN_LIMIT_BOUNDARY_CURVE,  /* smooth corner or boundary EV */
+    CCN_LIMIT_EV,              /* interior extraordinary vertex: use ccn__ev_limit */
+    CCN_LIMIT_ISOLATED
+};
+
+int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
+/* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the
+ * stencil is left empty). */
+int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s);
+/* 1-ring of an interior vertex in M's order (F_0..F_{n-1}, E_0..E_{n-1}, V); returns 2n+1. */
+int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring);
+/* Limit point and tangent directions of an interior EV from the left eigenvectors of M
+ * (scheme's matrix). The tangent pair's orientation is arbitrary: callers orient the
+ * normal with the 1-ring. */
+ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
+                         ccn_error *err);
+#endif

@@ -1,0 +1,51 @@
+/* The plan: everything that depends on topology, intervals and options (internal). */
+#ifndef CCN_PLAN_H
+#define CCN_PLAN_H
+
+#include "internal.h"
+#include "limit.h"
+
+struct ccn__bi5;
+
+/* One extraordinary vertex filled by the guided bi-5 cap (K&P 2018). */
+typedef struct {
+    int32_t n;          /* valence */
+    int32_t *cnet;      /* 6n+1 level-K vertex indices, SPEC §1.2 order */
+    int32_t *ring;      /* 2n+1 level-K 1-ring (centre stencil support) */
+    double *l0;         /* 2n+1 limit weights (centre point) */
+    double *knots;      /* n spoke intervals at level K */
+    const struct ccn__bi5 *op; /* shared per valence, owned by the plan */
+    double *patches;    /* (3*nsig+1)*n bi-5 patches, 36*3 doubles each */
+} ccn__cap;
+
+struct ccn_plan {
+    ccn_options opts;
+    int32_t L, R, K;        /* output level, refinement depth, cap level (-1: none) */
+    ccn_mesh **lev;         /* R+1 meshes: lev[0] is the cage */
+    ccn__level *prep;       /* R prepared levels */
+    int32_t ncage;
+    /* output mesh = level L without isolated vertices */
+    int32_t nout_v, nout_f;
+    int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */
+    int32_t *out_fv, *out_origin;
+    /* limit stencils over level-R vertices, CSR */
+    int32_t *st_start, *st_v;
+    double *st_wp, *st_wu, *st_wv;
+    int32_t *orient;        /* 3 level-R vertices per output vertex (v, a, b) or -1: flip the
+                               normal to agree with (a-v) x (b-v) */
+    /* caps */
+    int32_t ncap;
+    ccn__cap *caps;
+    struct ccn__bi5 **ops;  /* one per valence used, nops entries */
+    int32_t *op_n;          /* valence of each op */
+    int32_t nops;
+    int32_t nhv;            /* output vertices evaluated on a cap */
+    int32_t *hv_out, *hv_cap, *hv_sector;
+    double *hv_uv;
+    ccn_sizes sizes;
+};
+
+/* tessellate.c */
+ccn_status ccn__tess_output(ccn_plan *p, ccn_error *err);
+ccn_status ccn__tess_holes(ccn_plan *p, ccn_error *err);
+#endif

@@ -1,0 +1,201 @@
+/* The output mesh: the level-L refinement of the cage (a (2^L+1)^2 grid per cage quad,
+ * shared samples along edges), its per-face origin, the limit stencil of every output
+ * vertex, and the vertices that lie in a guided-cap hole with their hole coordinates. */
+#include "plan.h"
+
+#include <string.h>
+
+/* Level-R descendant (vertex-point chain) of level-l vertex v. */
+static int32_t descend_vertex(const ccn_plan *p, int32_t l, int32_t v, int32_t to) {
+    for (; l < to; l++) v += p->lev[l]->nf + p->lev[l]->ne;
+    return v;
+}
+
+static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L];
+    p->vmapL = malloc(sizeof(int32_t) * (size_t)mL->nv);
+    p->out_fv = malloc(sizeof(int32_t) * (size_t)mL->nh);
+    p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
+    if (!p->vmapL || !p->out_fv || !p->out_origin)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    int32_t no = 0;
+    for (int32_t v = 0; v < mL->nv; v++)
+        p->vmapL[v] = mL->vfan_start[v + 1] > mL->vfan_start[v] ? no++ : -1;
+    p->nout_v = no;
+    p->nout_f = mL->nf;
+    for (int32_t h = 0; h < mL->nh; h++) p->out_fv[h] = p->vmapL[mL->hvert[h]];
+    for (int32_t f = 0; f < mL->nf; f++) {
+        int32_t g = f;
+        for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
+        p->out_origin[f] = g;
+    }
+    return CCN_OK;
+}
+
+typedef struct { int32_t n, cap; int32_t *v; double *wp, *wu, *wv; } csr_buf;
+
+static int csr_push(csr_buf *b, const ccn__stencil *s) {
+    if (b->n + s->n > b->cap) {
+        int64_t nc = 2 * (int64_t)b->cap + s->n + 1024;
+        if (nc > INT32_MAX) return -1;
+        int32_t *v = realloc(b->v, sizeof(int32_t) * (size_t)nc);
+        if (v) b->v = v;
+        double *a = realloc(b->wp, sizeof(double) * (size_t)nc);
+        if (a) b->wp = a;
+        double *c = realloc(b->wu, sizeof(double) * (size_t)nc);
+        if (c) b->wu = c;
+        double *d = realloc(b->wv, sizeof(double) * (size_t)nc);
+        if (d) b->wv = d;
+        if (!v || !a || !c || !d) return -1;
+        b->cap = (int32_t)nc;
+    }
+    memcpy(b->v + b->n, s->v, sizeof(int32_t) * (size_t)s->n);
+    memcpy(b->wp + b->n, s->wp, sizeof(double) * (size_t)s->n);
+    memcpy(b->wu + b->n, s->wu, sizeof(double) * (size_t)s->n);
+    memcpy(b->wv + b->n, s->wv, sizeof(double) * (size_t)s->n);
+    b->n += s->n;
+    return 0;
+}
+
+/* EV normals are oriented against the 1-ring's first face at evaluation time. */
+static void ev_orientation(const ccn_mesh *m, int32_t v, int32_t *o) {
+    int32_t h = m->vfan[m->vfan_start[v]];
+    o[0] = v;
+    o[1] = m->hvert[ccn__next(m, h)];
+    o[2] = m->hvert[ccn__prev(m, h)];
+}
+
+static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mR = p->lev[p->R];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    ccn__stencil *s = malloc(sizeof *s);
+    csr_buf b = {0, 0, NULL, NULL, NULL, NULL};
+    p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
+    p->orient = malloc(sizeof(int32_t) * 3 * (size_t)(p->nout_v ? p->nout_v : 1));
+    ccn_status st = CCN_OK;
+    if (!s || !p->st_start || !p->orient) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+        goto done;
+    }
+    p->st_start[0] = 0;
+    const ccn_mesh *mL = p->lev[p->L];
+    for (int32_t v = 0; v < mL->nv; v++) {
+        int32_t o = p->vmapL[v];
+        if (o < 0) continue;
+        int32_t vr = descend_vertex(p, p->L, v, p->R);
+        int kind = ccn__limit_stencil(mR, vr, pinned, s);
+        p->orient[3 * o] = -1;
+        if (kind == CCN_LIMIT_EV) {
+            if ((st = ccn__ev_limit(mR, vr, p->opts.scheme, s, err))) goto done;
+            ev_orientation(mR, vr, p->orient + 3 * o);
+        }
+        if (csr_push(&b, s)) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+            goto done;
+        }
+        p->st_start[o + 1] = b.n;
+    }
+done:
+    p->st_v = b.v; p->st_wp = b.wp; p->st_wu = b.wu; p->st_wv = b.wv;
+    free(s);
+    return st;
+}
+
+ccn_status ccn__tess_output(ccn_plan *p, ccn_error *err) {
+    ccn_status st = output_topology(p, err);
+    if (!st) st = output_stencils(p, err);
+    return st;
+}
+
+/* ---- cap holes ---------------------------------------------------------------------- */
+
+typedef struct {
+    ccn_plan *p;
+    int32_t cap, sector;
+    uint8_t *seen; /* per level-L vertex */
+    int32_t n, capacity;
+} hole_walk;
+
+static int record(hole_walk *w, int32_t vL, const double uv[2]) {
+    ccn_plan *p = w->p;
+    if (w->seen[vL] || p->vmapL[vL] < 0) return 0;
+    w->seen[vL] = 1;
+    if (w->n >= w->capacity) {
+        int32_t nc = 2 * w->capacity + 64;
+        int32_t *a = realloc(p->hv_out, sizeof(int32_t) * (size_t)nc);
+        if (a) p->hv_out = a;
+        int32_t *b = realloc(p->hv_cap, sizeof(int32_t) * (size_t)nc);
+        if (b) p->hv_cap = b;
+        int32_t *c = realloc(p->hv_sector, sizeof(int32_t) * (size_t)nc);
+        if (c) p->hv_sector = c;
+        double *d = realloc(p->hv_uv, sizeof(double) * 2 * (size_t)nc);
+        if (d) p->hv_uv = d;
+        if (!a || !b || !c || !d) return -1;
+        w->capacity = nc;
+    }
+    p->hv_out[w->n] = p->vmapL[vL];
+    p->hv_cap[w->n] = w->cap;
+    p->hv_sector[w->n] = w->sector;
+    p->hv_uv[2 * w->n] = uv[0];
+    p->hv_uv[2 * w->n + 1] = uv[1];
+    w->n++;
+    return 0;
+}
+
+/* Face f of level l with corner coordinates c[k] (in f's half-edge order). */
+static int walk_face(hole_walk *w, int32_t l, int32_t f, double c[][2]) {
+    const ccn_mesh *m = w->p->lev[l];
+    int32_t s0 = m->fstart[f], n = ccn__fsize(m, f);
+    if (l == w->p->L) {
+        for (int32_t j = 0; j < n; j++)
+            if (record(w, m->hvert[s0 + j], c[j])) return -1;
+        return 0;
+    }
+    double ctr[2] = {0, 0};
+    for (int32_t j = 0; j < n; j++) { ctr[0] += c[j][0] / n; ctr[1] += c[j][1] / n; }
+    for (int32_t j = 0; j < n; j++) {
+        int32_t jn = (j + 1) % n, jp = (j + n - 1) % n;
+        double cc[4][2] = {{c[j][0], c[j][1]},
+                           {(c[j][0] + c[jn][0]) / 2, (c[j][1] + c[jn][1]) / 2},
+                           {ctr[0], ctr[1]},
+                           {(c[j][0] + c[jp][0]) / 2, (c[j][1] + c[jp][1]) / 2}};
+        if (walk_face(w, l + 1, s0 + j, cc)) return -1;
+    }
+    return 0;
+}
+
+ccn_status ccn__tess_holes(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mK = p->lev[p->K], *mL = p->lev[p->L];
+    hole_walk w = {p, 0, 0, calloc((size_t)mL->nv, 1), 0, 0};
+    if (!w.seen) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
+    for (int32_t c = 0; c < p->ncap; c++) {
+        int32_t ev = p->caps[c].cnet[0], n = p->caps[c].n;
+        w.cap = c;
+        if (p->L < p->K) { /* only the EV itself is an output vertex of its hole */
+            int32_t v = ev;
+            for (int32_t l = p->K; l > p->L; l--) v -= p->lev[l - 1]->nf + p->lev[l - 1]->ne;
+            double uv[2] = {0, 0};
+            w.sector = 0;
+            if (v >= 0 && v < mL->nv && record(&w, v, uv)) goto oom;
+            continue;
+        }
+        for (int32_t k = 0; k < n; k++) {
+            int32_t h = mK->vfan[mK->vfan_start[ev] + k], f = mK->hface[h];
+            int32_t j0 = h - mK->fstart[f];
+            double cc[4][2];
+            static const double corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            for (int j = 0; j < 4; j++) {
+                cc[(j0 + j) % 4][0] = corner[j][0];
+                cc[(j0 + j) % 4][1] = corner[j][1];
+            }
+            w.sector = k;
+            if (walk_face(&w, p->K, f, cc)) goto oom;
+        }
+    }
+    p->nhv = w.n;
+    free(w.seen);
+    return CCN_OK;
+oom:
+    free(w.seen);
+    return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
+}

@@ -1,0 +1,115 @@
+/* ccnurbs limit: the limit mesh (positions + exact normals) as OBJ with vn lines. */
+#include "cli.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static int parse_limit_args(int argc, char **argv, ccn_options *o, const char **in,
+                            const char **out) {
+    o->levels = 2;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--scheme") == 0 && val) {
+            if (ccn_cli_scheme(val, &o->scheme)) { fprintf(stderr, "ccnurbs: bad --scheme '%s'\n", val); return 2; }
+            i++;
+        } else if (strcmp(a, "--levels") == 0 && val) {
+            if (ccn_cli_int(val, 0, 10, &o->levels)) { fprintf(stderr, "ccnurbs: --levels must be 0..10\n"); return 2; }
+            i++;
+        } else if (strcmp(a, "--cap") == 0 && val) {
+            if (strcmp(val, "bi5") == 0) o->cap = CCN_CAP_GUIDED_BI5;
+            else if (strcmp(val, "refine") == 0) o->cap = CCN_CAP_REFINE;
+            else { fprintf(stderr, "ccnurbs: bad --cap '%s'\n", val); return 2; }
+            i++;
+        } else if (strcmp(a, "--corners") == 0 && val) {
+            if (strcmp(val, "smooth") == 0) o->boundary_corners = CCN_CORNERS_SMOOTH;
+            else if (strcmp(val, "pinned") == 0) o->boundary_corners = CCN_CORNERS_PINNED;
+            else { fprintf(stderr, "ccnurbs: bad --corners '%s'\n", val); return 2; }
+            i++;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);
+            return 2;
+        } else if (!*in) *in = a;
+        else if (!*out) *out = a;
+        else { fprintf(stderr, "ccnurbs: too many arguments\n"); return 2; }
+    }
+    if (!*in || !*out) { fprintf(stderr, "ccnurbs limit: need in.obj and out.obj\n"); return 2; }
+    return 0;
+}
+
+/* Loads an OBJ into a plan. */
+int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan) {
+    size_t len = 0;
+    char *text = ccn_cli_read_file(path, &len);
+    if (!text) return 2;
+    ccn_obj *obj = NULL;
+    ccn_error err;
+    ccn_status st = ccn_obj_parse(text, len, &obj, &err);
+    free(text);
+    if (st) return ccn_cli_error(path, &err);
+    ccn_cage cage;
+    ccn_obj_cage(obj, &cage);
+    st = ccn_plan_create(&cage, o, plan, &err);
+    ccn_obj_destroy(obj);
+    return st ? ccn_cli_error(path, &err) : 0;
+}
+
+static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm) {
+    fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
+               "%d EV fallbacks, %d ring conflicts\n", (int)s->levels, (int)s->num_verts,
+            (int)s->num_faces, (int)s->num_caps, (int)s->num_cap_fallbacks,
+            (int)s->num_ev_fallbacks, (int)s->num_ring_conflicts);
+    for (int32_t v = 0; v < s->num_verts; v++)
+        fprintf(f, "v %.17g %.17g %.17g\n", lm->positions[3 * v], lm->positions[3 * v + 1],
+                lm->positions[3 * v + 2]);
+    for (int32_t v = 0; v < s->num_verts; v++)
+        fprintf(f, "vn %.17g %.17g %.17g\n", lm->normals[3 * v], lm->normals[3 * v + 1],
+                lm->normals[3 * v + 2]);
+    for (int32_t q = 0; q < s->num_faces; q++) {
+        const int32_t *fv = lm->face_verts + 4 * q;
+        fprintf(f, "f %d//%d %d//%d %d//%d %d//%d\n", fv[0] + 1, fv[0] + 1, fv[1] + 1, fv[1] + 1,
+                fv[2] + 1, fv[2] + 1, fv[3] + 1, fv[3] + 1);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
+static int write_atomic(const char *path, const ccn_sizes *s, const ccn_limit_mesh *lm) {
+    size_t n = strlen(path);
+    char *tmp = malloc(n + 32);
+    if (!tmp) return 2;
+    snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "wb");
+    int rc = f ? write_limit(f, s, lm) : -1;
+    if (f && fclose(f) != 0) rc = -1;
+    if (rc == 0 && rename(tmp, path) != 0) rc = -1;
+    if (rc) { remove(tmp); fprintf(stderr, "ccnurbs: cannot write %s\n", path); }
+    free(tmp);
+    return rc ? 2 : 0;
+}
+
+int ccn_cmd_limit(int argc, char **argv) {
+    ccn_options o = {0};
+    const char *in = NULL, *out = NULL;
+    int rc = parse_limit_args(argc, argv, &o, &in, &out);
+    if (rc) return rc;
+    ccn_plan *plan = NULL;
+    if ((rc = ccn_cli_load_plan(in, &o, &plan))) return rc;
+    ccn_sizes s;
+    ccn_plan_sizes(plan, &s);
+    ccn_limit_mesh lm = {0};
+    lm.positions = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
+    lm.normals = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
+    lm.face_verts = malloc(sizeof(int32_t) * 4 * (size_t)(s.num_faces ? s.num_faces : 1));
+    ccn_error err;
+    if (!lm.positions || !lm.normals || !lm.face_verts) {
+        fprintf(stderr, "ccnurbs: out of memory\n");
+        rc = 2;
+    } else if (ccn_plan_evaluate(plan, NULL, &lm, &err)) {
+        rc = ccn_cli_error(in, &err);
+    } else {
+        rc = write_atomic(out, &s, &lm);
+    }
+    free(lm.positions); free(lm.normals); free(lm.face_verts);
+    ccn_plan_destroy(plan);
+    return rc;
+}
