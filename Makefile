@@ -45,7 +45,7 @@ $(B)/ccnurbs: $(wildcard csrc/tools/*.c) $(B)/libccnurbs.a $(HDRS)
 
 $(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Icsrc -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
 
 test: deps
 	@$(MAKE) --no-print-directory build $(TEST_BIN) $(TEST_DEPS)

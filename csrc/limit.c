@@ -29,7 +29,7 @@
 #include <string.h>
 
 /* 1-D value (w) and derivative (dw) weights on (P_-1, P_0, P_1). */
-static void curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
+void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
                                 double dw[3]) {
     double a = (dm2 + dm1) / (dm2 + dm1 + d0), b = dm1 / (dm1 + d0 + d1);
     double g = dm1 / (dm1 + d0), s = 3.0 / (dm1 + d0);
@@ -40,17 +40,14 @@ static void curve_limit_weights(double dm2, double dm1, double d0, double d1, do
     }
 }
 
-/* A virtual grid point: up to 4 real vertices with weights (mirror ghosts). */
-typedef struct { int32_t v[4]; double w[4]; int n; } vpoint;
-
-static vpoint vp1(int32_t v) {
-    vpoint p = {{v, 0, 0, 0}, {1, 0, 0, 0}, 1};
+static ccn__vpoint vp1(int32_t v) {
+    ccn__vpoint p = {{v, 0, 0, 0}, {1, 0, 0, 0}, 1};
     return p;
 }
 
 /* 2a - b */
-static vpoint mirror(vpoint a, vpoint b) {
-    vpoint p = a;
+static ccn__vpoint mirror(ccn__vpoint a, ccn__vpoint b) {
+    ccn__vpoint p = a;
     for (int i = 0; i < p.n; i++) p.w[i] *= 2;
     for (int i = 0; i < b.n; i++) { p.v[p.n] = b.v[i]; p.w[p.n] = -b.w[i]; p.n++; }
     return p;
@@ -83,7 +80,7 @@ static double beyond_end(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
 }
 
 /* Tensor stencil over a 3x3 grid of virtual points g[i+1][j+1], i along u, j along v. */
-static void tensor_stencil(vpoint g[3][3], const double wu[3], const double dwu[3],
+static void tensor_stencil(ccn__vpoint g[3][3], const double wu[3], const double dwu[3],
                            const double wv[3], const double dwv[3], ccn__stencil *s) {
     s->n = 0;
     for (int i = 0; i < 3; i++)
@@ -95,34 +92,57 @@ static void tensor_stencil(vpoint g[3][3], const double wu[3], const double dwu[
             }
 }
 
+/* Fan edge of slot s (0: +u, 1: +v, 2: -u, 3: -v) for a grid whose +u is fan edge k0; -1
+ * when the slot does not exist (boundary: mirrored). */
+static int32_t slot_edge(const ccn_mesh *m, int32_t v, int32_t k0, int s) {
+    int32_t n = ccn__valence(m, v), k = s == 3 ? k0 - 1 : k0 + s;
+    if (!m->vboundary[v]) return (k % n + n) % n;
+    return k >= 0 && k < n ? k : -1;
+}
+
+void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g) {
+    int32_t sl[4];
+    for (int s = 0; s < 4; s++) sl[s] = slot_edge(m, v, k0, s);
+    /* fan face k lies between fan edges k and k+1: quadrant (+u,+v) is face sl[0],
+     * (-u,+v) face sl[1], (-u,-v) face sl[2], (+u,-v) face sl[3] */
+    ccn__vpoint (*p)[3] = g->p;
+    int has2 = sl[2] >= 0, has3 = sl[3] >= 0;
+    p[1][1] = vp1(v);
+    p[2][1] = vp1(fan_end(m, v, sl[0]));
+    p[1][2] = vp1(fan_end(m, v, sl[1]));
+    p[2][2] = vp1(fan_diag(m, v, sl[0]));
+    if (has2) {
+        p[0][1] = vp1(fan_end(m, v, sl[2]));
+        p[0][2] = vp1(fan_diag(m, v, sl[1]));
+    } else {
+        p[0][1] = mirror(p[1][1], p[2][1]);
+        p[0][2] = mirror(p[1][2], p[2][2]);
+    }
+    if (has3) {
+        p[1][0] = vp1(fan_end(m, v, sl[3]));
+        p[2][0] = vp1(fan_diag(m, v, sl[3]));
+        p[0][0] = has2 ? vp1(fan_diag(m, v, sl[2])) : mirror(p[1][0], p[2][0]);
+    } else {
+        for (int i = 0; i < 3; i++) p[i][0] = mirror(p[i][1], p[i][2]);
+    }
+    double d0 = m->eknot[ccn__fan_edge(m, v, sl[0])], e0 = m->eknot[ccn__fan_edge(m, v, sl[1])];
+    double d1 = beyond_end(m, v, sl[0], pinned), e1 = beyond_end(m, v, sl[1], pinned);
+    g->du[2] = d0; g->du[3] = d1;
+    g->du[1] = sl[2] >= 0 ? m->eknot[ccn__fan_edge(m, v, sl[2])] : d0;
+    g->du[0] = sl[2] >= 0 ? beyond_end(m, v, sl[2], pinned) : d1;
+    g->dv[2] = e0; g->dv[3] = e1;
+    g->dv[1] = sl[3] >= 0 ? m->eknot[ccn__fan_edge(m, v, sl[3])] : e0;
+    g->dv[0] = sl[3] >= 0 ? beyond_end(m, v, sl[3], pinned) : e1;
+}
+
 /* Interior valence 4, boundary valence 3 or pinned corner. */
 static void regular_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
-    int32_t n = ccn__valence(m, v);
-    int bnd = m->vboundary[v];
-    /* fan slots: +u = edge 0, +v = edge 1, -u = edge 2, -v = edge 3 (may be mirrored) */
-    int has[4] = {1, 1, !bnd || n == 3, !bnd};
-    vpoint g[3][3];
-    g[1][1] = vp1(v);
-    g[2][1] = vp1(fan_end(m, v, 0));
-    g[1][2] = vp1(fan_end(m, v, 1));
-    g[2][2] = vp1(fan_diag(m, v, 0));
-    if (has[2]) { g[0][1] = vp1(fan_end(m, v, 2)); g[0][2] = vp1(fan_diag(m, v, 1)); }
-    else { g[0][1] = mirror(g[1][1], g[2][1]); g[0][2] = mirror(g[1][2], g[2][2]); }
-    if (has[3]) {
-        g[1][0] = vp1(fan_end(m, v, 3)); g[0][0] = vp1(fan_diag(m, v, 2)); g[2][0] = vp1(fan_diag(m, v, 3));
-    } else {
-        for (int i = 0; i < 3; i++) g[i][0] = mirror(g[i][1], g[i][2]);
-    }
-    double du0 = m->eknot[ccn__fan_edge(m, v, 0)], dv0 = m->eknot[ccn__fan_edge(m, v, 1)];
-    double du1 = beyond_end(m, v, 0, pinned), dv1 = beyond_end(m, v, 1, pinned);
-    double dum1 = has[2] ? m->eknot[ccn__fan_edge(m, v, 2)] : du0;
-    double dum2 = has[2] ? beyond_end(m, v, 2, pinned) : du1;
-    double dvm1 = has[3] ? m->eknot[ccn__fan_edge(m, v, 3)] : dv0;
-    double dvm2 = has[3] ? beyond_end(m, v, 3, pinned) : dv1;
+    ccn__vgrid g;
+    ccn__vertex_grid(m, v, 0, pinned, &g);
     double wu[3], dwu[3], wv[3], dwv[3];
-    curve_limit_weights(dum2, dum1, du0, du1, wu, dwu);
-    curve_limit_weights(dvm2, dvm1, dv0, dv1, wv, dwv);
-    tensor_stencil(g, wu, dwu, wv, dwv, s);
+    ccn__curve_limit_weights(g.du[0], g.du[1], g.du[2], g.du[3], wu, dwu);
+    ccn__curve_limit_weights(g.dv[0], g.dv[1], g.dv[2], g.dv[3], wv, dwv);
+    tensor_stencil(g.p, wu, dwu, wv, dwv, s);
 }
 
 /* Smooth corners and boundary EVs: boundary curve limit, interior direction. */
@@ -132,7 +152,7 @@ static void boundary_curve_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn
     double d0 = m->eknot[ccn__fan_edge(m, v, 0)], dm1 = m->eknot[ccn__fan_edge(m, v, n - 1)];
     double d1 = beyond_end(m, v, 0, pinned), dm2 = beyond_end(m, v, n - 1, pinned);
     double w[3], dw[3];
-    curve_limit_weights(dm2, dm1, d0, d1, w, dw);
+    ccn__curve_limit_weights(dm2, dm1, d0, d1, w, dw);
     s->n = 0;
     int32_t pts[3] = {prev, v, next};
     for (int i = 0; i < 3; i++) stencil_add(s, pts[i], w[i], dw[i], -w[i]);

@@ -21,6 +21,18 @@ enum {
     CCN_LIMIT_ISOLATED
 };
 
+/* A virtual grid point: up to 4 real vertices with weights (mirror ghosts). */
+typedef struct { int32_t v[4]; double w[4]; int n; } ccn__vpoint;
+/* The 3x3 grid around a regular vertex v (interior valence 4, boundary valence 3 or pinned
+ * corner) with +u along fan edge k0 and +v along fan edge k0+1: p[i+1][j+1] is grid point
+ * (i,j); missing points across the boundary are mirror ghosts. du[0..3] = intervals
+ * D_-2, D_-1, D_0, D_1 along u (D_0 between (0,0) and (1,0)); dv likewise. */
+typedef struct { ccn__vpoint p[3][3]; double du[4], dv[4]; } ccn__vgrid;
+void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g);
+/* 1-D limit value (w) and derivative (dw) weights on (P_-1, P_0, P_1) at knot t_0. */
+void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
+                              double dw[3]);
+
 int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
 /* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the
  * stencil is left empty). */
