@@ -1,6 +1,7 @@
 /* Regular faces -> bicubic Bézier patches by exact conversion of the non-uniform B-spline.
  *
- * A quad face is a bicubic patch of its 4x4 control net when every vertex of the net is
+ * A quad face is a bicubic patch of its 4x4 control net when its corners are regular (the
+ * net exists); it is the exact subdivision limit ("strict") when every vertex of the net is
  * regular (interior valence 4, boundary valence 3 or pinned corner; mirrored ghosts across
  * the boundary): then the net refines by knot insertion forever. The net is assembled from
  * the 3x3 grids of the four corners (limit.c); the intervals D_-2..D_2 of each direction
@@ -34,7 +35,7 @@ static int vpoint_regular(const ccn_mesh *m, const ccn__vpoint *p, int pinned) {
     return 1;
 }
 
-int ccn__bicubic_net(const ccn_mesh *m, int32_t f, int pinned, ccn__vpoint net[4][4],
+int ccn__bicubic_net(const ccn_mesh *m, int32_t f, int pinned, int strict, ccn__vpoint net[4][4],
                      double Cu[4][4], double Cv[4][4]) {
     if (ccn__fsize(m, f) != 4) return 0;
     int32_t h0 = m->fstart[f];
@@ -51,7 +52,7 @@ int ccn__bicubic_net(const ccn_mesh *m, int32_t f, int pinned, ccn__vpoint net[4
         }
     net[3][0] = g[1].p[0][0]; /* v1 at (1,0): local (a,b) -> (1-b, a) */
     net[0][3] = g[3].p[0][0]; /* v3 at (0,1): local (a,b) -> (b, 1-a) */
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; strict && i < 4; i++)
         for (int j = 0; j < 4; j++)
             if (!vpoint_regular(m, &net[i][j], pinned)) return 0;
     double Du[5] = {g[0].du[0], g[0].du[1], g[0].du[2], g[0].du[3], g[2].du[0]};
@@ -67,10 +68,10 @@ static void vpoint_pos(const double *pos, const ccn__vpoint *p, double out[3]) {
         for (int i = 0; i < 3; i++) out[i] += p->w[k] * pos[3 * (size_t)p->v[k] + i];
 }
 
-int ccn__bicubic_patch(const ccn_mesh *m, int32_t f, int pinned, double bez[4][4][3]) {
+int ccn__bicubic_patch(const ccn_mesh *m, int32_t f, int pinned, int strict, double bez[4][4][3]) {
     ccn__vpoint net[4][4];
     double Cu[4][4], Cv[4][4], P[4][4][3], T[4][4][3];
-    if (!ccn__bicubic_net(m, f, pinned, net, Cu, Cv)) return 0;
+    if (!ccn__bicubic_net(m, f, pinned, strict, net, Cu, Cv)) return 0;
     for (int i = 0; i < 4; i++)
         for (int j = 0; j < 4; j++) vpoint_pos(m->pos, &net[i][j], P[i][j]);
     memset(T, 0, sizeof T);

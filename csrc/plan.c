@@ -11,6 +11,7 @@
 #include "plan.h"
 
 #include "bspline.h"
+#include "patches.h"
 
 #include <math.h>
 #include <string.h>
@@ -43,6 +44,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->vmapL); free(p->out_fv); free(p->out_origin);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
     free(p->orient); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
+    free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
     free(p);
 }
 
@@ -338,6 +340,26 @@ static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
     }
 }
 
+#if CCN_HAVE_BI5
+/* The faces around each hole: bicubic patches of the level-K net (see plan.h). */
+static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out) {
+    const ccn_mesh *mK = p->lev[p->K];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    for (int32_t i = 0; i < p->nrf; i++)
+        if (!ccn__bicubic_patch(mK, p->rf_face[i], pinned, 0, (double(*)[4][3])(p->rf_bez + 48 * (size_t)i)))
+            p->rf_bez[48 * (size_t)i] = NAN; /* not a patch: keep the limit stencil */
+    for (int32_t i = 0; i < p->nbv; i++) {
+        const double *b = p->rf_bez + 48 * (size_t)p->bv_rf[i];
+        if (isnan(b[0])) continue;
+        double x[3], du[3], dv[3];
+        ccn__bezier_eval(b, 3, p->bv_uv[2 * i], p->bv_uv[2 * i + 1], x, du, dv);
+        int32_t o = p->bv_out[i];
+        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
+        if (out->normals) unit_normal(du, dv, out->normals + 3 * (size_t)o);
+    }
+}
+#endif
+
 static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
 #if CCN_HAVE_BI5
     const double *P = p->lev[p->K]->pos;
@@ -361,6 +383,7 @@ static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
         if (out->normals) unit_normal(du, dv, out->normals + 3 * (size_t)o);
     }
+    eval_ring_faces(p, out);
 #else
     (void)p; (void)out; (void)err;
 #endif

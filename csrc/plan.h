@@ -42,6 +42,13 @@ struct ccn_plan {
     int32_t nhv;            /* output vertices evaluated on a cap */
     int32_t *hv_out, *hv_cap, *hv_sector;
     double *hv_uv;
+    /* ring around each cap: level-K faces touching the hole, evaluated as the bicubic patch
+     * of their level-K net (the spline the cap joins C2), not as the subdivision limit */
+    int32_t nrf, *rf_face;  /* distinct faces */
+    double *rf_bez;         /* 48 doubles per face, filled by evaluate */
+    int32_t nbv;            /* output vertices on those faces */
+    int32_t *bv_out, *bv_rf;
+    double *bv_uv;
     ccn_sizes sizes;
 };
 

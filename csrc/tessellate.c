@@ -111,44 +111,72 @@ ccn_status ccn__tess_output(ccn_plan *p, ccn_error *err) {
 
 typedef struct {
     ccn_plan *p;
-    int32_t cap, sector;
-    uint8_t *seen; /* per level-L vertex */
-    int32_t n, capacity;
+    int mode;              /* 0: cap hole vertex, 1: vertex on a ring face */
+    int32_t cap, sector;   /* mode 0 */
+    int32_t rf;            /* mode 1 */
+    uint8_t *seen;         /* per level-L vertex */
+    int32_t n[2], capacity[2];
 } hole_walk;
+
+static int grow_i32(int32_t **a, int32_t nc) {
+    int32_t *b = realloc(*a, sizeof(int32_t) * (size_t)nc);
+    if (b) *a = b;
+    return b ? 0 : -1;
+}
+static int grow_f64(double **a, int32_t nc) {
+    double *b = realloc(*a, sizeof(double) * (size_t)nc);
+    if (b) *a = b;
+    return b ? 0 : -1;
+}
 
 static int record(hole_walk *w, int32_t vL, const double uv[2]) {
     ccn_plan *p = w->p;
+    int md = w->mode;
     if (w->seen[vL] || p->vmapL[vL] < 0) return 0;
     w->seen[vL] = 1;
-    if (w->n >= w->capacity) {
-        int32_t nc = 2 * w->capacity + 64;
-        int32_t *a = realloc(p->hv_out, sizeof(int32_t) * (size_t)nc);
-        if (a) p->hv_out = a;
-        int32_t *b = realloc(p->hv_cap, sizeof(int32_t) * (size_t)nc);
-        if (b) p->hv_cap = b;
-        int32_t *c = realloc(p->hv_sector, sizeof(int32_t) * (size_t)nc);
-        if (c) p->hv_sector = c;
-        double *d = realloc(p->hv_uv, sizeof(double) * 2 * (size_t)nc);
-        if (d) p->hv_uv = d;
-        if (!a || !b || !c || !d) return -1;
-        w->capacity = nc;
+    if (w->n[md] >= w->capacity[md]) {
+        int32_t nc = 2 * w->capacity[md] + 64;
+        int bad = md == 0 ? grow_i32(&p->hv_out, nc) | grow_i32(&p->hv_cap, nc) |
+                                grow_i32(&p->hv_sector, nc) | grow_f64(&p->hv_uv, 2 * nc)
+                          : grow_i32(&p->bv_out, nc) | grow_i32(&p->bv_rf, nc) |
+                                grow_f64(&p->bv_uv, 2 * nc);
+        if (bad) return -1;
+        w->capacity[md] = nc;
     }
-    p->hv_out[w->n] = p->vmapL[vL];
-    p->hv_cap[w->n] = w->cap;
-    p->hv_sector[w->n] = w->sector;
-    p->hv_uv[2 * w->n] = uv[0];
-    p->hv_uv[2 * w->n + 1] = uv[1];
-    w->n++;
+    int32_t i = w->n[md]++;
+    if (md == 0) {
+        p->hv_out[i] = p->vmapL[vL];
+        p->hv_cap[i] = w->cap;
+        p->hv_sector[i] = w->sector;
+        p->hv_uv[2 * i] = uv[0];
+        p->hv_uv[2 * i + 1] = uv[1];
+    } else {
+        p->bv_out[i] = p->vmapL[vL];
+        p->bv_rf[i] = w->rf;
+        p->bv_uv[2 * i] = uv[0];
+        p->bv_uv[2 * i + 1] = uv[1];
+    }
     return 0;
+}
+
+/* Level-L vertex whose vertex-point chain is level-K vertex v, or -1. */
+static int32_t ancestor_at_L(const ccn_plan *p, int32_t v) {
+    for (int32_t l = p->K; l > p->L; l--) {
+        v -= p->lev[l - 1]->nf + p->lev[l - 1]->ne;
+        if (v < 0) return -1;
+    }
+    return v;
 }
 
 /* Face f of level l with corner coordinates c[k] (in f's half-edge order). */
 static int walk_face(hole_walk *w, int32_t l, int32_t f, double c[][2]) {
     const ccn_mesh *m = w->p->lev[l];
     int32_t s0 = m->fstart[f], n = ccn__fsize(m, f);
-    if (l == w->p->L) {
-        for (int32_t j = 0; j < n; j++)
-            if (record(w, m->hvert[s0 + j], c[j])) return -1;
+    if (l == w->p->L || w->p->L < w->p->K) { /* record what exists at the output level */
+        for (int32_t j = 0; j < n; j++) {
+            int32_t v = l == w->p->L ? m->hvert[s0 + j] : ancestor_at_L(w->p, m->hvert[s0 + j]);
+            if (v >= 0 && record(w, v, c[j])) return -1;
+        }
         return 0;
     }
     double ctr[2] = {0, 0};
@@ -164,38 +192,67 @@ static int walk_face(hole_walk *w, int32_t l, int32_t f, double c[][2]) {
     return 0;
 }
 
-ccn_status ccn__tess_holes(ccn_plan *p, ccn_error *err) {
-    const ccn_mesh *mK = p->lev[p->K], *mL = p->lev[p->L];
-    hole_walk w = {p, 0, 0, calloc((size_t)mL->nv, 1), 0, 0};
-    if (!w.seen) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
-    for (int32_t c = 0; c < p->ncap; c++) {
-        int32_t ev = p->caps[c].cnet[0], n = p->caps[c].n;
-        w.cap = c;
-        if (p->L < p->K) { /* only the EV itself is an output vertex of its hole */
-            int32_t v = ev;
-            for (int32_t l = p->K; l > p->L; l--) v -= p->lev[l - 1]->nf + p->lev[l - 1]->ne;
-            double uv[2] = {0, 0};
-            w.sector = 0;
-            if (v >= 0 && v < mL->nv && record(&w, v, uv)) goto oom;
-            continue;
+static const double UNIT[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+
+static int walk_cap(hole_walk *w, int32_t c) {
+    const ccn_mesh *mK = w->p->lev[w->p->K];
+    int32_t ev = w->p->caps[c].cnet[0], n = w->p->caps[c].n;
+    w->mode = 0;
+    w->cap = c;
+    for (int32_t k = 0; k < n; k++) {
+        int32_t h = mK->vfan[mK->vfan_start[ev] + k], f = mK->hface[h];
+        int32_t j0 = h - mK->fstart[f];
+        double cc[4][2];
+        for (int j = 0; j < 4; j++) {
+            cc[(j0 + j) % 4][0] = UNIT[j][0];
+            cc[(j0 + j) % 4][1] = UNIT[j][1];
         }
-        for (int32_t k = 0; k < n; k++) {
-            int32_t h = mK->vfan[mK->vfan_start[ev] + k], f = mK->hface[h];
-            int32_t j0 = h - mK->fstart[f];
+        w->sector = k;
+        if (walk_face(w, w->p->K, f, cc)) return -1;
+    }
+    return 0;
+}
+
+/* Faces touching the cap's 1-ring vertices but not the EV (the ring around the hole). */
+static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
+    ccn_plan *p = w->p;
+    const ccn_mesh *mK = p->lev[p->K];
+    const ccn__cap *cp = &p->caps[c];
+    w->mode = 1;
+    for (int32_t j = 0; j < 2 * cp->n; j++) {
+        int32_t v = cp->ring[j];
+        for (int32_t k = mK->vfan_start[v]; k < mK->vfan_start[v + 1]; k++) {
+            int32_t f = mK->hface[mK->vfan[k]], touches = 0;
+            for (int32_t h = mK->fstart[f]; h < mK->fstart[f + 1]; h++) touches |= mK->hvert[h] == cp->cnet[0];
+            if (touches || face_done[f]) continue;
+            face_done[f] = 1;
+            if (grow_i32(&p->rf_face, p->nrf + 1)) return -1;
+            p->rf_face[p->nrf] = f;
+            w->rf = p->nrf++;
             double cc[4][2];
-            static const double corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-            for (int j = 0; j < 4; j++) {
-                cc[(j0 + j) % 4][0] = corner[j][0];
-                cc[(j0 + j) % 4][1] = corner[j][1];
-            }
-            w.sector = k;
-            if (walk_face(&w, p->K, f, cc)) goto oom;
+            memcpy(cc, UNIT, sizeof cc);
+            if (walk_face(w, p->K, f, cc)) return -1;
         }
     }
-    p->nhv = w.n;
+    return 0;
+}
+
+ccn_status ccn__tess_holes(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L], *mK = p->lev[p->K];
+    hole_walk w;
+    memset(&w, 0, sizeof w);
+    w.p = p;
+    w.seen = calloc((size_t)mL->nv, 1);
+    uint8_t *face_done = calloc((size_t)mK->nf, 1);
+    int bad = !w.seen || !face_done;
+    for (int32_t c = 0; !bad && c < p->ncap; c++) bad = walk_cap(&w, c) != 0;
+    for (int32_t c = 0; !bad && c < p->ncap; c++) bad = walk_ring_faces(&w, c, face_done) != 0;
+    if (!bad) p->rf_bez = malloc(sizeof(double) * 48 * (size_t)(p->nrf ? p->nrf : 1));
+    bad = bad || !p->rf_bez;
+    p->nhv = w.n[0];
+    p->nbv = w.n[1];
     free(w.seen);
+    free(face_done);
+    if (bad) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
     return CCN_OK;
-oom:
-    free(w.seen);
-    return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
 }

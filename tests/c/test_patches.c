@@ -103,7 +103,7 @@ static void check_level(int levels, double *maxerr) {
         for (int l = 0; l < levels; l++) { child_param(&q, chain[l], &q2); q = q2; }
         int i0 = g / NV, j0 = g % NV;
         double bez[4][4][3];
-        CHECK(ccn__bicubic_patch(r, f, 0, bez) == 1, "face %d regular", f);
+        CHECK(ccn__bicubic_patch(r, f, 0, 1, bez) == 1, "face %d regular", f);
         for (int s = 0; s < 3; s++) {
             double u = tl_rand01(), v = tl_rand01(), x[3], dx[3], dy[3], y[3];
             ccn__bezier_eval(&bez[0][0][0], 3, u, v, x, dx, dy);
