@@ -407,3 +407,51 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
     return CCN_OK;
 }
+
+/* ---- patch export --------------------------------------------------------------- */
+
+static int32_t cage_face_of(const ccn_plan *p, int32_t l, int32_t f) {
+    for (; l > 0; l--) f = p->lev[l - 1]->hface[f];
+    return f;
+}
+
+static void export_bicubic(const ccn_plan *p, int32_t lvl, ccn_patch_fn fn, void *user,
+                           int32_t *skipped) {
+    const ccn_mesh *m = p->lev[lvl];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    uint8_t *kind = calloc((size_t)(m->nf ? m->nf : 1), 1); /* 1 hole, 2 ring face */
+    if (!kind) { *skipped = m->nf; return; }
+    for (int32_t c = 0; c < p->ncap; c++)
+        for (int32_t k = p->lev[p->K]->vfan_start[p->caps[c].cnet[0]];
+             k < p->lev[p->K]->vfan_start[p->caps[c].cnet[0] + 1]; k++)
+            kind[p->lev[p->K]->hface[p->lev[p->K]->vfan[k]]] = 1;
+    for (int32_t i = 0; i < p->nrf; i++) kind[p->rf_face[i]] = 2;
+    double bez[4][4][3];
+    for (int32_t f = 0; f < m->nf; f++) {
+        if (kind[f] == 1) continue;
+        if (ccn__bicubic_patch(m, f, pinned, kind[f] != 2, bez))
+            fn(user, 3, &bez[0][0][0], cage_face_of(p, lvl, f));
+        else
+            (*skipped)++;
+    }
+    free(kind);
+}
+
+ccn_status ccn_plan_patches(const ccn_plan *p, ccn_patch_fn fn, void *user, int32_t *skipped) {
+    if (!p || !fn) return CCN_ERR_ARGUMENT;
+    int32_t sk = 0, lvl = p->K >= 0 ? p->K : p->R;
+    export_bicubic(p, lvl, fn, user, &sk);
+#if CCN_HAVE_BI5
+    for (int32_t c = 0; c < p->ncap; c++) {
+        const ccn__cap *cp = &p->caps[c];
+        const ccn_mesh *mK = p->lev[p->K];
+        int32_t np = ccn__bi5_num_patches(cp->op);
+        for (int32_t i = 0; i < np; i++) {
+            int32_t s = i % cp->n, h = mK->vfan[mK->vfan_start[cp->cnet[0]] + s];
+            fn(user, 5, cp->patches + 108 * (size_t)i, cage_face_of(p, p->K, mK->hface[h]));
+        }
+    }
+#endif
+    if (skipped) *skipped = sk;
+    return CCN_OK;
+}

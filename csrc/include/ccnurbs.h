@@ -155,6 +155,16 @@ ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_
                              ccn_error *err);
 void ccn_plan_destroy(ccn_plan *plan);
 
+/* The finite patch set for the positions of the last ccn_plan_evaluate (call it first):
+ * bicubic patches of the regular faces of the cap level (or of the deepest level without
+ * caps) and the bi-5 rings and caps. fn receives the degree (3 or 5), (degree+1)^2 control
+ * points (3 doubles each, first index along u) and the cage face the patch lies on.
+ * Faces that are neither (irregular faces refined to the limit) are counted in *skipped. */
+typedef void (*ccn_patch_fn)(void *user, int32_t degree, const double *points,
+                             int32_t cage_face);
+ccn_status ccn_plan_patches(const ccn_plan *plan, ccn_patch_fn fn, void *user,
+                            int32_t *skipped);
+
 /* ---- OBJ ------------------------------------------------------------------------ */
 
 typedef struct ccn_obj ccn_obj; /* parsed OBJ: v, f and "# knot i j d" lines */

@@ -9,6 +9,7 @@ static int usage(void) {
             "usage:\n"
             "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] in.obj out.obj\n"
             "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] in.obj out.obj\n"
+            "  ccnurbs patches [--scheme ...] [--corners ...] in.obj out.bv\n"
             "  ccnurbs matrix --valence N [--knots d0,d1,...] [--scheme eigen|nurss|cc]\n"
             "  ccnurbs experiment maxima|charmap --cases N --seed S [...] (experiment --help)\n");
     return 2;
@@ -20,6 +21,7 @@ int main(int argc, char **argv) {
     if (strcmp(cmd, "refine") == 0) return ccn_cmd_refine(argc - 1, argv + 1);
     if (strcmp(cmd, "matrix") == 0) return ccn_cmd_matrix(argc - 1, argv + 1);
     if (strcmp(cmd, "limit") == 0) return ccn_cmd_limit(argc - 1, argv + 1);
+    if (strcmp(cmd, "patches") == 0) return ccn_cmd_patches(argc - 1, argv + 1);
     if (strcmp(cmd, "experiment") == 0) return ccn_cmd_experiment(argc - 1, argv + 1);
     if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0) { usage(); return 0; }
     fprintf(stderr, "ccnurbs: unknown command '%s'\n", cmd);

@@ -8,6 +8,7 @@
 int ccn_cmd_refine(int argc, char **argv);
 int ccn_cmd_matrix(int argc, char **argv);
 int ccn_cmd_limit(int argc, char **argv);
+int ccn_cmd_patches(int argc, char **argv);
 /* Parses an OBJ and creates a plan; prints the error and returns 2 on failure. */
 int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan);
 int ccn_cmd_experiment(int argc, char **argv);
