@@ -94,6 +94,9 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
                               ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
 void ccn__level_points(const ccn__level *c, double *out);
+/* Next-level points around the listed vertices only (see refine.c). */
+void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
+                              double *out);
 /* Topology and intervals of the next level (positions uninitialised). */
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
 void ccn__level_free(ccn__level *c);

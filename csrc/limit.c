@@ -234,8 +234,17 @@ static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *
     return CCN_OK;
 }
 
+static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
+                               ccn__stencil *s, ccn_error *err);
+
 ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
                          ccn_error *err) {
+    return ev_limit_ring(m, v, scheme, 0, s, err);
+}
+
+/* child: the ring is that of v's vertex point one level finer (same spoke ratios). */
+static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
+                               ccn__stencil *s, ccn_error *err) {
     int32_t n = ccn__valence(m, v), sz = 2 * n + 1;
     if (sz > CCN_STENCIL_MAX)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
@@ -250,9 +259,86 @@ ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil 
     if (!st) st = left_eigvecs(M, sz, l0, l1, l2, err);
     if (!st) {
         ccn__ev_ring(m, v, ring);
+        if (child) {
+            for (int32_t k = 0; k < n; k++) {
+                int32_t h = m->vfan[m->vfan_start[v] + k];
+                ring[k] = m->hface[h];           /* face point */
+                ring[n + k] = m->nf + m->hedge[h]; /* edge point */
+            }
+            ring[2 * n] = m->nf + m->ne + v;
+        }
         s->n = 0;
         for (int32_t j = 0; j < sz; j++) stencil_add(s, ring[j], l0[j], l1[j], l2[j]);
     }
     free(buf);
     return st;
+}
+
+/* ---- stencils one level finer, from this level's topology ------------------------ */
+/* Level l+1 numbering: face point f -> f, edge point e -> nf + e, vertex point v -> nf+ne+v.
+ * Around the vertex point of v every interval along a spoke is the spoke's (halved: only
+ * ratios matter), so no level-(l+1) topology is needed. */
+
+static void child_regular(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+    int32_t sl[4];
+    for (int k = 0; k < 4; k++) sl[k] = slot_edge(m, v, 0, k);
+    int has2 = sl[2] >= 0, has3 = sl[3] >= 0;
+    int32_t nf = m->nf, ne = m->ne;
+#define CE(k) vp1(nf + ccn__fan_edge(m, v, k))
+#define CF(k) vp1(m->hface[m->vfan[m->vfan_start[v] + (k)]])
+    ccn__vpoint p[3][3];
+    p[1][1] = vp1(nf + ne + v);
+    p[2][1] = CE(sl[0]);
+    p[1][2] = CE(sl[1]);
+    p[2][2] = CF(sl[0]);
+    if (has2) { p[0][1] = CE(sl[2]); p[0][2] = CF(sl[1]); }
+    else { p[0][1] = mirror(p[1][1], p[2][1]); p[0][2] = mirror(p[1][2], p[2][2]); }
+    if (has3) {
+        p[1][0] = CE(sl[3]);
+        p[2][0] = CF(sl[3]);
+        p[0][0] = has2 ? CF(sl[2]) : mirror(p[1][0], p[2][0]);
+    } else {
+        for (int i = 0; i < 3; i++) p[i][0] = mirror(p[i][1], p[i][2]);
+    }
+#undef CE
+#undef CF
+    double d0 = m->eknot[ccn__fan_edge(m, v, sl[0])], d1 = m->eknot[ccn__fan_edge(m, v, sl[1])];
+    double d2 = has2 ? m->eknot[ccn__fan_edge(m, v, sl[2])] : d0;
+    double d3 = has3 ? m->eknot[ccn__fan_edge(m, v, sl[3])] : d1;
+    double wu[3], dwu[3], wv[3], dwv[3];
+    ccn__curve_limit_weights(d2, d2, d0, d0, wu, dwu);
+    ccn__curve_limit_weights(d3, d3, d1, d1, wv, dwv);
+    tensor_stencil(p, wu, dwu, wv, dwv, s);
+}
+
+static void child_boundary_curve(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+    int32_t n = ccn__valence(m, v), nf = m->nf, nfan = m->vfan_start[v + 1] - m->vfan_start[v];
+    double d0 = m->eknot[ccn__fan_edge(m, v, 0)], dm = m->eknot[ccn__fan_edge(m, v, n - 1)];
+    double w[3], dw[3];
+    ccn__curve_limit_weights(dm, dm, d0, d0, w, dw);
+    s->n = 0;
+    int32_t pts[3] = {nf + ccn__fan_edge(m, v, n - 1), nf + m->ne + v, nf + ccn__fan_edge(m, v, 0)};
+    for (int i = 0; i < 3; i++) stencil_add(s, pts[i], w[i], dw[i], -w[i]);
+    int32_t cnt = (n - 2) + nfan;
+    for (int32_t k = 1; k < n - 1; k++) stencil_add(s, nf + ccn__fan_edge(m, v, k), 0, 0, 1.0 / cnt);
+    for (int32_t k = 0; k < nfan; k++) stencil_add(s, m->hface[m->vfan[m->vfan_start[v] + k]], 0, 0, 1.0 / cnt);
+}
+
+ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
+                                    ccn__stencil *s, int32_t orient[3], ccn_error *err) {
+    int kind = ccn__limit_kind(m, v, pinned);
+    orient[0] = -1;
+    s->n = 0;
+    if (kind == CCN_LIMIT_REGULAR) child_regular(m, v, s);
+    else if (kind == CCN_LIMIT_BOUNDARY_CURVE) child_boundary_curve(m, v, s);
+    else if (kind == CCN_LIMIT_ISOLATED) stencil_add(s, m->nf + m->ne + v, 1, 0, 0);
+    else {
+        ccn_status st = ev_limit_ring(m, v, scheme, 1, s, err);
+        if (st) return st;
+        int32_t h = m->vfan[m->vfan_start[v]];
+        orient[0] = m->nf + m->ne + v;
+        orient[1] = m->nf + m->hedge[h];
+        orient[2] = m->nf + m->hedge[m->vfan[m->vfan_start[v] + 1]];
+    }
+    return CCN_OK;
 }

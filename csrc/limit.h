@@ -44,4 +44,9 @@ int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring);
  * normal with the 1-ring. */
 ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
                          ccn_error *err);
+/* Limit stencil of the vertex point of v one level finer, in level-(l+1) numbering (face
+ * point f -> f, edge point e -> nf+e, vertex point v -> nf+ne+v), built from this level's
+ * topology. orient: for EVs the (v, a, b) whose (a-v) x (b-v) orients the normal, else -1. */
+ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
+                                    ccn__stencil *s, int32_t orient[3], ccn_error *err);
 #endif

@@ -32,6 +32,8 @@
 void ccn_plan_destroy(ccn_plan *p) {
     if (!p) return;
     for (int32_t l = 0; l < p->R; l++) ccn__level_free(&p->prep[l]);
+    if (p->has_sub) { ccn__level_free(&p->sub); free(p->posS); }
+    free(p->near);
     for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
     for (int32_t c = 0; c < p->ncap; c++) {
         free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
@@ -234,6 +236,20 @@ static ccn_status setup_caps(ccn_plan *p, ccn_error *err) {
 
 /* ---- create ----------------------------------------------------------------------- */
 
+/* Level L+1: the built lev[L+1] when caps needed it, else computed around irregular
+ * vertices only (evaluate) from a prepared level L. */
+static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
+    if (p->R > p->L) { p->posS = p->lev[p->L + 1]->pos; return CCN_OK; }
+    const ccn_mesh *m = p->lev[p->L];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, err);
+    if (st) return st;
+    p->has_sub = 1;
+    p->posS = malloc(sizeof(double) * 3 * ((size_t)m->nf + m->ne + m->nv));
+    if (!p->posS) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    return CCN_OK;
+}
+
 static int has_non_quads(const ccn_mesh *m) {
     for (int32_t f = 0; f < m->nf; f++)
         if (ccn__fsize(m, f) != 4) return 1;
@@ -279,7 +295,8 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     p->ncage = cage->num_verts;
     p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
     if ((st = setup_caps(p, err))) goto fail;
-    if ((st = build_levels(p, p->R > p->L + 1 ? p->R : p->L + 1, err))) goto fail;
+    if ((st = build_levels(p, p->R > p->L ? p->R : p->L, err))) goto fail;
+    if ((st = setup_level_s(p, err))) goto fail;
     if ((st = ccn__tess_output(p, err))) goto fail;
     if (p->ncap && (st = ccn__tess_holes(p, err))) goto fail;
     fill_sizes(p);
@@ -311,12 +328,15 @@ static void unit_normal(const double du[3], const double dv[3], double n[3]) {
     else { n[0] = 0; n[1] = 0; n[2] = 1; } /* degenerate cage geometry: documented fallback */
 }
 
+#define SPOINT(i) ((i) < nvL ? PL + 3 * (size_t)(i) : PS + 3 * ((size_t)(i) - nvL))
+
 static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
-    const double *P = p->lev[p->R]->pos;
+    const double *PL = p->lev[p->L]->pos, *PS = p->posS;
+    int32_t nvL = p->lev[p->L]->nv;
     for (int32_t o = 0; o < p->nout_v; o++) {
         double x[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
         for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
-            const double *q = P + 3 * (size_t)p->st_v[k];
+            const double *q = SPOINT(p->st_v[k]);
             for (int i = 0; i < 3; i++) {
                 x[i] += p->st_wp[k] * q[i];
                 du[i] += p->st_wu[k] * q[i];
@@ -330,9 +350,10 @@ static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
         const int32_t *r = p->orient + 3 * (size_t)o;
         if (r[0] >= 0) { /* EV: agree with the first face of the 1-ring */
             double a[3], b[3], c[3];
+            const double *r0 = SPOINT(r[0]), *r1 = SPOINT(r[1]), *r2 = SPOINT(r[2]);
             for (int i = 0; i < 3; i++) {
-                a[i] = P[3 * (size_t)r[1] + i] - P[3 * (size_t)r[0] + i];
-                b[i] = P[3 * (size_t)r[2] + i] - P[3 * (size_t)r[0] + i];
+                a[i] = r1[i] - r0[i];
+                b[i] = r2[i] - r0[i];
             }
             cross(a, b, c);
             if (c[0] * n[0] + c[1] * n[1] + c[2] * n[2] < 0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
@@ -362,6 +383,7 @@ static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out) {
 
 static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
 #if CCN_HAVE_BI5
+    if (p->ncap == 0) return CCN_OK;
     const double *P = p->lev[p->K]->pos;
     for (int32_t c = 0; c < p->ncap; c++) {
         ccn__cap *cp = &p->caps[c];
@@ -400,6 +422,7 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
         if (st) return st;
     }
     for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
+    if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
     eval_stencils(p, out);
     ccn_status st = eval_caps(p, out, err);
     if (st) return st;

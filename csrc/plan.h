@@ -20,18 +20,25 @@ typedef struct {
 
 struct ccn_plan {
     ccn_options opts;
-    int32_t L, R, K;        /* output level, refinement depth, cap level (-1: none) */
+    int32_t L, R, K;        /* output level, levels built (max(L, K)), cap level (-1: none) */
     ccn_mesh **lev;         /* R+1 meshes: lev[0] is the cage */
     ccn__level *prep;       /* R prepared levels */
+    /* level L+1, needed only around irregular vertices: either lev[L+1] (R > L) or computed
+     * partially into posS from level L by `sub` around the vertices in near[] */
+    ccn__level sub;
+    int has_sub;
+    double *posS;
+    int32_t nnear, *near;
     int32_t ncage;
     /* output mesh = level L without isolated vertices */
     int32_t nout_v, nout_f;
     int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */
     int32_t *out_fv, *out_origin;
-    /* limit stencils over level-R vertices, CSR */
+    /* limit stencils, CSR; index < lev[L]->nv: a level-L vertex, else (index - lev[L]->nv)
+     * is a level-(L+1) point (face points, edge points, vertex points) */
     int32_t *st_start, *st_v;
     double *st_wp, *st_wu, *st_wv;
-    int32_t *orient;        /* 3 level-R vertices per output vertex (v, a, b) or -1: flip the
+    int32_t *orient;        /* 3 stencil indices per output vertex (v, a, b) or -1: flip the
                                normal to agree with (a-v) x (b-v) */
     /* caps */
     int32_t ncap;

@@ -236,6 +236,40 @@ void ccn__level_points(const ccn__level *c, double *out) {
     apply_red(c, 2, fp, ep, vp);
 }
 
+/* Only the points around the listed vertices: their vertex points, the edge points of
+ * their edges and the face points of their faces (plus every EV's red points). */
+void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
+                              double *out) {
+    const ccn_mesh *m = c->m;
+    double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i];
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
+            else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
+        }
+    }
+    apply_red(c, 0, fp, ep, vp);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i], n = ccn__valence(m, v);
+        for (int32_t k = 0; k < n; k++) {
+            int32_t e = ccn__fan_edge(m, v, k);
+            ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+            ccn__edge_point(m, c->erep[e], c->H, fp, ep + 3 * (size_t)e);
+        }
+    }
+    apply_red(c, 1, fp, ep, vp);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i];
+        double *o = vp + 3 * (size_t)v;
+        if (m->vfan_start[v + 1] == m->vfan_start[v]) memcpy(o, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        else if (m->vboundary[v]) ccn__boundary_vertex_point(m, v, c->H, c->pinned, o);
+        else ccn__nurss_vertex_point(m, v, c->H, fp, o);
+    }
+    apply_red(c, 2, fp, ep, vp);
+}
+
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err) {
     const ccn_mesh *m = c->m;
     int64_t nv2 = (int64_t)m->nf + m->ne + m->nv, nh2 = 4 * (int64_t)m->nh;

@@ -5,12 +5,6 @@
 
 #include <string.h>
 
-/* Level-R descendant (vertex-point chain) of level-l vertex v. */
-static int32_t descend_vertex(const ccn_plan *p, int32_t l, int32_t v, int32_t to) {
-    for (; l < to; l++) v += p->lev[l]->nf + p->lev[l]->ne;
-    return v;
-}
-
 static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     p->vmapL = malloc(sizeof(int32_t) * (size_t)mL->nv);
@@ -57,37 +51,49 @@ static int csr_push(csr_buf *b, const ccn__stencil *s) {
     return 0;
 }
 
-/* EV normals are oriented against the 1-ring's first face at evaluation time. */
-static void ev_orientation(const ccn_mesh *m, int32_t v, int32_t *o) {
-    int32_t h = m->vfan[m->vfan_start[v]];
-    o[0] = v;
-    o[1] = m->hvert[ccn__next(m, h)];
-    o[2] = m->hvert[ccn__prev(m, h)];
+/* Is v, or a vertex of one of its faces, irregular (then its level-L box does not refine by
+ * knot insertion and its limit needs level L+1)? */
+static int near_irregular(const ccn_mesh *m, int32_t v, int pinned) {
+    if (ccn__limit_kind(m, v, pinned) != CCN_LIMIT_REGULAR) return 1;
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t f = m->hface[m->vfan[k]];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
+            if (ccn__limit_kind(m, m->hvert[h], pinned) != CCN_LIMIT_REGULAR) return 1;
+    }
+    return 0;
+}
+
+static void offset_stencil(ccn__stencil *s, int32_t off) {
+    for (int i = 0; i < s->n; i++) s->v[i] += off;
 }
 
 static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
-    const ccn_mesh *mR = p->lev[p->R];
+    const ccn_mesh *mL = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     ccn__stencil *s = malloc(sizeof *s);
     csr_buf b = {0, 0, NULL, NULL, NULL, NULL};
     p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
     p->orient = malloc(sizeof(int32_t) * 3 * (size_t)(p->nout_v ? p->nout_v : 1));
+    p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     ccn_status st = CCN_OK;
-    if (!s || !p->st_start || !p->orient) {
+    if (!s || !p->st_start || !p->orient || !p->near) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
     p->st_start[0] = 0;
-    const ccn_mesh *mL = p->lev[p->L];
+    p->nnear = 0;
     for (int32_t v = 0; v < mL->nv; v++) {
         int32_t o = p->vmapL[v];
         if (o < 0) continue;
-        int32_t vr = descend_vertex(p, p->L, v, p->R);
-        int kind = ccn__limit_stencil(mR, vr, pinned, s);
-        p->orient[3 * o] = -1;
-        if (kind == CCN_LIMIT_EV) {
-            if ((st = ccn__ev_limit(mR, vr, p->opts.scheme, s, err))) goto done;
-            ev_orientation(mR, vr, p->orient + 3 * o);
+        int32_t *ori = p->orient + 3 * o;
+        if (!near_irregular(mL, v, pinned)) {
+            ccn__limit_stencil(mL, v, pinned, s);
+            ori[0] = -1;
+        } else {
+            p->near[p->nnear++] = v;
+            if ((st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, s, ori, err))) goto done;
+            offset_stencil(s, mL->nv);
+            if (ori[0] >= 0) for (int k = 0; k < 3; k++) ori[k] += mL->nv;
         }
         if (csr_push(&b, s)) {
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");

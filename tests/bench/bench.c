@@ -1,0 +1,71 @@
+/* Benchmark of the C library: plan creation (topology/interval change) and evaluation
+ * (position-only change) for one cage; prints seconds (min over repeats). */
+#include "ccnurbs.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+static char *slurp(const char *path, size_t *len) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *b = malloc((size_t)n + 1);
+    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
+    fclose(f);
+    if (b) { b[n] = 0; *len = (size_t)n; }
+    return b;
+}
+
+int main(int argc, char **argv) {
+    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats]\n"); return 2; }
+    int levels = atoi(argv[2]), reps = argc > 4 ? atoi(argv[4]) : 5;
+    ccn_options o = {0};
+    o.levels = levels;
+    o.cap = argc > 3 && strcmp(argv[3], "refine") == 0 ? CCN_CAP_REFINE : CCN_CAP_GUIDED_BI5;
+    size_t len;
+    char *text = slurp(argv[1], &len);
+    ccn_obj *obj;
+    ccn_error err;
+    if (!text || ccn_obj_parse(text, len, &obj, &err)) { fprintf(stderr, "cannot read %s\n", argv[1]); return 2; }
+    ccn_cage cage;
+    ccn_obj_cage(obj, &cage);
+    double tplan = 1e30, teval = 1e30;
+    ccn_plan *plan = NULL;
+    for (int r = 0; r < reps; r++) {
+        double t0 = now();
+        if (ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+        double t1 = now() - t0;
+        tplan = t1 < tplan ? t1 : tplan;
+        if (r + 1 < reps) ccn_plan_destroy(plan);
+    }
+    ccn_sizes s;
+    ccn_plan_sizes(plan, &s);
+    double *pos = malloc(sizeof(double) * 3 * s.num_verts), *nrm = malloc(sizeof(double) * 3 * s.num_verts);
+    double *cp = malloc(sizeof(double) * 3 * cage.num_verts);
+    memcpy(cp, cage.positions, sizeof(double) * 3 * cage.num_verts);
+    ccn_limit_mesh lm = {pos, nrm, NULL, NULL};
+    for (int r = 0; r < 3 * reps; r++) {
+        cp[0] += 1e-3;
+        double t0 = now();
+        if (ccn_plan_evaluate(plan, cp, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+        double t1 = now() - t0;
+        teval = t1 < teval ? t1 : teval;
+    }
+    printf("%s L%d %s: cage %d faces -> %d verts %d faces; plan %.4f s, evaluate %.4f s\n", argv[1],
+           levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts, s.num_faces,
+           tplan, teval);
+    ccn_plan_destroy(plan);
+    ccn_obj_destroy(obj);
+    free(text); free(pos); free(nrm); free(cp);
+    return 0;
+}

@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Benchmark cages (standard library only): a quad cube-sphere (6 x 37 x 37 = 8214 faces),
+a production-like cage with valences 3-6 (>= 1500 faces, built by one Catmull-Clark-style
+split of a mixed cage), and a cage with non-uniform knot intervals."""
+import math, os, random, sys
+
+def write(path, V, F, knots=None):
+    with open(path, "w") as f:
+        for v in V: f.write("v %.9f %.9f %.9f\n" % tuple(v))
+        for q in F: f.write("f " + " ".join(str(i + 1) for i in q) + "\n")
+        for (a, b, d) in knots or []: f.write("# knot %d %d %.6g\n" % (a + 1, b + 1, d))
+
+def cube_sphere(n):
+    V, F, idx = [], [], {}
+    def vid(p):
+        key = tuple(round(c * 1e6) for c in p)
+        if key not in idx:
+            idx[key] = len(V); V.append(p)
+        return idx[key]
+    axes = [(0, 1, 2, 1), (0, 1, 2, -1), (1, 2, 0, 1), (1, 2, 0, -1), (2, 0, 1, 1), (2, 0, 1, -1)]
+    for (a, b, c, s) in axes:
+        for i in range(n):
+            for j in range(n):
+                quad = []
+                for (di, dj) in ((0, 0), (1, 0), (1, 1), (0, 1)) if s > 0 else ((0, 0), (0, 1), (1, 1), (1, 0)):
+                    p = [0.0, 0.0, 0.0]
+                    p[a] = -1 + 2 * (i + di) / n; p[b] = -1 + 2 * (j + dj) / n; p[c] = s
+                    l = math.sqrt(sum(x * x for x in p))
+                    quad.append(vid([x / l for x in p]))
+                F.append(quad)
+    return V, F
+
+def split_once(V, F):
+    """Linear quad split (face point, edge points): all-quad cage, valences of V kept."""
+    V = [list(v) for v in V]; emap = {}; NF = []
+    def ep(a, b):
+        k = (min(a, b), max(a, b))
+        if k not in emap:
+            emap[k] = len(V); V.append([(V[a][i] + V[b][i]) / 2 for i in range(3)])
+        return emap[k]
+    for f in F:
+        c = len(V); V.append([sum(V[v][i] for v in f) / len(f) for i in range(3)])
+        n = len(f)
+        for j in range(n):
+            NF.append([f[j], ep(f[j], f[(j + 1) % n]), c, ep(f[(j - 1) % n], f[j])])
+    return V, NF
+
+def car_like():
+    """A rounded box with a few poles: cube sphere 5x5 per face with some faces triangulated
+    and a pentagon, then split twice -> valences 3, 4, 5, 6, >= 1500 quads."""
+    V, F = cube_sphere(5)
+    random.seed(3)
+    out = []
+    for k, f in enumerate(F):
+        if k % 17 == 3: out += [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]  # valence 5/6 poles
+        else: out.append(f)
+    V, F = split_once(V, out)
+    V, F = split_once(V, F)
+    V = [[x * (1.8 if i == 0 else 1.0) + 0.01 * random.uniform(-1, 1) for i, x in enumerate(v)] for v in V]
+    return V, F
+
+def nonuniform(V, F):
+    random.seed(7)
+    knots = []
+    for f in F:
+        for j in range(len(f)):
+            if random.random() < 0.3:
+                knots.append((f[j], f[(j + 1) % len(f)], 10 ** random.uniform(-1, 1)))
+    return knots
+
+if __name__ == "__main__":
+    out = sys.argv[1] if len(sys.argv) > 1 else "."
+    os.makedirs(out, exist_ok=True)
+    V, F = cube_sphere(37); write(os.path.join(out, "sphere8k.obj"), V, F)
+    V, F = car_like(); write(os.path.join(out, "carlike.obj"), V, F)
+    write(os.path.join(out, "carlike_knots.obj"), V, F, nonuniform(V, F))
+    print("sphere8k: %d faces" % (6 * 37 * 37))
