@@ -53,12 +53,12 @@ static int csr_push(csr_buf *b, const ccn__stencil *s) {
 
 /* Is v, or a vertex of one of its faces, irregular (then its level-L box does not refine by
  * knot insertion and its limit needs level L+1)? */
-static int near_irregular(const ccn_mesh *m, int32_t v, int pinned) {
-    if (ccn__limit_kind(m, v, pinned) != CCN_LIMIT_REGULAR) return 1;
+static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irregular) {
+    if (irregular[v]) return 1;
     for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
         int32_t f = m->hface[m->vfan[k]];
         for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
-            if (ccn__limit_kind(m, m->hvert[h], pinned) != CCN_LIMIT_REGULAR) return 1;
+            if (irregular[m->hvert[h]]) return 1;
     }
     return 0;
 }
@@ -75,18 +75,20 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
     p->orient = malloc(sizeof(int32_t) * 3 * (size_t)(p->nout_v ? p->nout_v : 1));
     p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    uint8_t *irr = malloc((size_t)(mL->nv ? mL->nv : 1));
     ccn_status st = CCN_OK;
-    if (!s || !p->st_start || !p->orient || !p->near) {
+    if (!s || !p->st_start || !p->orient || !p->near || !irr) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
     p->st_start[0] = 0;
     p->nnear = 0;
+    for (int32_t v = 0; v < mL->nv; v++) irr[v] = ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_REGULAR;
     for (int32_t v = 0; v < mL->nv; v++) {
         int32_t o = p->vmapL[v];
         if (o < 0) continue;
         int32_t *ori = p->orient + 3 * o;
-        if (!near_irregular(mL, v, pinned)) {
+        if (!near_irregular(mL, v, irr)) {
             ccn__limit_stencil(mL, v, pinned, s);
             ori[0] = -1;
         } else {
@@ -104,6 +106,7 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
 done:
     p->st_v = b.v; p->st_wp = b.wp; p->st_wu = b.wu; p->st_wv = b.wv;
     free(s);
+    free(irr);
     return st;
 }
 
