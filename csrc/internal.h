@@ -83,6 +83,7 @@ ccn_status ccn__resolve_rings(ccn_mesh *m, const double *edge_values, const int3
 typedef struct {
     const ccn_mesh *m;   /* the level's topology, intervals and (input) positions */
     int pinned, red;     /* red: eigen matrices at the EVs */
+    int threads;         /* for ccn__level_points (set by the owner; default 1) */
     int32_t *erep;       /* a half-edge per edge */
     int32_t nev, *ev_list;
     double *M;           /* concatenated EV matrices ((2n+1)^2 each) */

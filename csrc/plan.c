@@ -12,6 +12,7 @@
 
 #include "bspline.h"
 #include "patches.h"
+#include "parallel.h"
 
 #include <math.h>
 #include <string.h>
@@ -75,6 +76,7 @@ static ccn_status build_levels(ccn_plan *p, int32_t R, ccn_error *err) {
     for (int32_t l = p->R; l < R; l++) {
         ccn_status st = ccn__level_prepare(&p->prep[l], p->lev[l], p->opts.scheme, pinned, err);
         if (st) return st;
+        p->prep[l].threads = p->threads;
         p->lev[l + 1] = NULL;
         p->R = l + 1; /* prep[l] is owned from here on */
         st = ccn__level_topology(&p->prep[l], &p->lev[l + 1], err);
@@ -245,6 +247,7 @@ static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
     ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, err);
     if (st) return st;
     p->has_sub = 1;
+    p->sub.threads = 1; /* a few points only */
     p->posS = malloc(sizeof(double) * 3 * ((size_t)m->nf + m->ne + m->nv));
     if (!p->posS) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     return CCN_OK;
@@ -283,6 +286,7 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     ccn_plan *p = calloc(1, sizeof *p);
     if (!p) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     p->opts = o;
+    p->threads = ccn__thread_count(o.threads);
     p->lev = calloc(1, sizeof(ccn_mesh *));
     if (!p->lev) { free(p); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     ccn_mesh *cage_mesh = NULL;
@@ -330,10 +334,15 @@ static void unit_normal(const double du[3], const double dv[3], double n[3]) {
 
 #define SPOINT(i) ((i) < nvL ? PL + 3 * (size_t)(i) : PS + 3 * ((size_t)(i) - nvL))
 
-static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
+typedef struct { const ccn_plan *p; ccn_limit_mesh *out; } stencil_job;
+
+static void stencil_range(void *ctx, int32_t begin, int32_t end) {
+    const stencil_job *j = ctx;
+    const ccn_plan *p = j->p;
+    ccn_limit_mesh *out = j->out;
     const double *PL = p->lev[p->L]->pos, *PS = p->posS;
     int32_t nvL = p->lev[p->L]->nv;
-    for (int32_t o = 0; o < p->nout_v; o++) {
+    for (int32_t o = begin; o < end; o++) {
         double x[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
         for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
             const double *q = SPOINT(p->st_v[k]);
@@ -359,6 +368,11 @@ static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
             if (c[0] * n[0] + c[1] * n[1] + c[2] * n[2] < 0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
         }
     }
+}
+
+static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
+    stencil_job j = {p, out};
+    ccn__parallel_for(p->threads, p->nout_v, stencil_range, &j);
 }
 
 #if CCN_HAVE_BI5

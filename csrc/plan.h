@@ -20,6 +20,7 @@ typedef struct {
 
 struct ccn_plan {
     ccn_options opts;
+    int threads;
     int32_t L, R, K;        /* output level, levels built (max(L, K)), cap level (-1: none) */
     ccn_mesh **lev;         /* R+1 meshes: lev[0] is the cage */
     ccn__level *prep;       /* R prepared levels */

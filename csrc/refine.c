@@ -17,38 +17,45 @@
  * the face point of f to the edge point of h_j is 2*ne + fstart[f] + j.
  */
 #include "bspline.h"
+#include "parallel.h"
 
 #include <math.h>
 #include <string.h>
 
 /* ---- points ----------------------------------------------------------------------- */
 
-static void face_points(const ccn__level *c, double *fp) {
-    const ccn_mesh *m = c->m;
-    for (int32_t f = 0; f < m->nf; f++) {
-        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
-        else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
+typedef struct { const ccn__level *c; double *fp, *ep, *vp; } points_job;
+
+static void face_range(void *ctx, int32_t b, int32_t e) {
+    const points_job *j = ctx;
+    const ccn_mesh *m = j->c->m;
+    for (int32_t f = b; f < e; f++) {
+        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, j->c->pinned, j->fp + 3 * (size_t)f);
+        else ccn__ngon_face_point(m, f, j->fp + 3 * (size_t)f);
     }
 }
 
-static void edge_points(const ccn__level *c, const double *fp, double *ep) {
-    const ccn_mesh *m = c->m;
-    for (int32_t e = 0; e < m->ne; e++)
-        ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
-    for (int32_t e = 0; e < m->ne; e++)
-        ccn__edge_point(m, c->erep[e], c->H, fp, ep + 3 * (size_t)e);
+static void edge_range(void *ctx, int32_t b, int32_t end) {
+    const points_job *j = ctx;
+    const ccn__level *c = j->c;
+    for (int32_t e = b; e < end; e++) {
+        ccn__curve_edge_point(c->m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+        ccn__edge_point(c->m, c->erep[e], c->H, j->fp, j->ep + 3 * (size_t)e);
+    }
 }
 
-static void vertex_points(const ccn__level *c, const double *fp, double *vp) {
+static void vertex_range(void *ctx, int32_t b, int32_t e) {
+    const points_job *j = ctx;
+    const ccn__level *c = j->c;
     const ccn_mesh *m = c->m;
-    for (int32_t v = 0; v < m->nv; v++) {
-        double *out = vp + 3 * (size_t)v;
+    for (int32_t v = b; v < e; v++) {
+        double *out = j->vp + 3 * (size_t)v;
         if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
             memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
         } else if (m->vboundary[v]) {
             ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
         } else {
-            ccn__nurss_vertex_point(m, v, c->H, fp, out);
+            ccn__nurss_vertex_point(m, v, c->H, j->fp, out);
         }
     }
 }
@@ -210,6 +217,7 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
     c->m = m;
     c->pinned = pinned;
     c->red = scheme == CCN_SCHEME_EIGEN && m->info.level >= 1;
+    c->threads = 1;
     c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
     c->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
     c->ev_list = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
@@ -228,11 +236,12 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
 void ccn__level_points(const ccn__level *c, double *out) {
     const ccn_mesh *m = c->m;
     double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
-    face_points(c, fp);
+    points_job j = {c, fp, ep, vp};
+    ccn__parallel_for(c->threads, m->nf, face_range, &j);
     apply_red(c, 0, fp, ep, vp);
-    edge_points(c, fp, ep);
+    ccn__parallel_for(c->threads, m->ne, edge_range, &j);
     apply_red(c, 1, fp, ep, vp);
-    vertex_points(c, fp, vp);
+    ccn__parallel_for(c->threads, m->nv, vertex_range, &j);
     apply_red(c, 2, fp, ep, vp);
 }
 
@@ -305,11 +314,12 @@ done:
     return st;
 }
 
-static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, ccn_mesh **out,
-                               ccn_error *err) {
+static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, int threads,
+                               ccn_mesh **out, ccn_error *err) {
     ccn__level c;
     ccn_status st = ccn__level_prepare(&c, m, scheme, pinned, err);
     if (st) return st;
+    c.threads = threads;
     st = ccn__level_topology(&c, out, err);
     if (!st) ccn__level_points(&c, (*out)->pos);
     ccn__level_free(&c);
@@ -363,7 +373,7 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
     if (!cur) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     for (int32_t l = 0; l < levels; l++) {
         ccn_mesh *next = NULL;
-        ccn_status st = refine_level(cur, o.scheme, pinned, &next, err);
+        ccn_status st = refine_level(cur, o.scheme, pinned, ccn__thread_count(o.threads), &next, err);
         ccn_mesh_destroy(cur);
         if (st) return st;
         cur = next;

@@ -328,7 +328,30 @@ static void test_nonuniform_finite(void) {
     }
 }
 
+/* Threads split work into disjoint ranges: bitwise identical output for 1 and 3 threads. */
+static void test_threads_deterministic(void) {
+    ccn_cage cage;
+    ccn_obj *obj = load("icosa_quad.obj", &cage);
+    if (!obj) { CHECK(0, "load"); return; }
+    limit_mesh a, b;
+    ccn_options o = {0};
+    o.levels = 4; o.cap = CCN_CAP_REFINE; o.threads = 1;
+    int ra = evaluate(&cage, &o, NULL, &a);
+    o.threads = 3;
+    int rb = evaluate(&cage, &o, NULL, &b);
+    CHECK(ra == 0 && rb == 0, "evaluate");
+    if (!ra && !rb) {
+        CHECK(a.nv == b.nv && a.nv > 3 * 4096, "large enough to run threaded (%d)", a.nv);
+        CHECK(memcmp(a.pos, b.pos, sizeof(double) * 3 * a.nv) == 0, "positions identical");
+        CHECK(memcmp(a.nrm, b.nrm, sizeof(double) * 3 * a.nv) == 0, "normals identical");
+    }
+    if (!ra) free_lm(&a);
+    if (!rb) free_lm(&b);
+    ccn_obj_destroy(obj);
+}
+
 int main(void) {
+    RUN(test_threads_deterministic);
     RUN(test_watertight);
     RUN(test_normals_vs_finite_differences);
     RUN(test_plan_reuse);
