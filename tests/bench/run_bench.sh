@@ -1,0 +1,28 @@
+#!/bin/sh
+# `make bench`: CCNURBS vs OpenSubdiv 3.5 (and Blender's Subdivision Surface modifier when
+# tests/blender/bench_blender.py exists) on the same meshes, in one run on this machine.
+# Ratios are ours / theirs (lower is better for times).
+cd "$(dirname "$0")/../.." || exit 2
+D=build/bench
+mkdir -p "$D"
+python3 tests/bench/make_bench_cages.py "$D" > /dev/null || exit 2
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", (b > 0 ? a / b : 0) }'; }
+field() { sed -n "s/.*$1 \([0-9.]*\) s.*/\1/p"; }
+echo "mesh level | ccn plan | ccn evaluate | ccn refine | osd topology+points | osd points+limit | refine ratio | evaluate ratio | plan ratio"
+for cage in sphere8k carlike carlike_knots; do
+  for L in 2 3; do
+    o=$(build/bench/osd_bench "$D/$cage.obj" "$L" 3) || exit 2
+    c=$(build/bench/ccn_bench "$D/$cage.obj" "$L" refine 3) || exit 2
+    ot=$(echo "$o" | field topology); op=$(echo "$o" | field points); ol=$(echo "$o" | field limit)
+    cp=$(echo "$c" | field plan); ce=$(echo "$c" | field evaluate); cr=$(echo "$c" | field refine)
+    otp=$(awk -v a="$ot" -v b="$op" 'BEGIN{print a+b}'); opl=$(awk -v a="$op" -v b="$ol" 'BEGIN{print a+b}')
+    oall=$(awk -v a="$ot" -v b="$op" -v c="$ol" 'BEGIN{print a+b+c}')
+    echo "$cage L$L | $cp | $ce | $cr | $otp | $opl | $(ratio "$cr" "$otp") | $(ratio "$ce" "$opl") | $(ratio "$cp" "$oall")"
+  done
+done
+echo "refine ratio = ccn_refine (topology + points) / OSD uniform refinement (topology + points);"
+echo "evaluate ratio = plan evaluate (positions + normals) / OSD re-interpolation + Limit with tangents;"
+echo "plan ratio = plan creation / OSD topology + points + limit."
+if [ -f tests/blender/bench_blender.py ] && command -v blender > /dev/null; then
+  blender --background --factory-startup --python-exit-code 1 --python tests/blender/bench_blender.py -- "$D" 2>/dev/null | grep '^bench'
+fi
