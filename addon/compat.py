@@ -1,0 +1,110 @@
+"""Every Blender 3.x / 4.x API difference used by the add-on lives here.
+
+Tested on Blender 3.4; written for 4.2+ (extension platform) from the 4.x API documentation.
+"""
+import bpy
+
+VERSION = bpy.app.version
+
+
+# ---- node groups ------------------------------------------------------------------------------
+
+def new_group_socket(group, name, in_out, socket_type):
+    """Group interface socket: `interface.new_socket` (4.0+) vs `inputs/outputs.new` (3.x)."""
+    if hasattr(group, "interface"):
+        return group.interface.new_socket(name=name, in_out=in_out, socket_type=socket_type)
+    sockets = group.inputs if in_out == 'INPUT' else group.outputs
+    return sockets.new(socket_type, name)
+
+
+def switch_geometry_sockets(node):
+    """(switch, false, true, output) of a Geometry Switch node. 3.x: one pair of sockets per
+    type, the non-field boolean 'Switch' is the enabled one; 4.1+: a single typed set."""
+    node.input_type = 'GEOMETRY'
+    switch = [s for s in node.inputs if s.type == 'BOOLEAN' and s.enabled][0]
+    false_in, true_in = [s for s in node.inputs if s.type == 'GEOMETRY'][:2]
+    out = [s for s in node.outputs if s.type == 'GEOMETRY'][0]
+    return switch, false_in, true_in, out
+
+
+# ---- meshes -----------------------------------------------------------------------------------
+
+def set_face_loops(mesh, loop_start, loop_total):
+    """Polygon corner ranges: `loop_total` is writable (and required) in 3.x only."""
+    mesh.polygons.foreach_set("loop_start", loop_start)
+    if VERSION < (4, 0, 0):
+        mesh.polygons.foreach_set("loop_total", loop_total)
+
+
+def set_vertex_normals(mesh, normals):
+    """Custom split normals from per-vertex unit normals, smooth shading.
+    < 4.1 needs `use_auto_smooth` for custom normals to be used; 4.1 removed it."""
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = True
+    mesh.normals_split_custom_set_from_vertices(normals)
+
+
+def corner_normals(mesh):
+    """Per-corner (loop) normals as a flat float list: `calc_normals_split` + loops (< 4.1)
+    vs `corner_normals` (4.1+)."""
+    import numpy as np
+    n = len(mesh.loops)
+    out = np.empty(3 * n, np.float32)
+    if hasattr(mesh, "corner_normals"):
+        mesh.corner_normals.foreach_get("vector", out)
+    else:
+        mesh.calc_normals_split()
+        mesh.loops.foreach_get("normal", out)
+    return out.reshape(n, 3)
+
+
+def has_custom_normals(mesh):
+    return bool(mesh.has_custom_normals)
+
+
+# ---- drawing ----------------------------------------------------------------------------------
+
+_SHADERS_3X = {"POLYLINE_SMOOTH_COLOR": "3D_POLYLINE_SMOOTH_COLOR",
+               "SMOOTH_COLOR": "3D_SMOOTH_COLOR",
+               "UNIFORM_COLOR_2D": "2D_UNIFORM_COLOR",
+               "SMOOTH_COLOR_2D": "2D_SMOOTH_COLOR"}
+_SHADERS_4X = {"POLYLINE_SMOOTH_COLOR": "POLYLINE_SMOOTH_COLOR",
+               "SMOOTH_COLOR": "SMOOTH_COLOR",
+               "UNIFORM_COLOR_2D": "UNIFORM_COLOR",
+               "SMOOTH_COLOR_2D": "SMOOTH_COLOR"}
+
+
+def builtin_shader(name):
+    """Built-in shader names lost their 2D_/3D_ prefixes in 4.0."""
+    import gpu
+    table = _SHADERS_4X if VERSION >= (4, 0, 0) else _SHADERS_3X
+    return gpu.shader.from_builtin(table[name])
+
+
+def blf_size(font_id, size):
+    """blf.size lost its dpi argument in 4.0."""
+    import blf
+    if VERSION >= (4, 0, 0):
+        blf.size(font_id, size)
+    else:
+        blf.size(font_id, size, 72)
+
+
+# ---- context ----------------------------------------------------------------------------------
+
+def temp_override(context, **kw):
+    """Context override: `context.temp_override` (3.2+ and 4.x)."""
+    return context.temp_override(**kw)
+
+
+def move_modifier_first(obj, mod, context=None):
+    """`ObjectModifiers.move` (3.5+/4.x) vs the operator with a context override (3.4)."""
+    idx = list(obj.modifiers).index(mod)
+    if idx == 0:
+        return
+    if hasattr(obj.modifiers, "move"):
+        obj.modifiers.move(idx, 0)
+        return
+    ctx = context or bpy.context
+    with ctx.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.modifier_move_to_index(modifier=mod.name, index=0)

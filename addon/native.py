@@ -1,0 +1,236 @@
+"""ctypes binding to libccnurbs.so, shipped inside this package.
+
+Only the plan API is bound: ccn_plan_create / ccn_plan_sizes / ccn_plan_evaluate /
+ccn_plan_destroy. Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
+buffers passed by pointer; a failing call raises CCNError carrying the library's message.
+"""
+import ctypes
+import os
+
+import numpy as np
+
+LIB_NAME = "libccnurbs.so"
+
+c_int32_p = ctypes.POINTER(ctypes.c_int32)
+c_double_p = ctypes.POINTER(ctypes.c_double)
+
+# ccn_scheme, ccn_cap, ccn_corners (C enums: int)
+SCHEMES = {"EIGEN": 0, "NURSS": 1, "CATMULL_CLARK": 2}
+CAPS = {"GUIDED_BI5": 0, "REFINE": 1}
+CORNERS = {"ALL": 0, "PRESERVE_CORNERS": 1}
+
+
+class CCNError(Exception):
+    """A library call failed. `status` is the ccn_status name, str(e) the library's message."""
+
+    def __init__(self, status, message, element_kind=0, element=-1):
+        super().__init__(message)
+        self.status = status
+        self.element_kind = element_kind
+        self.element = element
+
+
+class ccn_error(ctypes.Structure):
+    _fields_ = [("status", ctypes.c_int),
+                ("element_kind", ctypes.c_int32),
+                ("element", ctypes.c_int32),
+                ("message", ctypes.c_char * 256)]
+
+
+class ccn_cage(ctypes.Structure):
+    _fields_ = [("num_verts", ctypes.c_int32),
+                ("num_faces", ctypes.c_int32),
+                ("num_edges", ctypes.c_int32),
+                ("positions", c_double_p),
+                ("face_sizes", c_int32_p),
+                ("face_verts", c_int32_p),
+                ("edge_verts", c_int32_p),
+                ("edge_knots", c_double_p),
+                ("edge_creases", c_double_p)]
+
+
+class ccn_options(ctypes.Structure):
+    _fields_ = [("scheme", ctypes.c_int),
+                ("cap", ctypes.c_int),
+                ("levels", ctypes.c_int32),
+                ("boundary_corners", ctypes.c_int32),
+                ("threads", ctypes.c_int32)]
+
+
+class ccn_sizes(ctypes.Structure):
+    _fields_ = [("num_verts", ctypes.c_int32),
+                ("num_faces", ctypes.c_int32),
+                ("num_cage_verts", ctypes.c_int32),
+                ("levels", ctypes.c_int32),
+                ("refine_levels", ctypes.c_int32),
+                ("num_extraordinary", ctypes.c_int32),
+                ("num_caps", ctypes.c_int32),
+                ("num_cap_fallbacks", ctypes.c_int32),
+                ("num_ev_fallbacks", ctypes.c_int32),
+                ("num_ring_conflicts", ctypes.c_int32),
+                ("num_ignored_verts", ctypes.c_int32),
+                ("num_ignored_edges", ctypes.c_int32)]
+
+
+class ccn_limit_mesh(ctypes.Structure):
+    _fields_ = [("positions", c_double_p),
+                ("normals", c_double_p),
+                ("face_verts", c_int32_p),
+                ("face_origin", c_int32_p)]
+
+
+_lib = None
+_load_error = None
+
+
+def library_path():
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), LIB_NAME)
+
+
+def _bind(lib):
+    """Sets argtypes/restype once for every function used."""
+    P = ctypes.c_void_p
+    lib.ccn_plan_create.argtypes = [ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
+                                    ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_create.restype = ctypes.c_int
+    lib.ccn_plan_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
+    lib.ccn_plan_sizes.restype = ctypes.c_int
+    lib.ccn_plan_evaluate.argtypes = [P, c_double_p, ctypes.POINTER(ccn_limit_mesh),
+                                      ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_evaluate.restype = ctypes.c_int
+    lib.ccn_plan_destroy.argtypes = [P]
+    lib.ccn_plan_destroy.restype = None
+    lib.ccn_status_name.argtypes = [ctypes.c_int]
+    lib.ccn_status_name.restype = ctypes.c_char_p
+
+
+def load():
+    """Returns the loaded library; raises CCNError('CCN_ERR_LOAD', ...) if it cannot be used."""
+    global _lib, _load_error
+    if _lib is not None:
+        return _lib
+    if _load_error is not None:
+        raise CCNError("CCN_ERR_LOAD", _load_error)
+    path = library_path()
+    try:
+        lib = ctypes.CDLL(path)
+        _bind(lib)
+    except (OSError, AttributeError) as e:
+        _load_error = "cannot load the CCNURBS library: %s" % (e,)
+        raise CCNError("CCN_ERR_LOAD", _load_error) from None
+    _lib = lib
+    return lib
+
+
+def available():
+    try:
+        load()
+        return True
+    except CCNError:
+        return False
+
+
+def load_error():
+    return _load_error
+
+
+def status_name(status):
+    try:
+        name = load().ccn_status_name(status)
+    except CCNError:
+        name = None
+    return name.decode("utf-8", "replace") if name else "CCN_STATUS_%d" % status
+
+
+def _raise(status, err):
+    msg = err.message.decode("utf-8", "replace").strip() or status_name(status)
+    raise CCNError(status_name(status), msg, err.element_kind, err.element)
+
+
+def _ptr(arr, ctype):
+    return arr.ctypes.data_as(ctypes.POINTER(ctype)) if arr is not None else None
+
+
+class Plan:
+    """A ccn_plan: topology, knot intervals and options, evaluated for new positions.
+
+    cage: positions (V,3), face_sizes (F,), face_verts (sum,), edge_verts (E,2) or None,
+    edge_knots (E,) or None. options: dict scheme/cap/boundary (enum identifiers), levels.
+    """
+
+    def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
+                 scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0):
+        lib = load()
+        self._lib = lib
+        self._handle = None
+        pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
+        fs = np.ascontiguousarray(face_sizes, dtype=np.int32).reshape(-1)
+        fv = np.ascontiguousarray(face_verts, dtype=np.int32).reshape(-1)
+        ev = ek = None
+        if edge_verts is not None and len(edge_verts):
+            ev = np.ascontiguousarray(edge_verts, dtype=np.int32).reshape(-1)
+            if edge_knots is not None:
+                ek = np.ascontiguousarray(edge_knots, dtype=np.float64).reshape(-1)
+                if ek.size * 2 != ev.size:
+                    raise CCNError("CCN_ERR_ARGUMENT", "edge_knots has %d values for %d edges"
+                                   % (ek.size, ev.size // 2))
+        if pos.size % 3:
+            raise CCNError("CCN_ERR_ARGUMENT", "positions must be 3 floats per vertex")
+        cage = ccn_cage(num_verts=pos.size // 3, num_faces=fs.size,
+                        num_edges=(ev.size // 2) if ev is not None else 0,
+                        positions=_ptr(pos, ctypes.c_double), face_sizes=_ptr(fs, ctypes.c_int32),
+                        face_verts=_ptr(fv, ctypes.c_int32), edge_verts=_ptr(ev, ctypes.c_int32),
+                        edge_knots=_ptr(ek, ctypes.c_double), edge_creases=None)
+        opts = ccn_options(scheme=SCHEMES[scheme], cap=CAPS[cap], levels=int(levels),
+                           boundary_corners=CORNERS[boundary], threads=int(threads))
+        handle = ctypes.c_void_p()
+        err = ccn_error()
+        st = lib.ccn_plan_create(ctypes.byref(cage), ctypes.byref(opts), ctypes.byref(handle),
+                                 ctypes.byref(err))
+        if st != 0:
+            _raise(st, err)
+        self._handle = handle
+        s = ccn_sizes()
+        st = lib.ccn_plan_sizes(handle, ctypes.byref(s))
+        if st != 0:
+            self.close()
+            _raise(st, ccn_error())
+        self.sizes = {name: int(getattr(s, name)) for name, _ in ccn_sizes._fields_}
+
+    def evaluate(self, positions=None, topology=True):
+        """Returns dict positions (N,3) f64, normals (N,3) f64 and, if topology, face_verts
+        (F,4) int32 and face_origin (F,) int32."""
+        if self._handle is None:
+            raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
+        n, f = self.sizes["num_verts"], self.sizes["num_faces"]
+        out = {"positions": np.empty((n, 3), np.float64), "normals": np.empty((n, 3), np.float64)}
+        if topology:
+            out["face_verts"] = np.empty((f, 4), np.int32)
+            out["face_origin"] = np.empty(f, np.int32)
+        lm = ccn_limit_mesh(positions=_ptr(out["positions"], ctypes.c_double),
+                            normals=_ptr(out["normals"], ctypes.c_double),
+                            face_verts=_ptr(out.get("face_verts"), ctypes.c_int32),
+                            face_origin=_ptr(out.get("face_origin"), ctypes.c_int32))
+        pos = None
+        if positions is not None:
+            pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
+            if pos.size != 3 * self.sizes["num_cage_verts"]:
+                raise CCNError("CCN_ERR_ARGUMENT", "expected %d cage positions, got %d"
+                               % (self.sizes["num_cage_verts"], pos.size // 3))
+        err = ccn_error()
+        st = self._lib.ccn_plan_evaluate(self._handle, _ptr(pos, ctypes.c_double),
+                                         ctypes.byref(lm), ctypes.byref(err))
+        if st != 0:
+            _raise(st, err)
+        return out
+
+    def close(self):
+        if self._handle is not None:
+            self._lib.ccn_plan_destroy(self._handle)
+            self._handle = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass

@@ -1,0 +1,76 @@
+"""Settings: `Object.ccnurbs` (per cage / proxy) and `Scene.ccnurbs_tools` (knot editing)."""
+import bpy
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
+                       StringProperty)
+
+SCHEME_ITEMS = (
+    ('EIGEN', "Eigen", "Li, Finnigan & Sederberg 2016: eigen-polyhedron rules at extraordinary "
+     "points (single smooth bump, G1)"),
+    ('NURSS', "NURSS", "Sederberg et al. 1998 non-uniform rules everywhere (may show twin "
+     "peaks at extraordinary points)"),
+    ('CATMULL_CLARK', "Catmull-Clark", "Uniform Catmull-Clark: knot intervals are ignored"),
+)
+CAP_ITEMS = (
+    ('GUIDED_BI5', "Guided Bi-5", "Fill extraordinary points with guided bi-5 rings and a G1 "
+     "cap (Karciauskas & Peters 2018): a finite, smooth surface"),
+    ('REFINE', "Refine", "Evaluate the limit of refinement at extraordinary points"),
+)
+BOUNDARY_ITEMS = (
+    ('ALL', "All", "Smooth the boundary and its corners (like Subdivision Surface 'All')"),
+    ('PRESERVE_CORNERS', "Keep Corners", "Pin valence-2 boundary corners (like Subdivision "
+     "Surface 'Keep Corners')"),
+)
+ROLE_ITEMS = (('NONE', "None", ""), ('CAGE', "Cage", ""), ('VIEW_PROXY', "Viewport Proxy", ""),
+              ('RENDER_PROXY', "Render Proxy", ""))
+
+
+def _tag(self, context):
+    """A setting changed: tag the cage so the depsgraph handler re-evaluates it."""
+    obj = self.id_data
+    if isinstance(obj, bpy.types.Object) and self.role == 'CAGE':
+        obj.update_tag(refresh={'DATA'})
+
+
+class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
+    role: EnumProperty(items=ROLE_ITEMS, default='NONE', options={'HIDDEN'})
+    levels: IntProperty(name="Levels Viewport", description="Samples per cage-face side are "
+                        "2^levels (viewport)", default=2, min=0, max=10, soft_max=6, update=_tag)
+    render_levels: IntProperty(name="Render", description="Samples per cage-face side are "
+                               "2^levels (final render)", default=3, min=0, max=10, soft_max=6,
+                               update=_tag)
+    scheme: EnumProperty(name="Scheme", items=SCHEME_ITEMS, default='EIGEN', update=_tag)
+    cap: EnumProperty(name="Cap", items=CAP_ITEMS, default='GUIDED_BI5', update=_tag)
+    boundary_smooth: EnumProperty(name="Boundary Smooth", items=BOUNDARY_ITEMS, default='ALL',
+                                  update=_tag)
+    proxy: PointerProperty(type=bpy.types.Object, name="Viewport Proxy", options={'HIDDEN'})
+    render_proxy: PointerProperty(type=bpy.types.Object, name="Render Proxy",
+                                  options={'HIDDEN'})
+    owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
+
+    def option_tuple(self):
+        return (self.scheme, self.cap, self.boundary_smooth)
+
+
+def _overlay_toggled(self, context):
+    from . import overlay
+    overlay.set_enabled(self.show_overlay, context)
+
+
+class CCNURBS_SceneTools(bpy.types.PropertyGroup):
+    knot_value: FloatProperty(name="Interval", description="Knot interval used by Set",
+                              default=2.0, min=1e-6, soft_min=0.01, soft_max=100.0, precision=3)
+    show_overlay: BoolProperty(name="Knot Overlay", description="Colour edges by knot interval "
+                               "in edit mode", default=False, update=_overlay_toggled)
+
+
+classes = (CCNURBS_ObjectSettings, CCNURBS_SceneTools)
+
+
+def register():
+    bpy.types.Object.ccnurbs = PointerProperty(type=CCNURBS_ObjectSettings)
+    bpy.types.Scene.ccnurbs_tools = PointerProperty(type=CCNURBS_SceneTools)
+
+
+def unregister():
+    del bpy.types.Scene.ccnurbs_tools
+    del bpy.types.Object.ccnurbs

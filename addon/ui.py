@@ -1,0 +1,162 @@
+"""Panels: knot tools in the edit-mode sidebar, modifier settings in the Modifier tab."""
+import bmesh
+import bpy
+
+from . import cage as cagemod
+from . import modifier, native, sync
+
+
+def active_edge_interval(obj):
+    """Interval of the active (last selected) edge in edit mode, or None."""
+    bm = bmesh.from_edit_mesh(obj.data)
+    act = bm.select_history.active
+    if not isinstance(act, bmesh.types.BMEdge):
+        return None
+    layer = bm.edges.layers.float.get(cagemod.KNOT_ATTR)
+    v = act[layer] if layer is not None else 0.0
+    return v if v > 0 else 1.0
+
+
+class VIEW3D_PT_ccnurbs_knots(bpy.types.Panel):
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "CCNURBS"
+    bl_label = "Knot Intervals"
+    bl_context = "mesh_edit"
+
+    def draw(self, context):
+        layout = self.layout
+        tools = context.scene.ccnurbs_tools
+        col = layout.column(align=True)
+        col.prop(tools, "knot_value")
+        op = col.operator("mesh.ccnurbs_set_knot_interval", text="Set on Rings", icon='CHECKMARK')
+        op.value = tools.knot_value
+        row = layout.row(align=True)
+        row.operator("mesh.ccnurbs_select_ring", text="Select Rings", icon='EDGESEL')
+        row = layout.row(align=True)
+        row.operator("mesh.ccnurbs_clear_knot_interval", text="Clear Rings").scope = 'SELECTED'
+        row.operator("mesh.ccnurbs_clear_knot_interval", text="Clear All").scope = 'ALL'
+        layout.prop(tools, "show_overlay", icon='OVERLAY')
+        obj = context.edit_object
+        if obj is not None and obj.type == 'MESH':
+            v = active_edge_interval(obj)
+            if v is not None:
+                layout.label(text="Active edge: %g" % v)
+            if modifier.is_cage(obj):
+                _draw_status(layout, obj)
+
+
+def _draw_status(layout, obj):
+    st = sync.status(obj, 'VIEW')
+    if st is None:
+        return
+    box = layout.box()
+    if st.error:
+        col = box.column()
+        col.alert = True
+        col.label(text="Cage error — showing the last valid limit:", icon='ERROR')
+        for line in _wrap(st.error, 48):
+            col.label(text=line)
+        return
+    box.label(text="Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces), icon='MESH_DATA')
+    z = st.sizes
+    if z:
+        box.label(text="Extraordinary: %d, caps: %d" % (z.get("num_extraordinary", 0),
+                                                      z.get("num_caps", 0)))
+        notes = []
+        if z.get("num_ring_conflicts"):
+            notes.append("%d ring conflicts (mean used)" % z["num_ring_conflicts"])
+        if z.get("num_ev_fallbacks"):
+            notes.append("%d eigen→NURSS fallbacks" % z["num_ev_fallbacks"])
+        if z.get("num_cap_fallbacks"):
+            notes.append("%d cap fallbacks" % z["num_cap_fallbacks"])
+        if z.get("num_ignored_verts") or z.get("num_ignored_edges"):
+            notes.append("ignored: %d loose verts, %d loose edges"
+                         % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))
+        for n in notes:
+            box.label(text=n, icon='INFO')
+        box.label(text="Updated in %.1f ms" % (1000 * st.seconds))
+
+
+def _wrap(text, width):
+    words, lines, cur = text.split(), [], ""
+    for w in words:
+        if cur and len(cur) + 1 + len(w) > width:
+            lines.append(cur)
+            cur = w
+        else:
+            cur = (cur + " " + w) if cur else w
+    if cur:
+        lines.append(cur)
+    return lines
+
+
+def status_lines(obj):
+    """The text the modifier panel shows for a cage (also used by tests)."""
+    st = sync.status(obj, 'VIEW')
+    if st is None:
+        return []
+    if st.error:
+        return ["Cage error — showing the last valid limit:", st.error]
+    return ["Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces)]
+
+
+class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "modifier"
+    bl_label = "CCNURBS"
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.object
+        return ob is not None and ob.type == 'MESH' and ob.ccnurbs.role != 'VIEW_PROXY'
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.object
+        if not native.available():
+            col = layout.column()
+            col.alert = True
+            col.label(text="Library not loaded:", icon='ERROR')
+            for line in _wrap(native.load_error() or "", 48):
+                col.label(text=line)
+        if not modifier.is_cage(obj):
+            layout.operator("object.ccnurbs_add", icon='MOD_SUBSURF')
+            return
+        s = obj.ccnurbs
+        layout.use_property_split = True
+        col = layout.column(align=True)
+        col.prop(s, "levels", text="Levels Viewport")
+        col.prop(s, "render_levels", text="Render")
+        layout.prop(s, "scheme")
+        layout.prop(s, "cap")
+        layout.prop(s, "boundary_smooth")
+        _draw_status(layout, obj)
+        rst = sync.status(obj, 'RENDER')
+        if rst is not None and rst.error:
+            col = layout.column()
+            col.alert = True
+            col.label(text="Render levels: " + rst.error, icon='ERROR')
+        layout.operator("object.ccnurbs_remove", icon='X')
+
+
+def edge_menu(self, context):
+    """Entries in Edit Mode > Edge."""
+    layout = self.layout
+    layout.separator()
+    layout.operator("mesh.ccnurbs_set_knot_interval", text="Set Knot Interval (Rings)")
+    layout.operator("mesh.ccnurbs_select_ring", text="Select Knot Rings")
+    layout.operator("mesh.ccnurbs_clear_knot_interval", text="Clear Knot Intervals").scope = \
+        'SELECTED'
+
+
+classes = (VIEW3D_PT_ccnurbs_knots, DATA_PT_ccnurbs_modifier)
+
+
+def register():
+    bpy.types.VIEW3D_MT_edit_mesh_edges.append(edge_menu)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_edit_mesh_edges.remove(edge_menu)

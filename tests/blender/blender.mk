@@ -1,0 +1,30 @@
+# Blender add-on packaging (included by the main Makefile; B = build dir).
+# `make package` → $(B)/ccnurbs.zip: the add-on package `ccnurbs/` with the library inside.
+# Installable on Blender 3.x (Preferences > Add-ons > Install, bl_info) and laid out as a 4.2+
+# extension (blender_manifest.toml at the package root, files inside one folder).
+BLENDER_SAVED_GOAL := $(.DEFAULT_GOAL)
+APT_PKGS  += blender zip
+ADDON_SRC  = $(sort $(wildcard addon/*.py)) addon/blender_manifest.toml
+
+.PHONY: package
+package: $(B)/ccnurbs.zip
+
+# The shipped library finds its LAPACK/BLAS/gfortran dependencies next to itself (DT_RPATH
+# $$ORIGIN also serves their own dependencies), so the add-on needs nothing installed.
+PKG_DEPS_RE = lapack|blas|tmglib|gfortran|quadmath
+$(B)/package-lib/libccnurbs.so: $(PIC_OBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared -o $@ $(PIC_OBJ) -Wl,--disable-new-dtags,-rpath,'$$ORIGIN' $(LDLIBS)
+
+$(B)/ccnurbs.zip: $(ADDON_SRC) $(B)/package-lib/libccnurbs.so tests/blender/blender.mk
+	@rm -rf $(B)/package && mkdir -p $(B)/package/ccnurbs
+	cp $(ADDON_SRC) $(B)/package/ccnurbs/
+	cp $(B)/package-lib/libccnurbs.so $(B)/package/ccnurbs/libccnurbs.so
+	@for l in $$(ldd $(B)/package-lib/libccnurbs.so | awk '/=> \// {print $$3}' | grep -E '$(PKG_DEPS_RE)'); do \
+	  cp -L "$$l" $(B)/package/ccnurbs/; done
+	@rm -f $@.tmp && cd $(B)/package && zip -qrX ../ccnurbs.zip.tmp ccnurbs
+	@mv $@.tmp $@
+	@echo "package: $@"
+
+TEST_DEPS += $(B)/ccnurbs.zip
+.DEFAULT_GOAL := $(BLENDER_SAVED_GOAL)
