@@ -17,15 +17,8 @@
 #include <math.h>
 #include <string.h>
 
-#if defined(__has_include)
-#if __has_include("bi5.h")
 #include "bi5.h"
 #define CCN_HAVE_BI5 1
-#endif
-#endif
-#ifndef CCN_HAVE_BI5
-#define CCN_HAVE_BI5 0
-#endif
 
 #define CCN_MAX_LEVELS 10
 #define CCN_CAP_MAX_VALENCE 32

@@ -1,0 +1,231 @@
+/* Guided rapidly-contracting bi-5 rings and G1 cap for one extraordinary vertex (EV)
+ * (Karciauskas & Peters 2018, "Rapidly contracting subdivision yields finite, effectively C2
+ * surfaces"; called "the paper" below). Specification: reference/bi5/SPEC.md (section numbers
+ * "SPEC §x" below). Internal header, not installed.
+ *
+ * Files: charmap.c  chi~_sigma, the characteristic tensor-border of adjustable-speed
+ *                   subdivision (SPEC §3), blossoms, c-net neighbour rules (SPEC §1);
+ *        guide.c    the guide g: explicit BB parametrisation (SPEC §4.2), composite jets /
+ *                   sampling matrices (SPEC §2.3), least-squares fit (SPEC §4.4);
+ *        rings.c    BB utilities, t_CC, C2-rule, rings (SPEC §2, §5), the operator
+ *                   (create / apply / eval, global stencil SPEC §7);
+ *        cap.c      planar reparameterisation tau and the G1 cap (SPEC §6).
+ *
+ * Reconstruction choices ([R] = not determined by the paper; SPEC tags in brackets):
+ *  [R1] c-net labels c_1..c_4 = grid nodes (2,0),(2,1),(2,2),(1,2) (SPEC §1.2 [R]); c_5 = (1,1),
+ *       c_6 = (1,0), c_7 = EV are forced by eq. (7) [I].
+ *  [R2] chi~_sigma is the frequency-1 eigenvector of the reconstructed adjustable-speed scheme
+ *       (exact cubic knot insertion on knots (-1/s~,-1,0,1,1/s~,(1+s)/s~), SPEC §3.1), its
+ *       bicubic tensor-border normalised so that chi~[3][0] = 1 (corner on spoke e_0).
+ *  [R3] Guide fit: unweighted least squares over all 27 tensor-border coefficients of every
+ *       sector (spoke coefficients counted twice), target = raise(t_CC) without C2-rule,
+ *       sampling map chi~_{1/2}; b_600 fixed to eq. (7)/(8) or to the caller's centre
+ *       (SPEC §4.4). Solved by Householder QR (LAPACK dgeqrf/dormqr/dtrtrs).
+ *  [R4] tau: the green coefficients max(i,j) >= 4 and tau_33 come from raise(chi~_{sigma_l})
+ *       (7 free parameters, the paper's count); F_5 energy by 6x6 Gauss-Legendre (SPEC §6.2).
+ *  [R5] Cap: the two free coefficients per separator (the differences a_k - b_k, k = 2,3) are
+ *       taken from the jet map a (least squares, SPEC §6.3 step 4).
+ *  [R6] The contraction of the guide g^r(x) = g(Lambda_r x), Lambda_r = lambda_1 ... lambda_r,
+ *       is folded into the sampling map (sampling g with Lambda_r chi~): identical to the
+ *       Appendix's de Casteljau restriction, with one sampling matrix per ring.
+ *  [R7] The guide is stored in BB form per sector (28 coefficients on the triangle
+ *       O, V_s, V_{s+1}); then the sampling matrix [g^s o omega^s phi] is the same for all s.
+ *  [R8] Non-uniform spoke intervals d_0..d_{n-1} (SPEC §9, DESIGN §4.4), t_CC: every interval
+ *       along the line of spoke e_k near the EV is taken equal to d_k (true once the EV is two
+ *       NU refinement levels deep, intervals halving); sector s uses the knots of its own
+ *       virtual regular grid: u-intervals (d_{s+2}, d_{s+2} | d_s, d_s, d_s), v-intervals
+ *       (d_{s-1}, d_{s-1} | d_{s+1}, d_{s+1}, d_{s+1}) ("|" = the EV; these are the real ring
+ *       intervals of the nodes the stencils use), normalised to the hole [0,1]^2; BB weights by
+ *       blossoming (SPEC §9.1, ccn__bi5_bb_weights).
+ *       * kappa_s = d_{s+1}/d_{s-1} = 1 for all s (all equal; alternating for even n): the knots
+ *         are uniform in each sector's own scale, so the operator IS the uniform one (BB form is
+ *         invariant under per-patch affine reparameterisation): stencil path.
+ *       * d_{s+2} = d_{s-2} for all s (kappa may be != 1 only for n = 0 mod 4, period-4
+ *         intervals): the sectors' grids agree, t_CC is C0 and C2 with ratio kappa_s across
+ *         spoke e_s, and it is the prolongation of the exact NU bi-3 ring (patches.c's
+ *         "beyond V" interval (d_{s-2}+d_{s+2})/2 equals d_{s+2} here): NU construction.
+ *       * otherwise sector s continues spoke e_s through the EV along e_{s+2}, sector s-1 along
+ *         e_{s-2}: the two bicubic hole patches (and the bi-3 patches on either side of the
+ *         spoke line) disagree along the spoke; no tensor-border joins such a ring C2:
+ *         ccn__bi5_apply returns CCN_ERR_KNOTS. ccn__bi5_apply_border accepts any intervals
+ *         when the caller supplies a consistent tensor-border of its own surrounding ring.
+ *  [R9] NU rings: the NU C2-rule with r = kappa_s at every level >= 1 (SPEC §9.3); the level-0
+ *       border must already satisfy it (checked in apply_border; exact for the cases above).
+ *  [R10] NU cap G1 form, per separator (spoke e_{s+1} between sectors s and s+1, k = kappa_{s+1}):
+ *       alpha(t) d_u f^s(0,t) + d_v f^{s+1}(t,0) = gamma(t) d_t f^{s+1}(t,0),
+ *       alpha = 1 + (k-1)(2t - t^2) (BB (1,k,k)), gamma = 2c (1-t)^2: symmetric at the centre
+ *       (alpha(0) = 1: the centre relation E_s + E_{s+2} = 2c E_{s+1} of SPEC §6.1), NU-C1 with
+ *       ratio k at t = 1 (alpha(1) = k, alpha'(1) = 0, gamma(1) = gamma'(1) = 0), so the
+ *       degree-7 BB equations 0,1 hold by the red (centre) data and 6,7 by the green (ring)
+ *       data; k = 1 is SPEC §6.1 (degree-raised). Chosen a priori, and tau is built to satisfy
+ *       it, rather than reading alpha, beta, gamma off an unconstrained tau: those are 2x2
+ *       determinants of tau's derivatives of degree 9, giving 15 equations per separator for
+ *       the cap's 5 free coefficients.
+ *  [R11] NU tau: one planar tau^s per sector, green layers (max(i,j) >= 4) = the NU C2-rule
+ *       applied to raise(omega^s chi~_{sigma_l}), tau^s_33 = raise(...)_33; constraints
+ *       tau^s_00 = 0, C0 and [R10] (as a polynomial identity) with tau^{s+1}; minimum of
+ *       sum_s F_5(tau^s). kappa = 1 reproduces the symmetric tau (test: 3e-14).
+ *  [R12] NU cap black squares e_3, a_2, a_3, b_2, b_3 of each separator: the solution of the 4
+ *       middle equations (2..5) of [R10] closest (Euclidean) to the jet map a (e_3's reference
+ *       = mean of the two sectors' jet values); kappa = 1 gives SPEC §6.3's closed form.
+ *  Numerics: tau's equality-constrained minimum by the SVD null space of the constraints
+ *  (they are redundant) and Cholesky on the reduced normal equations of F_5.
+ */
+#ifndef CCN_BI5_H
+#define CCN_BI5_H
+
+#include "internal.h"
+
+#include <complex.h>
+#define CCN_BI5_I _Complex_I
+#undef I /* keep the name I free for the files that include this header */
+#include <math.h>
+#include <stdint.h>
+
+typedef struct ccn__bi5 ccn__bi5; /* precomputed operator for one valence n and sigma sequence */
+
+/* n >= 3, n != 4; sigmas: the ring speeds in (0,1) (paper's default (3/4,7/8,7/8); n = 3:
+ * (15/16)); 1 <= nsig <= 16. */
+ccn_status ccn__bi5_create(int32_t n, const double *sigmas, int32_t nsig, ccn__bi5 **out,
+                           ccn_error *err);
+void ccn__bi5_destroy(ccn__bi5 *b);
+int32_t ccn__bi5_num_rings(const ccn__bi5 *b);
+int32_t ccn__bi5_num_patches(const ccn__bi5 *b); /* (3*nsig+1)*n */
+/* cnet: (6n+1) x 3 points in SPEC §1.2 order (X[0] = EV, X[1+6k+m-1] = c_m^k: grid nodes
+ * (2,0),(2,1),(2,2),(1,2),(1,1),(1,0) of sector k, u along spoke k, v along spoke k+1).
+ * spoke_knots: the n spoke intervals d_k (NULL = uniform). center: the surface point for the EV
+ * (NULL = eq (7)/(8)). Output: patches[(r*3 + {A,B,C}) * n + s][6][6][3] for rings r < nsig,
+ * then the cap patches[(3*nsig)*n + s][6][6][3]; (3*nsig+1)*n bi-5 patches in all.
+ * Knots [R8]: kappa_s = 1 for all s -> the uniform operator (one stencil product per
+ * coordinate). kappa != 1 and d_{s+2} = d_{s-2} for all s (n = 0 mod 4) -> the non-uniform
+ * construction [R8]-[R12], recomputed per call (tau^s, guide fit; ~1-30 ms). Any other
+ * intervals: CCN_ERR_KNOTS (caller uses another method, or ccn__bi5_apply_border). */
+ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                          const double *center, double *patches, ccn_error *err);
+/* Any intervals, given the caller's own surrounding ring: border[s][6][6][3] is the bi-5
+ * tensor-border t~^0 of sector s (SPEC §1.3; only the 27 entries with i >= 3 or j >= 3 are
+ * read): rows i = 3..5 = the C2 prolongation into the hole of the bi-3 patch across u = 1
+ * (raised to degree 5), columns j = 3..5 = that of the patch across v = 1, in the hole's
+ * [0,1]^2 parameters. For uniform knots this is raise(t_CC), SPEC §2.1. It must be C0 and C2
+ * with ratio kappa_s = d_{s+1}/d_{s-1} across every spoke e_s (checked, relative tolerance 1e-9,
+ * else CCN_ERR_KNOTS naming the spoke). center (required): the EV's surface point. The guide
+ * is fitted to this border; the rings use the NU C2-rule [R9], the cap [R10]-[R12]. */
+ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const double *spoke_knots,
+                                 const double *center, double *patches, ccn_error *err);
+/* Surface at sector s, hole coordinates (u,v) in [0,1]^2 ((0,0) = EV, u along spoke s, v along
+ * spoke s+1): finds the ring / patch (SPEC §1.4, rho_r = 1 - sigma_r) and returns the position
+ * and the derivatives with respect to u and v. */
+void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u, double v,
+                   double pos[3], double du[3], double dv[3]);
+
+/* ---------------------------------------------------------------------------------------- */
+/* Internals shared by charmap.c, guide.c, rings.c, cap.c (and the tests).                   */
+
+#define CCN_BI5_MAXSIG 16
+#define CCN_BI5_PI 3.14159265358979323846
+#define CCN_BI5_NTRI 28 /* coefficients of a total-degree-6 triangle patch */
+
+struct ccn__bi5 {
+    int32_t n, nsig, npar;         /* npar = 12n+10 guide parameters (SPEC §4.2) */
+    double c, theta;               /* c = cos(2 pi/n), theta = 2 pi/n */
+    double sig[CCN_BI5_MAXSIG], lam[CCN_BI5_MAXSIG], Lam[CCN_BI5_MAXSIG];
+    double complex chi_half[16];             /* chi~_{1/2}, 4x4 bi-3, [a*4+b] */
+    double complex chi[CCN_BI5_MAXSIG][16];  /* chi~_{sigma_r} */
+    double complex tau[36];                  /* symmetric cap reparameterisation (sector 0) */
+    double samp0[36 * CCN_BI5_NTRI];         /* fit sampling [. o chi~_{1/2}] (27-mask) */
+    double samp[CCN_BI5_MAXSIG][36 * CCN_BI5_NTRI]; /* ring r: [. o Lambda_r chi~_{sigma_r}] */
+    double scap[36 * CCN_BI5_NTRI];          /* cap: [. o Lambda_l tau] at 4 corners */
+    double *gpar;   /* (28n) x npar, row-major: guide parameters -> BB coefficients */
+    double *qr;     /* QR of the design matrix J (27n x (npar-1)), column-major */
+    double *qtau;   /* npar-1 Householder scalars */
+    double *s0;     /* 27n: the sampled border of parameter 0 (b_600) */
+    double *stencil;/* (3 nsig + 1)*36 rows (sector 0) x (6n+2) columns, row-major; column
+                     * 6n+1 is the weight of the centre point b_600 */
+};
+
+/* omega^k = exp(2 pi i k / n). */
+static inline double complex ccn__bi5_omega(int32_t n, int32_t k) {
+    double a = 2.0 * CCN_BI5_PI * (double)k / (double)n;
+    return cos(a) + sin(a) * CCN_BI5_I;
+}
+/* The 27-coefficient tensor-border mask (SPEC §1.3): i >= 3 or j >= 3. */
+static inline int ccn__bi5_in_mask(int32_t i, int32_t j) { return i >= 3 || j >= 3; }
+
+/* d += w a (m columns). */
+static inline void ccn__bi5_axpy(double *d, double w, const double *a, int32_t m) {
+    for (int32_t c = 0; c < m; c++) d[c] += w * a[c];
+}
+
+/* Binomial coefficient and Bernstein polynomial B^d_k(t). */
+double ccn__bi5_binom(int32_t d, int32_t k);
+double ccn__bi5_bern(int32_t d, int32_t k, double t);
+
+/* ---- charmap.c ---- */
+/* lambda_sigma (paper Sec. 4.1). */
+double ccn__bi5_lambda(int32_t n, double sigma);
+/* Neighbour rules (SPEC §1.1): c-net index (0 = EV) of node (i,j) of sector s, -1 <= i,j <= 2,
+ * and the sector offset *ds (node lies in sector s + *ds, for Fourier phases); -1 if the node
+ * is not in the 6n+1 net. */
+int32_t ccn__bi5_node(int32_t n, int32_t s, int32_t i, int32_t j, int32_t *ds);
+/* Cubic B-spline with control point c_m at knot t_m and blossom label (t_{m-1},t_m,t_{m+1});
+ * t[0..5] = t_{-2..3}. Weights w[0..2] on c_{k-1}, c_k, c_{k+1} (k = 0 or 1) of the blossom
+ * b(t_k, x, y). Returns 0, or -1 if the knots are degenerate. */
+int ccn__bi5_blossom(const double t[6], int32_t k, double x, double y, double w[3]);
+/* BB coefficients of the cubic piece on [t_0,t_1] = [0,1]: W[a][q] = weight of node
+ * first[a] + q (first = -1,-1,-1,0). */
+int ccn__bi5_bb_weights(const double t[6], double W[4][3]);
+/* chi~_sigma (SPEC §3.1, [R2]) and the dominant frequency-1 eigenvalue of the scheme. */
+ccn_status ccn__bi5_charmap(int32_t n, double sigma, double complex chi[16], double *lambda,
+                            ccn_error *err);
+
+/* ---- guide.c ---- */
+/* Index of the triangle coefficient b_{ijk} (i+j+k = 6; i <-> O, j <-> V_s, k <-> V_{s+1}). */
+static inline int32_t ccn__bi5_tri(int32_t i, int32_t j, int32_t k) {
+    (void)j;
+    return (6 - i) * (7 - i) / 2 + k;
+}
+/* Guide parameters -> BB coefficients, m columns: par (npar x m) -> bb (28n x m), row-major. */
+void ccn__bi5_guide_bb(int32_t n, const double *par, int32_t m, double *bb);
+/* Sampling matrix S (36 x 28): bi-5 coefficients of the corner jets [g o (mu phi)] for the
+ * sector-0 triangle piece g, phi a planar bi-d patch ((d+1)^2 complex, [i*(d+1)+j]); corners:
+ * bit 0 = (0,0), 1 = (1,0), 2 = (0,1), 3 = (1,1). Other rows are zero. */
+void ccn__bi5_sample(int32_t n, const double complex *phi, int32_t d, double mu,
+                     unsigned corners, double S[36 * 28]);
+/* Design matrix and its QR factorisation (SPEC §4.4). */
+ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err);
+/* Least-squares guide fit: tcc (n x 36 x m, raised t_CC), b600 (m) -> gbb (n x 28 x m). */
+ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double *b600,
+                              int32_t m, double *gbb, ccn_error *err);
+
+/* ---- rings.c ---- */
+/* 1-D Bernstein-Bezier helpers (degree 5 unless noted). */
+void ccn__bi5_split(double rho, double SR[36], double SL[36]);
+void ccn__bi5_prolong(double tau, double PR[9]);
+/* Truncated Taylor coefficients T[a*3+b] = d_u^a d_v^b P / (a! b!) (a,b <= 2) at corner
+ * (cu,cv) of a complex bi-d patch. */
+void ccn__bi5_taylor(const double complex *P, int32_t d, int32_t cu, int32_t cv,
+                     double complex T[9]);
+/* Corner jet constructor [f] (SPEC §2.3): weights Wj[k*3+a] for layer k from order a. */
+void ccn__bi5_jet_weights(int32_t corner1, double Wj[9]);
+/* C2-rule across every spoke (SPEC §2.4; NU ratio kap[s] for spoke e_s, NULL = 1, SPEC §9.3)
+ * on n tensor-borders T (n x 36 x m). */
+void ccn__bi5_c2_rule(int32_t n, const double *kap, int32_t m, double *T);
+/* Evaluates a bi-5 patch with m-column coefficients (36 x m) and its first derivatives. */
+void ccn__bi5_patch_eval(const double *P, int32_t m, double u, double v, double *pos,
+                         double *du, double *dv);
+
+/* ---- cap.c ---- */
+/* Symmetric tau (SPEC §6.2, [R4]) for valence n from chi~_{sigma_l}. */
+ccn_status ccn__bi5_tau(int32_t n, const double complex chi[16], double complex tau[36],
+                        ccn_error *err);
+/* Non-uniform taus (one per sector, [R9]); kap[s] = kappa of spoke e_s. */
+ccn_status ccn__bi5_tau_nu(int32_t n, const double complex chi[16], const double *kap,
+                           double complex *tau /* n x 36 */, ccn_error *err);
+/* Cap assembly (SPEC §6.3): gbb (n x 28 x m) the guide, T (n x 36 x m) the last upgraded
+ * tensor-border t~^l -> cap (n x 36 x m). kap == NULL: symmetric; else [R9] with the
+ * per-sector taus (n x 36). */
+ccn_status ccn__bi5_cap(const ccn__bi5 *b, const double *gbb, const double *T, int32_t m,
+                        const double *kap, const double complex *taus, double *cap,
+                        ccn_error *err);
+
+#endif

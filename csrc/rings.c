@@ -1,0 +1,536 @@
+/* Rapidly contracting bi-5 rings (paper Sec. 4.3, SPEC §2, §5) and the operator: create /
+ * apply / eval. The construction is linear in the c-net and the centre point, so create runs
+ * it once on unit nets and keeps sector 0's global stencil (SPEC §7); apply is one stencil
+ * product per coordinate (the other sectors by cyclic relabelling of the net). */
+#include "bi5.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- Bernstein-Bezier helpers (SPEC §2.2, §2.5) --------------------------------------- */
+
+double ccn__bi5_binom(int32_t d, int32_t k) {
+    if (k < 0 || k > d) return 0.0;
+    double r = 1.0;
+    for (int32_t q = 1; q <= k; q++) r = r * (double)(d - k + q) / (double)q;
+    return r;
+}
+
+double ccn__bi5_bern(int32_t d, int32_t k, double t) {
+    if (k < 0 || k > d) return 0.0;
+    return ccn__bi5_binom(d, k) * pow(1.0 - t, d - k) * pow(t, k);
+}
+
+void ccn__bi5_split(double rho, double SR[36], double SL[36]) {
+    /* Right piece [rho,1]: SR_kl = B^{5-k}_{l-k}(rho); left piece [0,rho]: SL_kl = B^k_l(rho). */
+    for (int32_t k = 0; k < 6; k++)
+        for (int32_t l = 0; l < 6; l++) {
+            SR[k * 6 + l] = l >= k ? ccn__bi5_bern(5 - k, l - k, rho) : 0.0;
+            SL[k * 6 + l] = l <= k ? ccn__bi5_bern(k, l, rho) : 0.0;
+        }
+}
+
+void ccn__bi5_prolong(double tau, double PR[9]) {
+    /* q_k = sum_m C(k,m) (1-tau)^m tau^(k-m) p_{5-m}; PR acts on (p_3, p_4, p_5). */
+    memset(PR, 0, sizeof(double) * 9);
+    for (int32_t k = 0; k < 3; k++)
+        for (int32_t mm = 0; mm <= k; mm++)
+            PR[k * 3 + 2 - mm] += ccn__bi5_binom(k, mm) * pow(1.0 - tau, mm) * pow(tau, k - mm);
+}
+
+/* Taylor weights Wt[a][idx] (a <= 2) of a degree-d Bernstein polynomial at t = corner. */
+static void taylor_weights_1d(int32_t d, int32_t corner, double Wt[3][6]) {
+    memset(Wt, 0, sizeof(double) * 18);
+    for (int32_t a = 0; a < 3; a++)
+        for (int32_t k = 0; k <= a; k++) {
+            double w = ccn__bi5_binom(d, a) * ccn__bi5_binom(a, k) * (((a - k) & 1) ? -1.0 : 1.0);
+            Wt[a][corner ? d - a + k : k] += w;
+        }
+}
+
+void ccn__bi5_taylor(const double complex *P, int32_t d, int32_t cu, int32_t cv,
+                     double complex T[9]) {
+    double Wu[3][6], Wv[3][6];
+    taylor_weights_1d(d, cu, Wu);
+    taylor_weights_1d(d, cv, Wv);
+    for (int32_t a = 0; a < 3; a++)
+        for (int32_t b = 0; b < 3; b++) {
+            double complex acc = 0;
+            for (int32_t k = 0; k <= d; k++)
+                for (int32_t l = 0; l <= d; l++)
+                    if (Wu[a][k] != 0.0 && Wv[b][l] != 0.0) acc += Wu[a][k] * Wv[b][l] * P[k * (d + 1) + l];
+            T[a * 3 + b] = acc;
+        }
+}
+
+void ccn__bi5_jet_weights(int32_t corner1, double Wj[9]) {
+    /* SPEC §2.3: layer k from orders a <= k: C(k,a)/C(5,a), times (-1)^a at corner 1. */
+    memset(Wj, 0, sizeof(double) * 9);
+    for (int32_t k = 0; k < 3; k++)
+        for (int32_t a = 0; a <= k; a++)
+            Wj[k * 3 + a] = ccn__bi5_binom(k, a) / ccn__bi5_binom(5, a) * ((corner1 && (a & 1)) ? -1.0 : 1.0);
+}
+
+static void bern5_with_deriv(double t, double B[6], double D[6]) {
+    for (int32_t k = 0; k < 6; k++) {
+        B[k] = ccn__bi5_bern(5, k, t);
+        D[k] = 5.0 * (ccn__bi5_bern(4, k - 1, t) - ccn__bi5_bern(4, k, t));
+    }
+}
+
+void ccn__bi5_patch_eval(const double *P, int32_t m, double u, double v, double *pos,
+                         double *du, double *dv) {
+    double Bu[6], Du[6], Bv[6], Dv[6];
+    bern5_with_deriv(u, Bu, Du);
+    bern5_with_deriv(v, Bv, Dv);
+    for (int32_t c = 0; c < m; c++) {
+        double p = 0, pu = 0, pv = 0;
+        for (int32_t i = 0; i < 6; i++)
+            for (int32_t j = 0; j < 6; j++) {
+                double x = P[(i * 6 + j) * m + c];
+                p += Bu[i] * Bv[j] * x;
+                pu += Du[i] * Bv[j] * x;
+                pv += Bu[i] * Dv[j] * x;
+            }
+        if (pos) pos[c] = p;
+        if (du) du[c] = pu;
+        if (dv) dv[c] = pv;
+    }
+}
+
+/* ---- t_CC (SPEC §2.1, §9.1, [R8]) ------------------------------------------------------ */
+
+/* Knot vector t_{-2..3} of a direction with interval dn on the negative side and dp on the
+ * positive side, normalised so that the hole interval is [0,1]. */
+static void dir_knots(double dn, double dp, double t[6]) {
+    double r = dn / dp;
+    t[0] = -2 * r; t[1] = -r; t[2] = 0; t[3] = 1; t[4] = 2; t[5] = 3;
+}
+
+static void bb_weights_exact(const double t[6], double W[4][3]) {
+    ccn__bi5_bb_weights(t, W);
+    W[1][0] = 0.0; /* b(t0,t0,t1) and b(t0,t1,t1) do not involve c_{-1} (exactly) */
+    W[2][0] = 0.0;
+}
+
+/* Raises bicubic tensor-borders p (n x 16 x m, [a*4+b], p_00 unused) to bi-5 on the mask:
+ * T (n x 36 x m), zero elsewhere (SPEC §2.2). */
+static void raise_border(int32_t n, const double *p, int32_t m, double *T) {
+    static const double E[6][4] = {{1, 0, 0, 0}, {0.4, 0.6, 0, 0}, {0.1, 0.6, 0.3, 0},
+                                   {0, 0.3, 0.6, 0.1}, {0, 0, 0.6, 0.4}, {0, 0, 0, 1}};
+    memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t i = 0; i < 6; i++)
+            for (int32_t j = 0; j < 6; j++) {
+                if (!ccn__bi5_in_mask(i, j)) continue;
+                for (int32_t a = 0; a < 4; a++)
+                    for (int32_t bq = 0; bq < 4; bq++)
+                        if (E[i][a] * E[j][bq] != 0.0 && (a || bq))
+                            ccn__bi5_axpy(T + ((size_t)s * 36 + i * 6 + j) * m, E[i][a] * E[j][bq],
+                                          p + ((size_t)s * 16 + a * 4 + bq) * m, m);
+            }
+}
+
+/* t_CC of every sector (SPEC §2.1; knots [R8]), bicubic: p (n x 16 x m). */
+static void tcc(int32_t n, const double *X, const double *d, int32_t m, double *p) {
+    static const int32_t first[4] = {-1, -1, -1, 0};
+    memset(p, 0, sizeof(double) * (size_t)n * 16 * (size_t)m);
+    for (int32_t s = 0; s < n; s++) {
+        double tu[6], tv[6], Wu[4][3], Wv[4][3];
+        dir_knots(d ? d[(s + 2) % n] : 1, d ? d[s] : 1, tu);
+        dir_knots(d ? d[(s + n - 1) % n] : 1, d ? d[(s + 1) % n] : 1, tv);
+        bb_weights_exact(tu, Wu);
+        bb_weights_exact(tv, Wv);
+        for (int32_t a = 0; a < 4; a++)
+            for (int32_t bq = 0; bq < 4; bq++) {
+                if (a == 0 && bq == 0) continue; /* p_00 is never used (SPEC §2.2) */
+                for (int32_t i = 0; i < 3; i++)
+                    for (int32_t j = 0; j < 3; j++) {
+                        double w = Wu[a][i] * Wv[bq][j];
+                        int32_t ds, node = ccn__bi5_node(n, s, first[a] + i, first[bq] + j, &ds);
+                        if (w == 0.0 || node < 0) continue;
+                        ccn__bi5_axpy(p + ((size_t)s * 16 + a * 4 + bq) * m, w, X + (size_t)node * m, m);
+                    }
+            }
+    }
+}
+
+/* ---- C2-rule (SPEC §2.4, §9.3) --------------------------------------------------------- */
+
+/* Across every spoke e_s, for along-spoke index i = 3..5: P_-2, P_-1 = T^{s-1}_{2,i},
+ * T^{s-1}_{1,i}; P_0 = T^s_{i,0}; P_1, P_2 = T^s_{i,1}, T^s_{i,2}. Ratio r = kap[s] (NULL: 1):
+ * P_-1 = ((1+r)^2 P_0 + r^2 P_-2 - P_2) / (2r(1+r)), P_1 = P_0 + r (P_0 - P_-1). */
+void ccn__bi5_c2_rule(int32_t n, const double *kap, int32_t m, double *T) {
+    for (int32_t s = 0; s < n; s++) {
+        int32_t p = (s + n - 1) % n;
+        double r = kap ? kap[s] : 1.0;
+        for (int32_t i = 3; i < 6; i++) {
+            double *Pm2 = T + ((size_t)p * 36 + 2 * 6 + i) * m, *Pm1 = T + ((size_t)p * 36 + 1 * 6 + i) * m;
+            double *P0 = T + ((size_t)s * 36 + i * 6 + 0) * m, *P1 = T + ((size_t)s * 36 + i * 6 + 1) * m;
+            double *P2 = T + ((size_t)s * 36 + i * 6 + 2) * m;
+            for (int32_t c = 0; c < m; c++) {
+                double pm1 = ((1 + r) * (1 + r) * P0[c] + r * r * Pm2[c] - P2[c]) / (2 * r * (1 + r));
+                Pm1[c] = pm1;
+                P1[c] = P0[c] + r * (P0[c] - pm1);
+            }
+        }
+    }
+}
+
+/* ---- rings (SPEC §5 step 4) ------------------------------------------------------------ */
+
+/* out[i][j] = sum_{k in [k0,6), l in [l0,6)} L[i][k] Tm[k][l] R[j][l] for i in [i0,i1),
+ * j in [j0,j1) (m columns). */
+static void tmul(const double L[36], const double *Tm, const double R[36], int32_t i0, int32_t i1,
+                 int32_t j0, int32_t j1, int32_t k0, int32_t l0, int32_t m, double *out) {
+    for (int32_t i = i0; i < i1; i++)
+        for (int32_t j = j0; j < j1; j++) {
+            double *o = out + (size_t)(i * 6 + j) * m;
+            memset(o, 0, sizeof(double) * (size_t)m);
+            for (int32_t k = k0; k < 6; k++)
+                for (int32_t l = l0; l < 6; l++) {
+                    double w = L[i * 6 + k] * R[j * 6 + l];
+                    if (w != 0.0) ccn__bi5_axpy(o, w, Tm + (size_t)(k * 6 + l) * m, m);
+                }
+        }
+}
+
+/* Patches A, B, C of one sector from the outer border To (level r-1) and the inner border Ti
+ * (level r): split sigma : 1-sigma, inner part prolonged with tau = 1/rho (SPEC §2.5). */
+static void ring_sector(const double *To, const double *Ti, double sigma, int32_t m,
+                        double *A, double *B, double *C) {
+    double rho = 1.0 - sigma, SR[36], SL[36], PR[9], P6[36] = {0}, Id[36] = {0};
+    ccn__bi5_split(rho, SR, SL);
+    ccn__bi5_prolong(1.0 / rho, PR);
+    for (int32_t k = 0; k < 3; k++)
+        for (int32_t l = 0; l < 3; l++) P6[k * 6 + 3 + l] = PR[k * 3 + l];
+    for (int32_t k = 0; k < 6; k++) Id[k * 6 + k] = 1.0;
+    tmul(SR, To, SL, 3, 6, 0, 6, 3, 0, m, A);   /* A[3..5][.] = SR To[3..5][.] SL^T */
+    tmul(P6, Ti, Id, 0, 3, 0, 6, 3, 0, m, A);   /* A[0..2][.] = PR Ti[3..5][.]      */
+    tmul(SL, To, SR, 0, 6, 3, 6, 0, 3, m, C);   /* C[.][3..5] = SL To[.][3..5] SR^T */
+    tmul(Id, Ti, P6, 0, 6, 0, 3, 0, 3, m, C);   /* C[.][0..2] = Ti[.][3..5] PR^T    */
+    tmul(SR, To, SR, 3, 6, 0, 6, 3, 0, m, B);   /* B[3..5][.]                        */
+    tmul(SR, To, SR, 0, 3, 3, 6, 0, 3, m, B);   /* B[0..2][3..5]                     */
+    tmul(P6, Ti, P6, 0, 3, 0, 3, 3, 3, m, B);   /* B[0..2][0..2] = PR Ti PR^T        */
+}
+
+/* T (n x 36 x m) = samp (36 x 28) applied to every sector of the guide gbb (n x 28 x m). */
+static void sample_border(int32_t n, const double *samp, const double *gbb, int32_t m, double *T) {
+    memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t e = 0; e < 36; e++)
+            for (int32_t t = 0; t < 28; t++) {
+                double w = samp[e * 28 + t];
+                if (w != 0.0)
+                    ccn__bi5_axpy(T + ((size_t)s * 36 + e) * m, w, gbb + ((size_t)s * 28 + t) * m, m);
+            }
+}
+
+/* ---- the whole construction on m columns (SPEC §5, §6) --------------------------------- */
+
+/* X: (6n+1) x m c-net or T0: the raised tensor-border t~^0 (n x 36 x m), b600: m centre values, d: spoke intervals (NULL: uniform), kap: C2-rule
+ * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric). out: patches x 36 x m. */
+static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0,
+                            const double *b600, int32_t m, const double *d, const double *kap,
+                            const double complex *taus, double *out, ccn_error *err) {
+    int32_t n = b->n;
+    size_t tsz = (size_t)n * 36 * (size_t)m, psz = 36 * (size_t)m;
+    double *To = malloc(sizeof(double) * tsz), *Ti = malloc(sizeof(double) * tsz);
+    double *gbb = malloc(sizeof(double) * (size_t)n * 28 * (size_t)m);
+    ccn_status st = CCN_OK;
+    if (!To || !Ti || !gbb) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (construction)");
+        goto done;
+    }
+    if (T0) memcpy(To, T0, sizeof(double) * tsz);
+    else {                                                /* t~^0 = raise(t_CC) */
+        tcc(n, X, d, m, Ti);
+        raise_border(n, Ti, m, To);
+    }
+    if ((st = ccn__bi5_guide_fit(b, To, b600, m, gbb, err))) goto done;
+    for (int32_t r = 0; r < b->nsig; r++) {
+        sample_border(n, b->samp[r], gbb, m, Ti);         /* t^{r+1} = [g^{r+1} o chi~] */
+        ccn__bi5_c2_rule(n, kap, m, Ti);                           /* t~^{r+1} */
+        for (int32_t s = 0; s < n; s++)
+            ring_sector(To + (size_t)s * psz, Ti + (size_t)s * psz, b->sig[r], m,
+                        out + ((size_t)(3 * r + 0) * n + s) * psz,
+                        out + ((size_t)(3 * r + 1) * n + s) * psz,
+                        out + ((size_t)(3 * r + 2) * n + s) * psz);
+        double *tmp = To; To = Ti; Ti = tmp;
+    }
+    st = ccn__bi5_cap(b, gbb, To, m, kap, taus, out + (size_t)3 * b->nsig * n * psz, err);
+done:
+    free(To); free(Ti); free(gbb);
+    return st;
+}
+
+/* ---- operator ------------------------------------------------------------------------- */
+
+void ccn__bi5_destroy(ccn__bi5 *b) {
+    if (!b) return;
+    free(b->gpar); free(b->qr); free(b->qtau); free(b->s0); free(b->stencil);
+    free(b);
+}
+
+int32_t ccn__bi5_num_rings(const ccn__bi5 *b) { return b->nsig; }
+int32_t ccn__bi5_num_patches(const ccn__bi5 *b) { return (3 * b->nsig + 1) * b->n; }
+
+static ccn_status check_create_args(int32_t n, const double *sigmas, int32_t nsig, ccn__bi5 **out,
+                                    ccn_error *err) {
+    if (!out || !sigmas)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL argument to create");
+    if (n < 3 || n == 4 || n > 1000)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, -1,
+                         "bi5: valence %d not supported (need n >= 3, n != 4)", (int)n);
+    if (nsig < 1 || nsig > CCN_BI5_MAXSIG)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                         "bi5: number of rings %d not in [1, %d]", (int)nsig, CCN_BI5_MAXSIG);
+    for (int32_t r = 0; r < nsig; r++)
+        if (!(sigmas[r] > 0.0 && sigmas[r] < 1.0))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                             "bi5: ring speed sigma_%d = %g is not in (0,1)", (int)r + 1, sigmas[r]);
+    return CCN_OK;
+}
+
+/* Characteristic maps, sampling matrices, tau (everything that depends on n, sigmas). */
+static ccn_status precompute(ccn__bi5 *b, ccn_error *err) {
+    ccn_status st = ccn__bi5_charmap(b->n, 0.5, b->chi_half, NULL, err);
+    double Lam = 1.0;
+    for (int32_t r = 0; !st && r < b->nsig; r++) {
+        st = ccn__bi5_charmap(b->n, b->sig[r], b->chi[r], &b->lam[r], err);
+        Lam *= b->lam[r];
+        b->Lam[r] = Lam;
+        if (!st) ccn__bi5_sample(b->n, b->chi[r], 3, Lam, 0xEu, b->samp[r]);
+    }
+    if (!st) st = ccn__bi5_guide_setup(b, err);
+    if (!st) st = ccn__bi5_tau(b->n, b->chi[b->nsig - 1], b->tau, err);
+    if (!st) ccn__bi5_sample(b->n, b->tau, 5, Lam, 0xFu, b->scap);
+    return st;
+}
+
+/* Global stencil of sector 0: run the construction on the unit nets and the unit centre. */
+static ccn_status build_stencil(ccn__bi5 *b, ccn_error *err) {
+    int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, np = ccn__bi5_num_patches(b), nt = 3 * b->nsig + 1;
+    double *X = calloc((size_t)nc * (size_t)m, sizeof(double)), *c0 = calloc((size_t)m, sizeof(double));
+    double *out = malloc(sizeof(double) * (size_t)np * 36 * (size_t)m);
+    b->stencil = malloc(sizeof(double) * (size_t)nt * 36 * (size_t)m);
+    ccn_status st = CCN_OK;
+    if (!X || !c0 || !out || !b->stencil)
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (stencil, n = %d)", (int)n);
+    if (!st) {
+        for (int32_t k = 0; k < nc; k++) X[(size_t)k * m + k] = 1.0;
+        c0[nc] = 1.0;
+        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, out, err);
+    }
+    for (int32_t t = 0; !st && t < nt; t++) /* sector 0 patch of type t = patch index t*n */
+        memcpy(b->stencil + (size_t)t * 36 * m, out + (size_t)t * n * 36 * m, sizeof(double) * 36 * (size_t)m);
+    free(X); free(c0); free(out);
+    return st;
+}
+
+ccn_status ccn__bi5_create(int32_t n, const double *sigmas, int32_t nsig, ccn__bi5 **out,
+                           ccn_error *err) {
+    ccn_status st = check_create_args(n, sigmas, nsig, out, err);
+    if (st) return st;
+    *out = NULL;
+    ccn__bi5 *b = calloc(1, sizeof *b);
+    if (!b) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (create)");
+    b->n = n;
+    b->nsig = nsig;
+    b->npar = 12 * n + 10;
+    b->theta = 2.0 * CCN_BI5_PI / n;
+    b->c = cos(b->theta);
+    memcpy(b->sig, sigmas, sizeof(double) * (size_t)nsig);
+    b->gpar = malloc(sizeof(double) * 28 * (size_t)n * (size_t)b->npar);
+    b->qr = malloc(sizeof(double) * 27 * (size_t)n * (size_t)(b->npar - 1));
+    b->qtau = malloc(sizeof(double) * (size_t)b->npar);
+    b->s0 = malloc(sizeof(double) * 27 * (size_t)n);
+    st = precompute(b, err);
+    if (!st) st = build_stencil(b, err);
+    if (st) {
+        ccn__bi5_destroy(b);
+        return st;
+    }
+    *out = b;
+    ccn__ok(err);
+    return CCN_OK;
+}
+
+/* Centre point, eq. (7) (n > 4) or eq. (8) (n = 3), from c_5 = (1,1) and c_6 = (1,0). */
+static void centre_point(int32_t n, const double *X, double ctr[3]) {
+    double g5 = n == 3 ? 5.0 / 96.0 : 1.0 / (n * (n + 5.0)), g6 = n == 3 ? 1.0 / 6.0 : 4.0 * g5;
+    double g7 = 1.0 - n * (g5 + g6);
+    for (int c = 0; c < 3; c++) {
+        double acc = g7 * X[c];
+        for (int32_t k = 0; k < n; k++) acc += g5 * X[3 * (1 + 6 * k + 4) + c] + g6 * X[3 * (1 + 6 * k + 5) + c];
+        ctr[c] = acc;
+    }
+}
+
+/* Uniform operator: sector s = stencil applied to the net relabelled so that s becomes 0. */
+static void apply_stencil(const ccn__bi5 *b, const double *X, const double ctr[3], double *patches) {
+    int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, nt = 3 * b->nsig + 1;
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t t = 0; t < nt; t++)
+            for (int32_t e = 0; e < 36; e++) {
+                const double *row = b->stencil + ((size_t)t * 36 + e) * m;
+                double acc[3] = {row[0] * X[0], row[0] * X[1], row[0] * X[2]};
+                for (int32_t k = 0; k < n; k++) {
+                    const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
+                    for (int32_t q = 0; q < 6; q++)
+                        for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
+                }
+                double *o = patches + (((size_t)t * n + s) * 36 + e) * 3;
+                for (int c = 0; c < 3; c++) o[c] = acc[c] + row[nc] * ctr[c];
+            }
+}
+
+/* Knot classification (see bi5.h): 0 uniform-equivalent, 1 supported NU, -1 unsupported. */
+static int classify_knots(int32_t n, const double *d, double *kap, int32_t *bad) {
+    int nu = 0;
+    for (int32_t s = 0; s < n; s++) {
+        kap[s] = d[(s + 1) % n] / d[(s + n - 1) % n];
+        if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
+    }
+    if (!nu) return 0;
+    for (int32_t s = 0; s < n; s++)
+        if (fabs(d[(s + 2) % n] - d[(s + n - 2) % n]) > 1e-12 * (d[(s + 2) % n] + d[(s + n - 2) % n])) {
+            *bad = s;
+            return -1;
+        }
+    return 1;
+}
+
+static ccn_status check_apply_args(const ccn__bi5 *b, const double *cnet, int32_t npts,
+                                   const double *d, const double *center, double *patches,
+                                   ccn_error *err) {
+    if (!b || !cnet || !patches)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL argument to apply");
+    for (int32_t k = 0; k < 3 * npts; k++)
+        if (!isfinite(cnet[k]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, k / 3,
+                             "bi5: input point %d is not finite", (int)(k / 3));
+    for (int c = 0; center && c < 3; c++)
+        if (!isfinite(center[c]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: centre point is not finite");
+    for (int32_t s = 0; d && s < b->n; s++)
+        if (!(d[s] > 0.0 && isfinite(d[s])))
+            return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, s,
+                             "bi5: spoke %d has knot interval %g (need finite > 0)", (int)s, d[s]);
+    return CCN_OK;
+}
+
+ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                          const double *center, double *patches, ccn_error *err) {
+    ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
+    if (st) return st;
+    int32_t n = b->n, bad = -1;
+    double ctr[3];
+    if (center) memcpy(ctr, center, sizeof ctr);
+    else centre_point(n, cnet, ctr);
+    double *kap = malloc(sizeof(double) * (size_t)n);
+    if (!kap) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
+    int kind = spoke_knots ? classify_knots(n, spoke_knots, kap, &bad) : 0;
+    if (kind == 0) apply_stencil(b, cnet, ctr, patches);
+    else if (kind < 0)
+        st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, bad,
+                       "bi5: spoke intervals with kappa != 1 and d_%d != d_%d around spoke %d: the "
+                       "sectors' bicubic tensor-borders disagree along the spoke (SPEC §9, bi5.h [R8])",
+                       (int)((bad + 2) % n), (int)((bad + n - 2) % n), (int)bad);
+    else {
+        double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+        st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
+                  : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
+        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus, patches, err);
+        free(taus);
+    }
+    free(kap);
+    if (!st) ccn__ok(err);
+    return st;
+}
+
+/* Largest C0 / NU-C2 defect of the raised borders T (n x 36 x 3) across the spokes, relative to
+ * the border's size; *spoke receives the worst spoke. */
+static double border_defect(int32_t n, const double *T, const double *kap, int32_t *spoke) {
+    double worst = 0, size = 1e-300;
+    for (int32_t k = 0; k < n * 108; k++) size = fmax(size, fabs(T[k]));
+    for (int32_t s = 0; s < n; s++) {
+        int32_t p = (s + n - 1) % n;
+        double r = kap ? kap[s] : 1.0;
+        for (int32_t i = 3; i < 6; i++)
+            for (int c = 0; c < 3; c++) {
+                double Pm2 = T[(p * 36 + 12 + i) * 3 + c], Pm1 = T[(p * 36 + 6 + i) * 3 + c];
+                double P0 = T[(s * 36 + i * 6) * 3 + c], P0b = T[(p * 36 + i) * 3 + c];
+                double P1 = T[(s * 36 + i * 6 + 1) * 3 + c], P2 = T[(s * 36 + i * 6 + 2) * 3 + c];
+                double e = fmax(fabs(P0 - P0b), fabs(P1 - P0 - r * (P0 - Pm1)));
+                e = fmax(e, fabs((P2 - 2 * P1 + P0) - r * r * (P0 - 2 * Pm1 + Pm2)));
+                if (e > worst) { worst = e; *spoke = s; }
+            }
+    }
+    return worst / size;
+}
+
+ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const double *spoke_knots,
+                                 const double *center, double *patches, ccn_error *err) {
+    if (!border || !center)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL border or centre");
+    ccn_status st = check_apply_args(b, center, 1, spoke_knots, center, patches, err);
+    if (st) return st;
+    int32_t n = b->n, spoke = -1, nu = 0;
+    for (int32_t k = 0; k < n * 108; k++)
+        if (ccn__bi5_in_mask(k / 3 % 36 / 6, k / 3 % 6) && !isfinite(border[k]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                             "bi5: tensor-border of sector %d is not finite", (int)(k / 108));
+    double *T = malloc(sizeof(double) * (size_t)n * 108), *kap = malloc(sizeof(double) * (size_t)n);
+    double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+    if (!T || !kap || !taus) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_border)");
+        goto done;
+    }
+    for (int32_t s = 0; s < n; s++) {
+        kap[s] = spoke_knots ? spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n] : 1.0;
+        if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
+    }
+    for (int32_t k = 0; k < n * 108; k++) /* the mask only */
+        T[k] = ccn__bi5_in_mask(k / 3 % 36 / 6, k / 3 % 6) ? border[k] : 0.0;
+    double def = border_defect(n, T, kap, &spoke);
+    if (def > 1e-9) {
+        st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, spoke,
+                       "bi5: tensor-border is not C0 / C2 (ratio kappa = %g) across spoke %d "
+                       "(relative defect %g)", kap[spoke], (int)spoke, def);
+        goto done;
+    }
+    if (nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, patches, err);
+    if (!st) ccn__ok(err);
+done:
+    free(T); free(kap); free(taus);
+    return st;
+}
+
+/* ---- evaluation (SPEC §1.4) ------------------------------------------------------------ */
+
+void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u, double v,
+                   double pos[3], double du[3], double dv[3]) {
+    int32_t n = b->n;
+    s = ((s % n) + n) % n;
+    double scale = 1.0; /* level-r units per hole unit */
+    u = u < 0 ? 0 : (u > 1 ? 1 : u);
+    v = v < 0 ? 0 : (v > 1 ? 1 : v);
+    for (int32_t r = 0; r < b->nsig; r++) {
+        double rho = 1.0 - b->sig[r], sg = b->sig[r];
+        if (u >= rho || v >= rho) {
+            int32_t kind = u >= rho ? (v <= rho ? 0 : 1) : 2; /* A, B, C */
+            double u0 = kind == 2 ? 0.0 : rho, lu = kind == 2 ? rho : sg;
+            double v0 = kind == 0 ? 0.0 : rho, lv = kind == 0 ? rho : sg;
+            const double *P = patches + (((size_t)(3 * r + kind) * n + s) * 36) * 3;
+            ccn__bi5_patch_eval(P, 3, (u - u0) / lu, (v - v0) / lv, pos, du, dv);
+            for (int c = 0; c < 3; c++) { du[c] *= scale / lu; dv[c] *= scale / lv; }
+            return;
+        }
+        u /= rho; v /= rho; scale /= rho;
+    }
+    const double *P = patches + (((size_t)3 * b->nsig * n + s) * 36) * 3;
+    ccn__bi5_patch_eval(P, 3, u, v, pos, du, dv);
+    for (int c = 0; c < 3; c++) { du[c] *= scale; dv[c] *= scale; }
+}
