@@ -48,6 +48,9 @@ ccn_mesh *ccn__mesh_alloc(int32_t nv, int32_t nf, int32_t nh, int32_t ne);
  * success, or the index + 1 of a vertex whose faces form more than one fan (non-manifold). */
 int32_t ccn__mesh_build_fans(ccn_mesh *m);
 void ccn__mesh_update_info(ccn_mesh *m);
+/* Affine normalisation of positions to a unit box (the rules are affine-invariant). */
+void ccn__normalize(ccn_mesh *m, double centre[3], double *scale);
+void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale);
 
 static inline int32_t ccn__next(const ccn_mesh *m, int32_t h) {
     int32_t f = m->hface[h];

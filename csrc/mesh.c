@@ -335,3 +335,30 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_erro
     memcpy(m->pos, positions, sizeof(double) * 3 * (size_t)m->nv);
     return CCN_OK;
 }
+
+/* Centre and half-size of the bounding box; positions become (p - centre) / scale. */
+void ccn__normalize(ccn_mesh *m, double centre[3], double *scale) {
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int32_t v = 0; v < m->nv; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = m->pos[3 * (size_t)v + k];
+            if (v == 0 || x < lo[k]) lo[k] = x;
+            if (v == 0 || x > hi[k]) hi[k] = x;
+        }
+    double s = 0;
+    for (int k = 0; k < 3; k++) {
+        centre[k] = lo[k] / 2 + hi[k] / 2; /* no overflow for |x| near DBL_MAX */
+        double h = hi[k] / 2 - lo[k] / 2;
+        if (h > s) s = h;
+    }
+    *scale = s > 0 && isfinite(s) ? s : 1.0;
+    for (int32_t v = 0; v < m->nv; v++)
+        for (int k = 0; k < 3; k++)
+            m->pos[3 * (size_t)v + k] = (m->pos[3 * (size_t)v + k] - centre[k]) / *scale;
+}
+
+void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale) {
+    for (int32_t v = 0; v < m->nv; v++)
+        for (int k = 0; k < 3; k++)
+            m->pos[3 * (size_t)v + k] = centre[k] + scale * m->pos[3 * (size_t)v + k];
+}

@@ -28,6 +28,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t l = 0; l < p->R; l++) ccn__level_free(&p->prep[l]);
     if (p->has_sub) { ccn__level_free(&p->sub); free(p->posS); }
     free(p->near);
+    free(p->cage_pos);
     for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
     for (int32_t c = 0; c < p->ncap; c++) {
         free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
@@ -290,7 +291,18 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     }
     p->lev[0] = cage_mesh;
     p->ncage = cage->num_verts;
+    p->scale = 1.0;
+    p->cage_pos = malloc(sizeof(double) * 3 * (size_t)(p->ncage ? p->ncage : 1));
+    if (!p->cage_pos) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto fail; }
+    memcpy(p->cage_pos, cage_mesh->pos, sizeof(double) * 3 * (size_t)p->ncage);
     p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
+    int64_t corners = cage_mesh->nh; /* fail before any work if the output cannot be indexed */
+    for (int32_t l = 0; l < p->L + 1 && !st; l++)
+        if ((corners *= 4) > INT32_MAX / 8)
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                           "%d levels of a %d-corner cage would exceed %d face corners",
+                           (int)p->L, (int)cage_mesh->nh, INT32_MAX / 8);
+    if (st) goto fail;
     if ((st = setup_caps(p, err))) goto fail;
     if ((st = build_levels(p, p->R > p->L ? p->R : p->L, err))) goto fail;
     if ((st = setup_level_s(p, err))) goto fail;
@@ -427,12 +439,22 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     if (positions) {
         ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
         if (st) return st;
+        memcpy(p->cage_pos, positions, sizeof(double) * 3 * (size_t)p->ncage);
+    } else {
+        memcpy(p->lev[0]->pos, p->cage_pos, sizeof(double) * 3 * (size_t)p->ncage);
     }
+    /* every rule is affine-invariant: work in a unit box so that huge coordinates (1e300)
+     * cannot overflow, and map back at the end */
+    double *centre = p->centre, scale;
+    ccn__normalize(p->lev[0], centre, &scale);
+    p->scale = scale;
     for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
     if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
     eval_stencils(p, out);
     ccn_status st = eval_caps(p, out, err);
     if (st) return st;
+    for (int32_t o = 0; o < p->nout_v; o++)
+        for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
     if (out->face_verts) memcpy(out->face_verts, p->out_fv, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
     return CCN_OK;
@@ -443,6 +465,16 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
 static int32_t cage_face_of(const ccn_plan *p, int32_t l, int32_t f) {
     for (; l > 0; l--) f = p->lev[l - 1]->hface[f];
     return f;
+}
+
+/* Control points back in the caller's coordinates (evaluate works in a unit box). */
+static void emit(const ccn_plan *p, ccn_patch_fn fn, void *user, int32_t deg, const double *pts,
+                 int32_t face) {
+    double buf[108];
+    int32_t n = (deg + 1) * (deg + 1);
+    for (int32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) buf[3 * i + k] = p->centre[k] + p->scale * pts[3 * i + k];
+    fn(user, deg, buf, face);
 }
 
 static void export_bicubic(const ccn_plan *p, int32_t lvl, ccn_patch_fn fn, void *user,
@@ -460,7 +492,7 @@ static void export_bicubic(const ccn_plan *p, int32_t lvl, ccn_patch_fn fn, void
     for (int32_t f = 0; f < m->nf; f++) {
         if (kind[f] == 1) continue;
         if (ccn__bicubic_patch(m, f, pinned, kind[f] != 2, bez))
-            fn(user, 3, &bez[0][0][0], cage_face_of(p, lvl, f));
+            emit(p, fn, user, 3, &bez[0][0][0], cage_face_of(p, lvl, f));
         else
             (*skipped)++;
     }
@@ -478,7 +510,7 @@ ccn_status ccn_plan_patches(const ccn_plan *p, ccn_patch_fn fn, void *user, int3
         int32_t np = ccn__bi5_num_patches(cp->op);
         for (int32_t i = 0; i < np; i++) {
             int32_t s = i % cp->n, h = mK->vfan[mK->vfan_start[cp->cnet[0]] + s];
-            fn(user, 5, cp->patches + 108 * (size_t)i, cage_face_of(p, p->K, mK->hface[h]));
+            emit(p, fn, user, 5, cp->patches + 108 * (size_t)i, cage_face_of(p, p->K, mK->hface[h]));
         }
     }
 #endif

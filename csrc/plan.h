@@ -31,6 +31,8 @@ struct ccn_plan {
     double *posS;
     int32_t nnear, *near;
     int32_t ncage;
+    double *cage_pos;       /* the caller's cage positions (evaluate works on a normalised copy) */
+    double centre[3], scale; /* normalisation of the last evaluate */
     /* output mesh = level L without isolated vertices */
     int32_t nout_v, nout_f;
     int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */

@@ -369,8 +369,16 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
     if (o.scheme < CCN_SCHEME_EIGEN || o.scheme > CCN_SCHEME_CATMULL_CLARK)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown scheme %d", (int)o.scheme);
     int pinned = o.boundary_corners == CCN_CORNERS_PINNED;
+    int64_t corners = in->nh; /* face corners quadruple per level: fail before any work */
+    for (int32_t l = 0; l < levels; l++)
+        if ((corners *= 4) > INT32_MAX / 8)
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                             "%d levels of a %d-corner cage would exceed %d face corners",
+                             (int)levels, (int)in->nh, INT32_MAX / 8);
     ccn_mesh *cur = o.scheme == CCN_SCHEME_CATMULL_CLARK ? uniform_copy(in) : mesh_clone(in);
     if (!cur) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    double centre[3], scale; /* unit box: huge coordinates cannot overflow */
+    ccn__normalize(cur, centre, &scale);
     for (int32_t l = 0; l < levels; l++) {
         ccn_mesh *next = NULL;
         ccn_status st = refine_level(cur, o.scheme, pinned, ccn__thread_count(o.threads), &next, err);
@@ -378,6 +386,7 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
         if (st) return st;
         cur = next;
     }
+    ccn__denormalize(cur, centre, scale);
     *out = cur;
     return CCN_OK;
 }

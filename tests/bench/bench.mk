@@ -9,5 +9,5 @@ $(B)/bench/osd_bench: tests/bench/osd_bench.cpp
 .PHONY: bench
 bench: deps
 	@$(MAKE) --no-print-directory build $(B)/bench/ccn_bench $(B)/bench/osd_bench
-	@./tests/bench/run_bench.sh
+	@./tests/bench/bench.sh
 .DEFAULT_GOAL := $(BENCH_SAVED_GOAL)

@@ -4,7 +4,7 @@
 # extension (blender_manifest.toml at the package root, files inside one folder).
 BLENDER_SAVED_GOAL := $(.DEFAULT_GOAL)
 APT_PKGS  += blender zip
-ADDON_SRC  = $(sort $(wildcard addon/*.py)) addon/blender_manifest.toml
+ADDON_SRC  = $(sort $(wildcard addon/*.py)) blender_manifest.toml
 
 .PHONY: package
 package: $(B)/ccnurbs.zip
