@@ -44,6 +44,13 @@ def set_vertex_normals(mesh, normals):
     mesh.normals_split_custom_set_from_vertices(normals)
 
 
+def use_plain_normals(mesh):
+    """Blender's own smooth vertex normals (no custom normals): < 4.1 turns auto smooth off
+    (custom normals are then ignored); 4.1+ has none after `clear_geometry`."""
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = False
+
+
 def corner_normals(mesh):
     """Per-corner (loop) normals as a flat float list: `calc_normals_split` + loops (< 4.1)
     vs `corner_normals` (4.1+)."""

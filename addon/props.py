@@ -20,6 +20,12 @@ BOUNDARY_ITEMS = (
     ('PRESERVE_CORNERS', "Keep Corners", "Pin valence-2 boundary corners (like Subdivision "
      "Surface 'Keep Corners')"),
 )
+NORMALS_ITEMS = (
+    ('EXACT', "Exact", "Exact surface normals from the derivatives, as custom split normals "
+     "(in Blender 3.x custom normals make each update several times slower)"),
+    ('FAST', "Fast", "Blender's smooth vertex normals of the exact limit positions: faster "
+     "updates while editing heavy meshes"),
+)
 ROLE_ITEMS = (('NONE', "None", ""), ('CAGE', "Cage", ""), ('VIEW_PROXY', "Viewport Proxy", ""),
               ('RENDER_PROXY', "Render Proxy", ""))
 
@@ -42,13 +48,14 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     cap: EnumProperty(name="Cap", items=CAP_ITEMS, default='GUIDED_BI5', update=_tag)
     boundary_smooth: EnumProperty(name="Boundary Smooth", items=BOUNDARY_ITEMS, default='ALL',
                                   update=_tag)
+    normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
     proxy: PointerProperty(type=bpy.types.Object, name="Viewport Proxy", options={'HIDDEN'})
     render_proxy: PointerProperty(type=bpy.types.Object, name="Render Proxy",
                                   options={'HIDDEN'})
     owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
 
     def option_tuple(self):
-        return (self.scheme, self.cap, self.boundary_smooth)
+        return (self.scheme, self.cap, self.boundary_smooth, self.normals)
 
 
 def _overlay_toggled(self, context):

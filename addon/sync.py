@@ -51,7 +51,14 @@ def status(obj, kind='VIEW'):
 
 # ---- writing a proxy ---------------------------------------------------------------------------
 
-def _write_topology(me, res, cage):
+def _write_normals(me, res, exact):
+    if exact:
+        compat.set_vertex_normals(me, res["normals"].astype(np.float32))
+    else:
+        compat.use_plain_normals(me)
+
+
+def _write_topology(me, res, cage, exact=True):
     pos = res["positions"].astype(np.float32).ravel()
     fv = res["face_verts"].ravel()
     nv, nf = len(res["positions"]), len(res["face_verts"])
@@ -67,13 +74,13 @@ def _write_topology(me, res, cage):
         origin = np.clip(res["face_origin"], 0, len(cage.material_index) - 1)
         me.polygons.foreach_set("material_index", cage.material_index[origin])
     me.update(calc_edges=True)
-    compat.set_vertex_normals(me, res["normals"].astype(np.float32))
+    _write_normals(me, res, exact)
 
 
-def _write_positions(me, res):
+def _write_positions(me, res, exact=True):
     me.vertices.foreach_set("co", res["positions"].astype(np.float32).ravel())
     me.update()
-    compat.set_vertex_normals(me, res["normals"].astype(np.float32))
+    _write_normals(me, res, exact)
 
 
 def _sync_materials(obj, proxy):
@@ -133,10 +140,12 @@ def sync_object(obj, kind='VIEW', force=False, cage=None):
         if same_topology and me.get(KEY_PROP) == key:
             pass  # forced: the proxy is already right
         elif same_topology:
-            _write_positions(me, plan.evaluate(cage.positions, topology=False))
+            res = plan.evaluate(cage.positions, topology=False)
+            _write_positions(me, res, s.normals == 'EXACT')
             stats["position_updates"] += 1
         else:
-            _write_topology(me, plan.evaluate(cage.positions, topology=True), cage)
+            _write_topology(me, plan.evaluate(cage.positions, topology=True), cage,
+                            s.normals == 'EXACT')
             stats["rebuilds"] += 1
         me[KEY_PROP] = key
         me[TOPO_PROP] = topo

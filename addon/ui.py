@@ -132,6 +132,7 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         layout.prop(s, "scheme")
         layout.prop(s, "cap")
         layout.prop(s, "boundary_smooth")
+        layout.prop(s, "normals")
         _draw_status(layout, obj)
         rst = sync.status(obj, 'RENDER')
         if rst is not None and rst.error:

@@ -8,6 +8,6 @@ $(B)/bench/osd_bench: tests/bench/osd_bench.cpp
 	$(CXX) -std=c++14 -O2 -Wall -Wextra -Werror $< -o $@ -losdCPU
 .PHONY: bench
 bench: deps
-	@$(MAKE) --no-print-directory build $(B)/bench/ccn_bench $(B)/bench/osd_bench
+	@$(MAKE) --no-print-directory build package $(B)/bench/ccn_bench $(B)/bench/osd_bench
 	@./tests/bench/bench.sh
 .DEFAULT_GOAL := $(BENCH_SAVED_GOAL)

@@ -23,6 +23,11 @@ done
 echo "refine ratio = ccn_refine (topology + points) / OSD uniform refinement (topology + points);"
 echo "evaluate ratio = plan evaluate (positions + normals) / OSD re-interpolation + Limit with tangents;"
 echo "plan ratio = plan creation / OSD topology + points + limit."
-if [ -f tests/blender/bench_blender.py ] && command -v blender > /dev/null; then
-  blender --background --factory-startup --python-exit-code 1 --python tests/blender/bench_blender.py -- "$D" 2>/dev/null | grep '^bench'
+if command -v blender > /dev/null; then
+  echo "Blender $(blender --version 2>/dev/null | head -n 1 | cut -d' ' -f2): CCNURBS modifier vs Subdivision Surface, same density (ratio = ours / Subsurf):"
+  tmp=$(mktemp -d) || exit 2
+  BLENDER_USER_SCRIPTS="$tmp/scripts" BLENDER_USER_CONFIG="$tmp/config" \
+    blender --background --factory-startup --python-exit-code 1 \
+    --python tests/blender/bench_blender.py -- "$D" build/ccnurbs.zip 2>&1 | grep '^bench'
+  rm -rf "$tmp"
 fi
