@@ -29,6 +29,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     if (p->has_sub) { ccn__level_free(&p->sub); free(p->posS); }
     free(p->near);
     free(p->cage_pos);
+    free(p->cap_net);
     for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
     for (int32_t c = 0; c < p->ncap; c++) {
         free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
@@ -227,6 +228,10 @@ static ccn_status setup_caps(ccn_plan *p, ccn_error *err) {
     }
     free(stamp); free(q);
     p->sizes.num_caps = p->ncap;
+    int32_t maxn = 0;
+    for (int32_t c = 0; c < p->ncap; c++) maxn = p->caps[c].n > maxn ? p->caps[c].n : maxn;
+    p->cap_net = malloc(sizeof(double) * 3 * (6 * (size_t)maxn + 1));
+    if (!p->cap_net) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     return CCN_OK;
 }
 
@@ -407,13 +412,11 @@ static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
     for (int32_t c = 0; c < p->ncap; c++) {
         ccn__cap *cp = &p->caps[c];
         int32_t n = cp->n, nc = 6 * n + 1;
-        double *net = malloc(sizeof(double) * 3 * (size_t)nc), ctr[3] = {0, 0, 0};
-        if (!net) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (cap)");
+        double *net = p->cap_net, ctr[3] = {0, 0, 0}; /* sized for the largest cap at create */
         for (int32_t j = 0; j < nc; j++) memcpy(net + 3 * j, P + 3 * (size_t)cp->cnet[j], sizeof(double) * 3);
         for (int32_t j = 0; j < 2 * n + 1; j++)
             for (int i = 0; i < 3; i++) ctr[i] += cp->l0[j] * P[3 * (size_t)cp->ring[j] + i];
         ccn_status st = ccn__bi5_apply(cp->op, net, cp->knots, ctr, cp->patches, err);
-        free(net);
         if (st) return st;
     }
     for (int32_t i = 0; i < p->nhv; i++) {

@@ -49,6 +49,7 @@ struct ccn_plan {
     struct ccn__bi5 **ops;  /* one per valence used, nops entries */
     int32_t *op_n;          /* valence of each op */
     int32_t nops;
+    double *cap_net;        /* evaluate's c-net buffer (largest cap) */
     int32_t nhv;            /* output vertices evaluated on a cap */
     int32_t *hv_out, *hv_cap, *hv_sector;
     double *hv_uv;

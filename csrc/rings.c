@@ -428,7 +428,8 @@ ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *s
     double ctr[3];
     if (center) memcpy(ctr, center, sizeof ctr);
     else centre_point(n, cnet, ctr);
-    double *kap = malloc(sizeof(double) * (size_t)n);
+    double kap_small[64]; /* no allocation on the uniform path for the valences the plan caps */
+    double *kap = n <= 64 ? kap_small : malloc(sizeof(double) * (size_t)n);
     if (!kap) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
     int kind = spoke_knots ? classify_knots(n, spoke_knots, kap, &bad) : 0;
     if (kind == 0) apply_stencil(b, cnet, ctr, patches);
@@ -444,7 +445,7 @@ ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *s
         if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus, patches, err);
         free(taus);
     }
-    free(kap);
+    if (kap != kap_small) free(kap);
     if (!st) ccn__ok(err);
     return st;
 }
