@@ -81,6 +81,8 @@ ccn_status ccn__resolve_rings(ccn_mesh *m, const double *edge_values, const int3
                               ccn_error *err);
 
 #define CCN_KNOT_MIN_RATIO 1e-6
+#define CCN_COORD_MAX 1e300 /* larger |coordinates| are rejected: results must stay finite */
+#define CCN_EV_MATRIX_MAX_VALENCE 1024 /* above: NURSS rules (memory grows as valence^2) */
 
 /* ---- refine.c: one refinement level, split so a plan can re-run only the points ---- */
 typedef struct {

@@ -3,8 +3,9 @@
  * Rejected (CCN_ERR_TOPOLOGY, the message names the element): a face with < 3 vertices or a
  * repeated vertex, an index out of range, an edge shared by more than two faces, two faces
  * using an edge in the same direction (inconsistent orientation), a vertex whose faces form
- * more than one fan (non-manifold vertex). Rejected (CCN_ERR_ARGUMENT): negative counts,
- * NULL arrays, NaN/Inf coordinates, no faces. Ignored and counted: isolated vertices, knot
+ * more than one fan (non-manifold vertex), an interior vertex of valence 2. Rejected
+ * (CCN_ERR_ARGUMENT): negative counts, NULL arrays, NaN/Inf coordinates or beyond
+ * +-CCN_COORD_MAX, no faces. Ignored and counted: isolated vertices, knot
  * values given for vertex pairs that are not edges of any face (loose edges).
  */
 #include "internal.h"
@@ -134,10 +135,15 @@ static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "num_edges is %d but edge_verts is NULL", (int)c->num_edges);
     for (int32_t v = 0; v < c->num_verts; v++)
-        for (int k = 0; k < 3; k++)
-            if (!isfinite(c->positions[3 * (size_t)v + k]))
+        for (int k = 0; k < 3; k++) {
+            double x = c->positions[3 * (size_t)v + k];
+            if (!isfinite(x))
                 return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
                                  "vertex %d has a non-finite coordinate (NaN or Inf)", (int)v);
+            if (fabs(x) > CCN_COORD_MAX)
+                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                 "vertex %d has a coordinate beyond +-%g", (int)v, CCN_COORD_MAX);
+        }
     int64_t nh = 0;
     for (int32_t f = 0; f < c->num_faces; f++) {
         int32_t s = c->face_sizes[f];
@@ -293,6 +299,13 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
                        (int)(bad - 1));
         goto done;
     }
+    for (int32_t v = 0; v < m->nv; v++)
+        if (!m->vboundary[v] && m->vfan_start[v + 1] - m->vfan_start[v] == 2) {
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
+                           "vertex %d is an interior vertex with only 2 edges (two faces share "
+                           "two consecutive edges): not supported", (int)v);
+            goto done;
+        }
     if ((st = apply_knots(m, cage, keys, err))) goto done;
     ccn__mesh_update_info(m);
     m->info.level = 0;
@@ -328,33 +341,30 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_erro
     ccn__ok(err);
     if (!m || !positions)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "mesh or positions is NULL");
-    for (int32_t i = 0; i < 3 * m->nv; i++)
+    for (int32_t i = 0; i < 3 * m->nv; i++) {
         if (!isfinite(positions[i]))
             return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
                              "vertex %d has a non-finite coordinate (NaN or Inf)", (int)(i / 3));
+        if (fabs(positions[i]) > CCN_COORD_MAX)
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
+                             "vertex %d has a coordinate beyond +-%g", (int)(i / 3), CCN_COORD_MAX);
+    }
     memcpy(m->pos, positions, sizeof(double) * 3 * (size_t)m->nv);
     return CCN_OK;
 }
 
-/* Centre and half-size of the bounding box; positions become (p - centre) / scale. */
+/* Exact scaling by a power of two (no centre shift: no precision is lost) so that the largest
+ * coordinate of the vertices in faces is below 1; isolated vertices do not count. */
 void ccn__normalize(ccn_mesh *m, double centre[3], double *scale) {
-    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int32_t v = 0; v < m->nv; v++)
-        for (int k = 0; k < 3; k++) {
-            double x = m->pos[3 * (size_t)v + k];
-            if (v == 0 || x < lo[k]) lo[k] = x;
-            if (v == 0 || x > hi[k]) hi[k] = x;
-        }
-    double s = 0;
-    for (int k = 0; k < 3; k++) {
-        centre[k] = lo[k] / 2 + hi[k] / 2; /* no overflow for |x| near DBL_MAX */
-        double h = hi[k] / 2 - lo[k] / 2;
-        if (h > s) s = h;
+    double big = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (m->vfan_start[v + 1] == m->vfan_start[v]) continue;
+        for (int k = 0; k < 3; k++) big = fmax(big, fabs(m->pos[3 * (size_t)v + k]));
     }
-    *scale = s > 0 && isfinite(s) ? s : 1.0;
-    for (int32_t v = 0; v < m->nv; v++)
-        for (int k = 0; k < 3; k++)
-            m->pos[3 * (size_t)v + k] = (m->pos[3 * (size_t)v + k] - centre[k]) / *scale;
+    centre[0] = centre[1] = centre[2] = 0;
+    *scale = big > 0 && isfinite(big) ? ldexp(1.0, ilogb(big) + 1) : 1.0;
+    double inv = 1.0 / *scale; /* a power of two: exact */
+    for (size_t i = 0; i < 3 * (size_t)m->nv; i++) m->pos[i] *= inv;
 }
 
 void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale) {

@@ -300,6 +300,18 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     p->cage_pos = malloc(sizeof(double) * 3 * (size_t)(p->ncage ? p->ncage : 1));
     if (!p->cage_pos) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto fail; }
     memcpy(p->cage_pos, cage_mesh->pos, sizeof(double) * 3 * (size_t)p->ncage);
+    for (int32_t v = 0; v < cage_mesh->nv && !st; v++)
+        if (cage_mesh->vfan_start[v + 1] > cage_mesh->vfan_start[v] &&
+            ccn__valence(cage_mesh, v) > CCN_EV_MATRIX_MAX_VALENCE)
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
+                           "vertex %d has valence %d; the limit surface supports at most %d",
+                           (int)v, (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE);
+    for (int32_t f = 0; f < cage_mesh->nf && !st; f++)
+        if (ccn__fsize(cage_mesh, f) > CCN_EV_MATRIX_MAX_VALENCE)
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                           "face %d has %d sides; the limit surface supports at most %d",
+                           (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE);
+    if (st) goto fail;
     p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
     int64_t corners = cage_mesh->nh; /* fail before any work if the output cannot be indexed */
     for (int32_t l = 0; l < p->L + 1 && !st; l++)
@@ -442,8 +454,7 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     if (positions) {
         ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
         if (st) return st;
-        memcpy(p->cage_pos, positions, sizeof(double) * 3 * (size_t)p->ncage);
-    } else {
+    } else { /* the cage's own positions, as given to ccn_plan_create */
         memcpy(p->lev[0]->pos, p->cage_pos, sizeof(double) * 3 * (size_t)p->ncage);
     }
     /* every rule is affine-invariant: work in a unit box so that huge coordinates (1e300)

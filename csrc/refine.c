@@ -200,8 +200,11 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
     const ccn_mesh *m = c->m;
     c->nev = 0;
     if (!c->red) return CCN_OK;
-    for (int32_t v = 0; v < m->nv; v++)
-        if (ccn__is_ev(m, v)) c->ev_list[c->nev++] = v;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!ccn__is_ev(m, v)) continue;
+        if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; continue; }
+        c->ev_list[c->nev++] = v;
+    }
     return build_ev_matrices(c, err);
 }
 

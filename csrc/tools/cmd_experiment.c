@@ -4,39 +4,55 @@
  *            has exactly one local maximum after L refinements (SPEC 3.2, DESIGN 4.3);
  *   charmap  the (12n+1) x (12n+1) three-ring refinement matrix has the spectrum
  *            1 > mu2 = mu3 > |mu4| and the characteristic map is regular and injective.
+ * Results: tests/experiments/RESULTS.md; tests: tests/experiments/run_experiments.sh.
  *
- * The cage ("G-ring fan", G = 3 unless --rings): valence-n centre vertex V, n sectors, sector s
- * a G x G quad grid between spoke s (angle 2 pi s / n) and spoke s+1. Grid point (s, i, j),
- * 0 <= i, j <= G, sits at i u_s + j u_{s+1}; (s, 0, j) is (s+1, j, 0) and (s, 0, 0) is V.
- * Vertex numbering (fan_vid): V = 0, then per sector the points i = 1..G, j = 0..G, i.e.
- * 1 + s G (G+1) + (i-1)(G+1) + j; for G = 3 that is 12n+1 points, 9n faces, 21n edges. Every
- * edge parallel to spoke s carries d_s (SPEC 3.2), so opposite edges of every quad agree and
- * the interval beyond every spoke end is the spoke's own (e_s = d_s, also at level 0).
+ * The cage ("G-ring fan"): valence-n centre vertex V, n sectors, sector s a G x G quad grid
+ * between spoke s (angle 2 pi s / n) and spoke s+1. Grid point (s, i, j), 0 <= i, j <= G, sits
+ * at i u_s + j u_{s+1}; (s, 0, j) is (s+1, j, 0) and (s, 0, 0) is V. Numbering (fan_vid): V = 0,
+ * then per sector i = 1..G, j = 0..G: 1 + s G (G+1) + (i-1)(G+1) + j; G = 3 gives 12n+1
+ * points, 9n faces, 21n edges. Every edge parallel to spoke s carries d_s (SPEC 3.2), so
+ * opposite edges of every quad agree and the interval beyond every spoke end is the spoke's own.
  *
- * Why three rings are exact (maxima): z = 1 at V, 0 elsewhere. The blending function's control
- * points at level k are non-zero only strictly inside fine ring 2 * 2^k (its support is the
- * coarse 2-ring). A point whose stencil differs from the infinite mesh's (boundary curve rules,
- * mirrored intervals) only reads points of fine rings >= 3 * 2^k - 2 >= 2 * 2^k (k >= 1; at
- * k = 0 it reads rings >= 1, all zero), and mirrored intervals equal the true ones here anyway.
- * So every refined z equals the infinite-mesh value. `--rings 4` checks this numerically (the
- * test script compares the two).
+ * Where the blending function starts (--start): `level1` (default) refines the cage once, then
+ * sets z = 1 at the EV's vertex point and 0 elsewhere. The level-1 mesh is again a fan whose
+ * rings parallel to spoke s carry d_s, and every following refinement uses the scheme's EV
+ * rules (for eigen: M at every level) -- the paper's and SPEC 3's setup. `cage` sets z on the
+ * level-0 cage and refines that, which is the library pipeline: level 0 -> 1 uses NURSS rules at
+ * the EV for every scheme (DESIGN 4.3), so its figures mix the two rule sets.
  *
- * Three-ring matrix (charmap): the cage is refined once (level 0 -> 1 uses NURSS rules at the EV
- * for every scheme, DESIGN 4.3), giving a level-1 mesh L1 whose intervals are again d_s (halved,
- * then normalised), so the matrix of L1 -> L2 is the stationary one. Its 3-ring is found through
- * topology (ring_grid): V1 = the vertex point of V (index nf + ne + 0 in L1, ccnurbs.h order)
- * and its spoke-0 neighbour = the edge point of the cage edge (V, (0,1,0)) (index nf + e); the
- * grid of each sector is then walked face by face through directed half-edges. The same walk
- * on L2 gives the fine 3-ring in the same order. Column c of the matrix is the refined 3-ring
- * when 3-ring point c of L1 is 1 and all else 0 (three columns per refine call, one per
- * coordinate). The characteristic net (x = eigenvector of mu2, y = of mu3, orthonormalised) is
- * placed on the 3-ring of L1 (everything else 0) and refined k levels; rings <= 2^(k+1) + 1 of
- * the result depend only on the 3-ring. The annulus of grid quads between rings R = 2^(k-1)
- * and 2R is checked: regular = every quad convex with one orientation (all four corner
- * triangles; positive Jacobian of its bilinear map); injective = in addition the ring-R and
- * ring-2R polygons are simple, do not cross each other, wind +-1 (the quad orientation) around
- * the EV's limit (the origin), and ring R lies inside ring 2R. For consistently oriented
- * triangles the number covering a point is winding(outer) - winding(inner) in {0, 1}.
+ * Why three rings are exact: the blending function's control points at level k are non-zero
+ * only strictly inside fine ring 2 * 2^k (its support is the 2-ring). A point whose stencil
+ * differs from the infinite mesh's (boundary curve rules, mirrored intervals) only reads points
+ * of fine rings >= R 2^k - 2, R = rings of the starting mesh (3 for `cage`, 4 for `level1`,
+ * built from a 2-ring cage), which is >= 2 * 2^k for k >= 1 (and reads only zeros at k = 0);
+ * mirrored intervals equal the true ones here anyway. So every refined z equals the
+ * infinite-mesh value; --rings 6 (level1) / 4 (cage) checks it (run_experiments.sh (b)).
+ * Local maximum (SPEC A11): z > 1e-12 and z strictly above every vertex sharing a face.
+ *
+ * Three-ring matrix (charmap): the cage (G = 3) is refined once to L1 (whose intervals are
+ * again d_s, halved and normalised), so the matrix of L1 -> L2 is the stationary one. Its
+ * 3-ring is found through topology (ring_grid): V1 = the vertex point of V (index nf + ne + 0,
+ * ccnurbs.h order) and its spoke-0 neighbour = the edge point of the cage edge (V, (0,1,0))
+ * (index nf + e); each sector's grid is walked face by face through directed half-edges; the
+ * same on L2 (track_refine follows V and its spoke-0 neighbour through every refinement).
+ * Column c is the refined 3-ring when 3-ring point c of L1 is 1 and all else 0 (three columns
+ * per refine call, one per coordinate). Checks: rows sum to 1, the 1-ring rows equal
+ * ccn_ev_matrix, and LAPACKE_dgeev's spectrum. The characteristic net (x, y = an orthonormal
+ * basis of the mu2, mu3 eigenvectors) is placed on L1's 3-ring (all else 0) and refined; after
+ * l levels rings <= 2^(l+1) + 1 depend on the 3-ring only.
+ *   regular, injective (the limit surface; the pass criterion): at level 2 every face of rings
+ *     2..4 is a regular bicubic patch; its Bezier net comes from the knot-interval form
+ *     (span_bezier, checked against the next level to 5e-17). det J is a bidegree-(5,5)
+ *     polynomial; its Bernstein coefficients all of one sign prove regularity, a corner value of
+ *     the other sign (or 0) disproves it, otherwise the patch is split (up to 6 times). Injective:
+ *     in addition the limit curves of parameter rings 2 and 4 (8 samples per face side) are
+ *     simple, do not meet, wind +-1 (the Jacobian's sign) around the EV's limit (the origin,
+ *     since mu2, mu3 != 1), and ring 2 lies inside ring 4: with a consistently signed Jacobian
+ *     the number of preimages of a point is winding(outer) - winding(inner), so it is <= 1.
+ *   net regular, net injective (diagnostic): the same on the control net of level k
+ *     (--charlevels): quads of rings 2^(k-1)..2^k convex with one orientation (all four corner
+ *     triangles), and the ring polygons. Control nets converge slowly where intervals differ
+ *     by 100x, so this test also fails on some regular maps.
  */
 #include "cli.h"
 
@@ -56,6 +72,7 @@
 #define EXP_MAX_VALS 16    /* entries of --valences */
 #define EXP_ZMIN 1e-12     /* z <= this: outside the support */
 #define EXP_CHUNK 8        /* cases taken by a worker at a time */
+#define EXP_MAX_LATER 8    /* levels followed beyond L by --persist */
 #define EXP_PI 3.14159265358979323846
 
 typedef enum { EXP_MAXIMA, EXP_CHARMAP } exp_kind;
@@ -64,7 +81,7 @@ typedef struct {
     exp_kind kind;
     ccn_scheme scheme;
     int levels, rings, threads, list, persist, charlevels, dist_log, start;
-    long cases;
+    long cases, offset;
     uint64_t seed;
     double lo;
     int nval, val[EXP_MAX_VALS];
@@ -79,9 +96,12 @@ static int exp_usage(void) {
             "usage:\n"
             "  ccnurbs experiment maxima  --cases N --seed S [--scheme eigen|nurss|cc] [--levels L]\n"
             "        [--dist uniform|loguniform] [--lo 1e-6] [--valences 3,5,6,7,8] [--knots d0,d1,...]\n"
-            "        [--threads T] [--rings G] [--list K] [--persist L2]\n"
+            "        [--threads T] [--rings G] [--list K] [--persist L2] [--start level1|cage] [--offset K]\n"
             "  ccnurbs experiment charmap --cases N --seed S [--scheme eigen|nurss|cc] [--dist ...]\n"
-            "        [--lo 1e-6] [--valences ...] [--knots ...] [--threads T] [--charlevels k] [--list K]\n");
+            "        [--lo 1e-6] [--valences ...] [--knots ...] [--threads T] [--charlevels k] [--list K]\n"
+            "        [--offset K]\n"
+            "  Case i (i = K .. K+N-1) has valence valences[i mod count] and intervals drawn from a\n"
+            "  generator seeded by (S, i): results do not depend on --threads or on how a run is split.\n");
     return 2;
 }
 
@@ -153,12 +173,13 @@ static int parse_number_opt(const char *opt, const char *val, exp_args *o) {
     long x;
     if (strcmp(opt, "--cases") == 0) return parse_long(val, 1, 100000000L, &o->cases);
     if (strcmp(opt, "--seed") == 0) return parse_u64(val, &o->seed);
+    if (strcmp(opt, "--offset") == 0) return parse_long(val, 0, 1000000000L, &o->offset);
     if (strcmp(opt, "--lo") == 0)
         return parse_double(val, &o->lo) || !(o->lo > 0 && o->lo <= 1) ? -1 : 0;
     struct { const char *name; long lo, hi; int *dst; } tab[] = {
         {"--levels", 0, 9, &o->levels},     {"--threads", 1, 256, &o->threads},
         {"--rings", 3, 8, &o->rings},       {"--list", 0, 1000000, &o->list},
-        {"--persist", 0, 9, &o->persist},   {"--charlevels", 1, 7, &o->charlevels},
+        {"--persist", 0, 12, &o->persist},   {"--charlevels", 2, 7, &o->charlevels},
     };
     for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++) {
         if (strcmp(opt, tab[i].name)) continue;
@@ -216,12 +237,13 @@ static uint64_t mix64(uint64_t z) {
     return z ^ (z >> 31);
 }
 
-/* Valence and spoke intervals of case idx: a function of (seed, idx) only. */
+/* Valence and spoke intervals of case offset + idx: a function of (seed, offset + idx) only. */
 static int case_setup(const exp_args *a, long idx, double *d) {
     if (a->nknots) {
         memcpy(d, a->knots, sizeof(double) * (size_t)a->nknots);
         return a->nknots;
     }
+    idx += a->offset;
     int n = a->val[idx % a->nval];
     uint64_t st = mix64(mix64(a->seed) ^ (uint64_t)idx);
     for (int s = 0; s < n; s++) {
@@ -355,11 +377,42 @@ typedef struct {
     int maxima;       /* face-local maxima at the last level counted */
     int fallbacks;    /* num_ev_fallbacks of the refined mesh */
     int nonfinite;    /* refined z that are NaN / Inf */
+    int show;         /* input: print the maxima */
+    int nlater;       /* counts at levels L+1 .. (--persist) of a failing case */
+    signed char later[EXP_MAX_LATER];
     int32_t support;  /* vertices with z > EXP_ZMIN */
     double zsum, zmax;
 } max_result;
 
-/* Counts vertices whose z exceeds that of every vertex sharing a face with them. */
+/* Candidates (z > EXP_ZMIN) and the support statistics. */
+static void support_stats(const double *pos, int32_t nv, unsigned char *flag, max_result *r) {
+    for (int32_t v = 0; v < nv; v++) {
+        double z = pos[3 * v + 2];
+        r->nonfinite += !isfinite(z);
+        flag[v] = z > EXP_ZMIN;
+        if (!flag[v]) continue;
+        r->support++;
+        r->zsum += z;
+        if (z > r->zmax) r->zmax = z;
+    }
+}
+
+/* A face-local maximum is the unique argmax of every face around it: clears all other corners. */
+static void clear_non_argmax(const double *pos, int32_t nf, const int32_t *fs, const int32_t *fv,
+                             unsigned char *flag) {
+    for (int32_t f = 0, k = 0; f < nf; k += fs[f], f++) {
+        int32_t best = 0, tie = 0;
+        for (int32_t a = 1; a < fs[f]; a++) {
+            double za = pos[3 * fv[k + a] + 2], zb = pos[3 * fv[k + best] + 2];
+            if (za > zb) { best = a; tie = 0; }
+            else if (!(za < zb)) tie = 1; /* equal to the best so far (or NaN) */
+        }
+        for (int32_t a = 0; a < fs[f]; a++)
+            if (a != best || tie) flag[fv[k + a]] = 0;
+    }
+}
+
+/* Counts vertices whose z exceeds that of every vertex sharing a face with them (SPEC A11). */
 static ccn_status count_maxima(const ccn_mesh *m, max_result *r, ccn_error *err) {
     ccn_mesh_info in;
     ccn_mesh_info_get(m, &in);
@@ -372,68 +425,78 @@ static ccn_status count_maxima(const ccn_mesh *m, max_result *r, ccn_error *err)
         return fail_memory(err);
     }
     ccn_mesh_copy(m, pos, fs, fv, NULL, NULL);
-    *r = (max_result){.fallbacks = in.num_ev_fallbacks};
+    r->maxima = r->nonfinite = 0;
+    r->support = 0;
+    r->zsum = r->zmax = 0;
+    r->fallbacks = in.num_ev_fallbacks;
+    support_stats(pos, in.num_verts, flag, r);
+    clear_non_argmax(pos, in.num_faces, fs, fv, flag);
     for (int32_t v = 0; v < in.num_verts; v++) {
-        double z = pos[3 * v + 2];
-        r->nonfinite += !isfinite(z);
-        flag[v] = z > EXP_ZMIN;
-        if (!flag[v]) continue;
-        r->support++;
-        r->zsum += z;
-        if (z > r->zmax) r->zmax = z;
+        r->maxima += flag[v];
+        if (flag[v] && r->show)
+            printf("maximum: vertex %d x %.9g y %.9g z %.17g\n", (int)v, pos[3 * v],
+                   pos[3 * v + 1], pos[3 * v + 2]);
     }
-    for (int32_t f = 0, k = 0; f < in.num_faces; k += fs[f], f++)
-        for (int32_t a = 0; a < fs[f]; a++)
-            for (int32_t b = 0; b < fs[f]; b++)
-                if (a != b && !(pos[3 * fv[k + a] + 2] > pos[3 * fv[k + b] + 2])) flag[fv[k + a]] = 0;
-    for (int32_t v = 0; v < in.num_verts; v++) r->maxima += flag[v];
     free(pos); free(fs); free(fv); free(flag);
     return CCN_OK;
 }
 
-/* start = 1: the blending function of the EV of the level-1 mesh (the cage refined once, then
- * z = 1 at the EV's vertex point and 0 elsewhere), so the EV rules of `scheme` act at every
- * level (SPEC 3's reference setup). Its intervals are again d_s per spoke direction. */
+/* --start level1: the cage refined once (any scheme: NURSS), then z = 1 at the EV's vertex
+ * point and 0 elsewhere (x, y kept); refining it applies the scheme's EV rules at every level. */
 static ccn_status start_level1(const double *d, const fan_cage *c, ccn_mesh **out, ccn_error *err) {
     ccn_mesh *m0 = NULL;
-    ccn_options o = {.scheme = CCN_SCHEME_NURSS};
+    ccn_options o = {.scheme = CCN_SCHEME_NURSS, .threads = 1};
     ccn_status st = fan_mesh(c, d, &m0, err);
     if (!st) st = ccn_refine(m0, 1, &o, out, err);
     ccn_mesh_destroy(m0);
     if (st) return st;
     ccn_mesh_info in;
     ccn_mesh_info_get(*out, &in);
-    double *pos = calloc(3 * (size_t)in.num_verts, sizeof(double));
+    double *pos = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     if (!pos) return fail_memory(err);
+    ccn_mesh_copy(*out, pos, NULL, NULL, NULL, NULL);
+    for (int32_t v = 0; v < in.num_verts; v++) pos[3 * v + 2] = 0.0;
     pos[3 * ((size_t)c->nf + (size_t)c->ne) + 2] = 1.0; /* vertex point of cage vertex 0 */
     st = ccn_mesh_set_positions(*out, pos, err);
     free(pos);
     return st;
 }
 
-/* Refines the fan with intervals d `levels` levels and counts maxima at the last level, or at
- * every level 1..levels into per_level[] when per_level is not NULL. */
-static ccn_status maxima_case(const fan_cage *c, const double *d, ccn_scheme scheme, int levels,
-                              int start, int *per_level, max_result *r, ccn_error *err) {
-    ccn_mesh *cur = NULL, *next = NULL;
-    ccn_options o = {.scheme = scheme};
-    ccn_status st = start ? start_level1(d, c, &cur, err) : fan_mesh(c, d, &cur, err);
-    if (st) {
-        ccn_mesh_destroy(cur);
-        return st;
+static ccn_status refine_in_place(ccn_mesh **cur, int k, ccn_scheme scheme, ccn_error *err) {
+    ccn_mesh *next = NULL;
+    ccn_options o = {.scheme = scheme, .threads = 1}; /* cases run in parallel */
+    ccn_status st = ccn_refine(*cur, k, &o, &next, err);
+    ccn_mesh_destroy(*cur);
+    *cur = next;
+    return st;
+}
+
+/* Levels L+1 .. persist of a case with != 1 maximum at level L (cur is at level L). */
+static ccn_status maxima_later(ccn_mesh **cur, const exp_args *a, max_result *r, ccn_error *err) {
+    ccn_status st = CCN_OK;
+    for (int l = a->levels; l < a->persist && !st && r->nlater < EXP_MAX_LATER; l++) {
+        max_result t = {0};
+        st = refine_in_place(cur, 1, a->scheme, err);
+        if (!st) st = count_maxima(*cur, &t, err);
+        if (!st) r->later[r->nlater++] = (signed char)(t.maxima > 127 ? 127 : t.maxima);
     }
-    int step = per_level ? 1 : levels;
-    for (int l = 0; l < levels && !st; l += step) {
-        st = ccn_refine(cur, step, &o, &next, err);
-        ccn_mesh_destroy(cur);
-        cur = next;
-        next = NULL;
-        if (!st && per_level) {
-            st = count_maxima(cur, r, err);
-            per_level[l] = r->maxima;
-        }
+    return st;
+}
+
+/* Refines the fan with intervals d a->levels levels and counts maxima at the last level, or at
+ * every level 1..levels into per_level[] when per_level is not NULL; a case with != 1 maximum
+ * is followed up to level a->persist. */
+static ccn_status maxima_case(const fan_cage *c, const double *d, const exp_args *a,
+                              int *per_level, max_result *r, ccn_error *err) {
+    ccn_mesh *cur = NULL;
+    ccn_status st = a->start ? start_level1(d, c, &cur, err) : fan_mesh(c, d, &cur, err);
+    int step = per_level ? 1 : a->levels;
+    for (int l = 0; l < a->levels && !st; l += step) {
+        st = refine_in_place(&cur, step, a->scheme, err);
+        if (!st && (per_level || l + step == a->levels)) st = count_maxima(cur, r, err);
+        if (!st && per_level) per_level[l] = r->maxima;
     }
-    if (!st && !per_level) st = count_maxima(cur, r, err);
+    if (!st && r->maxima != 1) st = maxima_later(&cur, a, r, err);
     ccn_mesh_destroy(cur);
     return st;
 }
@@ -447,10 +510,14 @@ typedef struct {
     int32_t *everts;   /* 2 * ne */
     int32_t *ostart;   /* nv + 1: outgoing half-edges (4 f + k) of each vertex */
     int32_t *out;
+    double *eknot;     /* ne: ring intervals (quad_load_knots) */
+    int32_t *vestart;  /* nv + 1: edges at each vertex (quad_load_knots) */
+    int32_t *vedges;
 } quad_mesh;
 
 static void quad_free(quad_mesh *q) {
     free(q->pos); free(q->fv); free(q->everts); free(q->ostart); free(q->out);
+    free(q->eknot); free(q->vestart); free(q->vedges);
     memset(q, 0, sizeof *q);
 }
 
@@ -483,6 +550,35 @@ static int quad_load(const ccn_mesh *m, quad_mesh *q) {
     if (!q->pos || !q->fv || !q->everts) return -1;
     ccn_mesh_copy(m, q->pos, NULL, q->fv, q->everts, NULL);
     return quad_index(q);
+}
+
+/* quad_load plus the edge intervals and the edges at each vertex. */
+static int quad_load_knots(const ccn_mesh *m, quad_mesh *q) {
+    if (quad_load(m, q)) return -1;
+    q->eknot = malloc(sizeof(double) * (size_t)(q->ne ? q->ne : 1));
+    q->vestart = calloc((size_t)q->nv + 1, sizeof(int32_t));
+    q->vedges = malloc(sizeof(int32_t) * 2 * (size_t)(q->ne ? q->ne : 1));
+    int32_t *fill = malloc(sizeof(int32_t) * (size_t)(q->nv ? q->nv : 1));
+    if (!q->eknot || !q->vestart || !q->vedges || !fill) {
+        free(fill);
+        return -1;
+    }
+    ccn_mesh_copy(m, NULL, NULL, NULL, NULL, q->eknot);
+    for (int32_t t = 0; t < 2 * q->ne; t++) q->vestart[q->everts[t] + 1]++;
+    for (int32_t v = 0; v < q->nv; v++) q->vestart[v + 1] += q->vestart[v];
+    memcpy(fill, q->vestart, sizeof(int32_t) * (size_t)q->nv);
+    for (int32_t t = 0; t < 2 * q->ne; t++) q->vedges[fill[q->everts[t]]++] = t / 2;
+    free(fill);
+    return 0;
+}
+
+/* Interval of the edge a-b, or -1 if there is none. */
+static double edge_knot(const quad_mesh *q, int32_t a, int32_t b) {
+    for (int32_t t = q->vestart[a]; t < q->vestart[a + 1]; t++) {
+        int32_t e = q->vedges[t];
+        if (q->everts[2 * e] + q->everts[2 * e + 1] - a == b) return q->eknot[e];
+    }
+    return -1;
 }
 
 /* Half-edge a -> b as 4 f + k (corner k of face f is a), or -1. */
@@ -569,7 +665,7 @@ static ccn_status track_refine(const ccn_mesh *m, ccn_scheme scheme, int32_t *ev
         snprintf(err->message, sizeof err->message, "EV spoke edge not found");
         return CCN_ERR_INTERNAL;
     }
-    ccn_options o = {.scheme = scheme};
+    ccn_options o = {.scheme = scheme, .threads = 1}; /* cases run in parallel */
     ccn_status st = ccn_refine(m, 1, &o, out, err);
     if (st) return st;
     *ev = nf + ne + *ev;
@@ -580,8 +676,10 @@ static ccn_status track_refine(const ccn_mesh *m, ccn_scheme scheme, int32_t *ev
 /* ---- charmap: the three-ring matrix ------------------------------------------------------ */
 
 typedef struct {
-    int spectrum, regular, injective, matrix_ok;
-    int fallbacks, orient, wind_in, wind_out, bad_quads, crossings, defective;
+    int spectrum, regular, injective, matrix_ok;  /* regular / injective: the limit surface */
+    int net_regular, net_injective;               /* the same tests on control-net quads */
+    int fallbacks, orient, wind_in, wind_out, bad_patches, undecided, crossings, defective;
+    int net_orient, net_bad_quads;
     double mod[6];               /* |mu_1| .. |mu_6| */
     double mu2, mu3, im2;        /* real parts of mu2, mu3; |imag| of mu2 */
     double split, ratio, lam_err; /* |mu2-mu3|/|mu2|, |mu4|/|mu2|, max |mu2,3 - lambda_n| */
@@ -828,19 +926,28 @@ static int winding(const double *pts, int m, const double *p) {
 }
 
 typedef struct {
-    int n, G;            /* valence, grid size per sector */
-    const int32_t *idx;  /* fan_vid(n, G, ...) -> vertex */
-    const double *pos;   /* 3 per vertex */
+    int n, G;              /* valence, grid size per sector */
+    const int32_t *idx;    /* fan_vid(n, G, ...) -> vertex */
+    const quad_mesh *q;    /* positions, edges, intervals */
 } char_grid;
 
-static const double *gp(const char_grid *g, int s, int i, int j) {
-    return g->pos + 3 * (size_t)g->idx[fan_vid(g->n, g->G, s, i, j)];
+/* Grid vertex (s, i, j); i < 0 or j < 0 reach into the neighbouring sectors:
+ * (s, -i, j) = (s+1, j, i) and (s, i, -j) = (s-1, j, i). */
+static int32_t grid_vertex(const char_grid *g, int s, int i, int j) {
+    if (i < 0) return grid_vertex(g, s + 1, j, -i);
+    if (j < 0) return grid_vertex(g, s + g->n - 1, -j, i);
+    return g->idx[fan_vid(g->n, g->G, s, i, j)];
 }
 
-/* Quads of rings R..2R: every corner triangle must have the orientation of the first. */
+static const double *gp(const char_grid *g, int s, int i, int j) {
+    return g->q->pos + 3 * (size_t)grid_vertex(g, s, i, j);
+}
+
+/* -- control-net test: quads of rings R..2R, every corner triangle with one orientation -- */
+
 static void annulus_quads(const char_grid *g, int R, cm_result *r) {
-    r->orient = 0;
-    r->bad_quads = 0;
+    r->net_orient = 0;
+    r->net_bad_quads = 0;
     for (int s = 0; s < g->n; s++)
         for (int i = 0; i < 2 * R; i++)
             for (int j = 0; j < 2 * R; j++) {
@@ -851,10 +958,10 @@ static void annulus_quads(const char_grid *g, int R, cm_result *r) {
                 for (int k = 0; k < 4; k++) {
                     double o = orient2(q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
                     int sg = o > 0 ? 1 : o < 0 ? -1 : 0;
-                    if (!r->orient) r->orient = sg;
-                    bad |= sg == 0 || sg != r->orient;
+                    if (!r->net_orient) r->net_orient = sg;
+                    bad |= sg == 0 || sg != r->net_orient;
                 }
-                r->bad_quads += bad;
+                r->net_bad_quads += bad;
             }
 }
 
@@ -883,27 +990,217 @@ static int polygon_crossings(const double *pts, int m1, int m2) {
     return count;
 }
 
-static int annulus_check(const char_grid *g, int R, cm_result *r) {
+/* Inner polygon pts[0..m1), outer pts[m1..m1+m2): both simple, disjoint, winding `orient`
+ * around the origin (the EV's limit), the inner one inside the outer one. */
+static int rings_injective(const double *pts, int m1, int m2, int orient, int *wind_in,
+                           int *wind_out, int *crossings) {
+    const double origin[2] = {0, 0};
+    *wind_in = winding(pts, m1, origin);
+    *wind_out = winding(pts + 2 * m1, m2, origin);
+    int nested = winding(pts + 2 * m1, m2, pts) == orient;
+    *crossings = polygon_crossings(pts, m1, m2);
+    return *crossings == 0 && nested && *wind_in == orient && *wind_out == orient;
+}
+
+static int net_check(const char_grid *g, int R, cm_result *r) {
     annulus_quads(g, R, r);
-    r->regular = r->bad_quads == 0 && r->orient != 0;
+    r->net_regular = r->net_bad_quads == 0 && r->net_orient != 0;
     int m1 = 2 * R * g->n, m2 = 4 * R * g->n;
     double *pts = malloc(sizeof(double) * 2 * (size_t)(m1 + m2));
     if (!pts) return -1;
     ring_polygon(g, R, pts);
     ring_polygon(g, 2 * R, pts + 2 * m1);
-    const double origin[2] = {0, 0};
-    r->wind_in = winding(pts, m1, origin);
-    r->wind_out = winding(pts + 2 * m1, m2, origin);
-    int nested = winding(pts + 2 * m1, m2, pts) == r->orient;
-    r->crossings = polygon_crossings(pts, m1, m2);
-    r->injective = r->regular && r->crossings == 0 && nested && r->wind_in == r->orient &&
-                   r->wind_out == r->orient;
+    int wi, wo, cr;
+    r->net_injective = r->net_regular && rings_injective(pts, m1, m2, r->net_orient, &wi, &wo, &cr);
     free(pts);
     return 0;
 }
 
-/* Places the characteristic net (x, y, 0) on L1's 3-ring, refines k levels and checks the
- * annulus between rings R = 2^(k-1) and 2R. */
+/* -- surface test: the limit patches of the annulus, exact Bezier form of det J ------------ */
+
+/* Bezier points of the cubic span of edge P0 P1 of the control polygon P_{-1..2} (p[0..3])
+ * with knot intervals d_{-2..2} (d[0..4]; d_j on edge P_j P_{j+1}): the inner points divide
+ * P0 P1 in the ratio d_{-1} : d_0 : d_1, the ends divide the neighbouring thirds d_{-1} : d_0
+ * and d_0 : d_1 (C2 knot-interval form, Sederberg et al. 1998). */
+static void span_bezier(double p[4][2], const double d[5], double b[4][2]) {
+    double s0 = d[0] + d[1] + d[2], s1 = d[1] + d[2] + d[3], s2 = d[2] + d[3] + d[4];
+    for (int k = 0; k < 2; k++) {
+        double rm = p[0][k] + (d[0] + d[1]) / s0 * (p[1][k] - p[0][k]);
+        double l0 = p[1][k] + d[1] / s1 * (p[2][k] - p[1][k]);
+        double r0 = p[1][k] + (d[1] + d[2]) / s1 * (p[2][k] - p[1][k]);
+        double l1 = p[2][k] + d[2] / s2 * (p[3][k] - p[2][k]);
+        b[0][k] = (d[2] * rm + d[1] * l0) / (d[1] + d[2]);
+        b[1][k] = l0;
+        b[2][k] = r0;
+        b[3][k] = (d[3] * r0 + d[2] * l1) / (d[2] + d[3]);
+    }
+}
+
+/* Bicubic Bezier net B[a][b] (a along i, b along j) of the limit patch of face (s, i, j). */
+static int face_patch(const char_grid *g, int s, int i, int j, double B[4][4][2]) {
+    double du[5], dv[5], P[4][2], T[4][4][2], b[4][2];
+    for (int t = 0; t < 5; t++) {
+        du[t] = edge_knot(g->q, grid_vertex(g, s, i - 2 + t, j), grid_vertex(g, s, i - 1 + t, j));
+        dv[t] = edge_knot(g->q, grid_vertex(g, s, i, j - 2 + t), grid_vertex(g, s, i, j - 1 + t));
+        if (!(du[t] > 0) || !(dv[t] > 0)) return -1;
+    }
+    for (int row = 0; row < 4; row++) { /* along i, rows j-1 .. j+2 */
+        for (int a = 0; a < 4; a++) memcpy(P[a], gp(g, s, i - 1 + a, j - 1 + row), sizeof P[a]);
+        span_bezier(P, du, b);
+        for (int a = 0; a < 4; a++) memcpy(T[a][row], b[a], sizeof b[a]);
+    }
+    for (int a = 0; a < 4; a++) {
+        span_bezier(T[a], dv, b);
+        memcpy(B[a], b, sizeof b);
+    }
+    return 0;
+}
+
+/* Bernstein coefficients (bidegree 5, 5) of det J = x_u y_v - y_u x_v (up to a positive
+ * factor): x_u has bidegree (2, 3), x_v (3, 2); B^m_i B^n_j = C(m,i) C(n,j) / C(m+n,i+j) B^{m+n}_{i+j}. */
+static void jacobian_bezier(double B[4][4][2], double J[6][6]) {
+    static const double C2[3] = {1, 2, 1}, C3[4] = {1, 3, 3, 1}, C5[6] = {1, 5, 10, 10, 5, 1};
+    memset(J, 0, sizeof(double) * 36);
+    for (int a1 = 0; a1 < 3; a1++)
+        for (int b1 = 0; b1 < 4; b1++) {
+            double ux = B[a1 + 1][b1][0] - B[a1][b1][0], uy = B[a1 + 1][b1][1] - B[a1][b1][1];
+            for (int a2 = 0; a2 < 4; a2++)
+                for (int b2 = 0; b2 < 3; b2++) {
+                    double vx = B[a2][b2 + 1][0] - B[a2][b2][0], vy = B[a2][b2 + 1][1] - B[a2][b2][1];
+                    double w = C2[a1] * C3[a2] / C5[a1 + a2] * C3[b1] * C2[b2] / C5[b1 + b2];
+                    J[a1 + a2][b1 + b2] += w * (ux * vy - uy * vx);
+                }
+        }
+}
+
+/* Halves a bidegree-(5,5) Bernstein polynomial at u = 1/2 (dir 0) or v = 1/2 (dir 1). */
+static void bern_split(double J[6][6], int dir, double lo[6][6], double hi[6][6]) {
+    for (int l = 0; l < 6; l++) {
+        double c[6];
+        for (int t = 0; t < 6; t++) c[t] = dir ? J[l][t] : J[t][l];
+        for (int r = 0; r < 6; r++) {
+            double *L = dir ? &lo[l][r] : &lo[r][l], *H = dir ? &hi[l][5 - r] : &hi[5 - r][l];
+            *L = c[0];
+            *H = c[5 - r];
+            for (int t = 0; t < 5 - r; t++) c[t] = 0.5 * (c[t] + c[t + 1]);
+        }
+    }
+}
+
+/* 1: every coefficient has sign sg (det J has sign sg on the whole patch); -1: a corner value
+ * (an actual value of det J) has the wrong sign or is zero; 0: undecided after `depth` splits. */
+static int jacobian_sign(double J[6][6], int sg, int depth) {
+    const double corner[4] = {J[0][0], J[5][0], J[0][5], J[5][5]};
+    for (int k = 0; k < 4; k++)
+        if (!(sg * corner[k] > 0)) return -1;
+    int all = 1;
+    for (int a = 0; a < 6 && all; a++)
+        for (int b = 0; b < 6 && all; b++) all = sg * J[a][b] > 0;
+    if (all) return 1;
+    if (depth == 0) return 0;
+    double U0[6][6], U1[6][6], Q[4][6][6];
+    bern_split(J, 0, U0, U1);
+    bern_split(U0, 1, Q[0], Q[1]);
+    bern_split(U1, 1, Q[2], Q[3]);
+    int res = 1;
+    for (int k = 0; k < 4 && res != -1; k++) {
+        int t = jacobian_sign(Q[k], sg, depth - 1);
+        res = t < res ? t : res;
+    }
+    return res;
+}
+
+/* Regularity of the limit patches of rings R..2R. */
+static int surface_patches(const char_grid *g, int R, cm_result *r) {
+    r->orient = 0;
+    for (int s = 0; s < g->n; s++)
+        for (int i = 0; i < 2 * R; i++)
+            for (int j = 0; j < 2 * R; j++) {
+                if (i < R && j < R) continue;
+                double B[4][4][2], J[6][6];
+                if (face_patch(g, s, i, j, B)) return -1;
+                jacobian_bezier(B, J);
+                if (!r->orient) r->orient = J[0][0] > 0 ? 1 : J[0][0] < 0 ? -1 : 0;
+                int t = r->orient ? jacobian_sign(J, r->orient, 6) : -1;
+                r->bad_patches += t < 0;
+                r->undecided += t == 0;
+            }
+    return 0;
+}
+
+static void bezier3(double b[4][2], double t, double out[2]) {
+    for (int k = 0; k < 2; k++) {
+        double u = 1 - t, a = b[0][k] * u + b[1][k] * t, c = b[1][k] * u + b[2][k] * t,
+               e = b[2][k] * u + b[3][k] * t;
+        a = a * u + c * t;
+        c = c * u + e * t;
+        out[k] = a * u + c * t;
+    }
+}
+
+/* The limit curve of parameter ring r, m samples per face side, in ring_polygon's order. */
+static int ring_curve(const char_grid *g, int r, int m, double *pts) {
+    int k = 0;
+    for (int s = 0; s < g->n; s++) {
+        double B[4][4][2], c[4][2];
+        for (int j = 0; j < r; j++) { /* side i = r, from j to j+1: u = 0 of face (s, r, j) */
+            if (face_patch(g, s, r, j, B)) return -1;
+            for (int b = 0; b < 4; b++) memcpy(c[b], B[0][b], sizeof c[b]);
+            for (int l = 0; l < m; l++, k++) bezier3(c, (double)l / m, pts + 2 * k);
+        }
+        for (int i = r - 1; i >= 0; i--) { /* side j = r, from i+1 to i: v = 0 of face (s, i, r) */
+            if (face_patch(g, s, i, r, B)) return -1;
+            for (int a = 0; a < 4; a++) memcpy(c[a], B[a][0], sizeof c[a]);
+            for (int l = 0; l < m; l++, k++) bezier3(c, 1.0 - (double)l / m, pts + 2 * k);
+        }
+    }
+    return 0;
+}
+
+#define EXP_CURVE_SAMPLES 8
+
+static int surface_check(const char_grid *g, int R, cm_result *r) {
+    if (surface_patches(g, R, r)) return -1;
+    r->regular = r->bad_patches == 0 && r->undecided == 0 && r->orient != 0;
+    int m1 = 2 * R * g->n * EXP_CURVE_SAMPLES, m2 = 2 * m1;
+    double *pts = malloc(sizeof(double) * 2 * (size_t)(m1 + m2));
+    if (!pts) return -1;
+    int rc = ring_curve(g, R, EXP_CURVE_SAMPLES, pts) || ring_curve(g, 2 * R, EXP_CURVE_SAMPLES, pts + 2 * m1);
+    if (!rc)
+        r->injective = r->regular && rings_injective(pts, m1, m2, r->orient, &r->wind_in,
+                                                     &r->wind_out, &r->crossings);
+    free(pts);
+    return rc ? -1 : 0;
+}
+
+/* The grid of G rings around the EV of mesh m, and `check` on it. */
+static ccn_status grid_check(const ccn_mesh *m, int n, int32_t ev, int32_t s0, int G, int R,
+                             int (*check)(const char_grid *, int, cm_result *), cm_result *r,
+                             ccn_error *err) {
+    quad_mesh q = {0};
+    ccn_status st = CCN_OK;
+    int32_t *idx = malloc(sizeof(int32_t) * (size_t)(1 + n * G * (G + 1)));
+    if (!idx || quad_load_knots(m, &q)) st = fail_memory(err);
+    if (!st && ring_grid(&q, ev, s0, n, G, idx)) {
+        err->status = st = CCN_ERR_INTERNAL;
+        snprintf(err->message, sizeof err->message, "characteristic net is not a quad grid");
+    }
+    char_grid g = {n, G, idx, &q};
+    if (!st && check(&g, R, r)) {
+        err->status = st = CCN_ERR_INTERNAL;
+        snprintf(err->message, sizeof err->message, "characteristic ring check failed");
+    }
+    quad_free(&q);
+    free(idx);
+    return st;
+}
+
+#define EXP_SURFACE_LEVEL 2 /* the limit-surface test uses rings 2..4 of level 2 */
+
+/* Places the characteristic net (x, y, 0) on L1's 3-ring and refines it k levels. After level l
+ * rings <= 2^(l+1) + 1 depend on the 3-ring only. Level 2: the limit patches of rings R = 2 to
+ * 2R (control points up to ring 2R + 2 = 6 <= 9); level k: the control-net quads of rings
+ * R = 2^(k-1) to 2R. */
 static ccn_status cm_charring(cm_ctx *c, int k, const double *x, const double *y, cm_result *r,
                               ccn_error *err) {
     ccn_mesh_info in;
@@ -918,24 +1215,16 @@ static ccn_status cm_charring(cm_ctx *c, int k, const double *x, const double *y
     free(pos);
     ccn_mesh *cur = NULL, *next = NULL;
     int32_t ev = c->ev1, s0 = c->s01;
-    for (int l = 0; l < k && !st; l++) {
+    for (int l = 1; l <= k && !st; l++) {
         next = NULL;
-        st = track_refine(l ? cur : c->L1, c->scheme, &ev, &s0, &next, err);
+        st = track_refine(l > 1 ? cur : c->L1, c->scheme, &ev, &s0, &next, err);
         ccn_mesh_destroy(cur);
         cur = next;
+        if (!st && l == EXP_SURFACE_LEVEL)
+            st = grid_check(cur, c->n, ev, s0, 7, 2, surface_check, r, err);
+        if (!st && l == k)
+            st = grid_check(cur, c->n, ev, s0, 1 << k, 1 << (k - 1), net_check, r, err);
     }
-    int R = 1 << (k - 1), G = 2 * R;
-    quad_mesh q = {0};
-    int32_t *idx = malloc(sizeof(int32_t) * (size_t)(1 + c->n * G * (G + 1)));
-    if (!st && (!idx || quad_load(cur, &q))) st = fail_memory(err);
-    if (!st && ring_grid(&q, ev, s0, c->n, G, idx)) {
-        err->status = st = CCN_ERR_INTERNAL;
-        snprintf(err->message, sizeof err->message, "characteristic net is not a quad grid");
-    }
-    char_grid g = {c->n, G, idx, q.pos};
-    if (!st && annulus_check(&g, R, r)) st = fail_memory(err);
-    quad_free(&q);
-    free(idx);
     ccn_mesh_destroy(cur);
     return st;
 }
@@ -972,7 +1261,7 @@ static void run_case(exp_run *run, long i) {
     const fan_cage *c = &run->cages[valence_slot(a, n)];
     ccn_error err;
     ccn_status st;
-    if (a->kind == EXP_MAXIMA) st = maxima_case(c, d, a->scheme, a->levels, a->start, NULL, &run->mres[i], &err);
+    if (a->kind == EXP_MAXIMA) st = maxima_case(c, d, a, NULL, &run->mres[i], &err);
     else st = charmap_case(c, d, a->scheme, a->charlevels, &run->cres[i], &err);
     run->status[i] = (unsigned char)st;
 }
@@ -1022,24 +1311,16 @@ static void print_header(const exp_args *a, const char *what) {
     } else {
         printf(", dist %s [%g, 1], valences", a->dist_log ? "loguniform" : "uniform", a->lo);
         for (int i = 0; i < a->nval; i++) printf("%s%d", i ? "," : " ", a->val[i]);
-        printf(", seed %llu", (unsigned long long)a->seed);
+        printf(", seed %llu, offset %ld", (unsigned long long)a->seed, a->offset);
     }
     printf(", threads %d\n", a->threads);
 }
 
-/* Per-level maxima of one failing case (--persist L2): "levels 1..L2: 1 1 2 ...". */
-static void print_persist(const exp_run *run, long i) {
-    const exp_args *a = run->a;
-    double d[EXP_MAX_N];
-    int n = case_setup(a, i, d), per[16];
-    max_result r;
-    ccn_error err;
-    if (maxima_case(&run->cages[valence_slot(a, n)], d, a->scheme, a->persist, a->start, per, &r, &err)) {
-        printf(" [levels: error]");
-        return;
-    }
-    printf(" [levels 1..%d:", a->persist);
-    for (int l = 0; l < a->persist; l++) printf(" %d", per[l]);
+/* " [levels L+1..P: 1 1 2]" for a failing case followed by --persist. */
+static void print_later(const exp_args *a, const max_result *r) {
+    if (!r->nlater) return;
+    printf(" [levels %d..%d:", a->levels + 1, a->levels + r->nlater);
+    for (int l = 0; l < r->nlater; l++) printf(" %d", r->later[l]);
     printf("]");
 }
 
@@ -1047,67 +1328,92 @@ static void print_error_case(const exp_run *run, long i) {
     const exp_args *a = run->a;
     double d[EXP_MAX_N];
     int n = case_setup(a, i, d);
-    printf("error case %ld valence %d intervals ", i, n);
+    printf("error case %ld valence %d intervals ", a->offset + i, n);
     print_intervals(d, n);
     printf(": %s\n", ccn_status_name((ccn_status)run->status[i]));
 }
 
-static long maxima_report(const exp_run *run) {
+typedef struct {
+    long single, fail, persistent, errors, fb_cases, fb_total, nonfinite;
+    long vfail[EXP_MAX_VALS], vcases[EXP_MAX_VALS];
+} max_totals;
+
+static void maxima_fail_line(const exp_run *run, long i) {
+    const max_result *r = &run->mres[i];
+    double d[EXP_MAX_N];
+    int n = case_setup(run->a, i, d);
+    printf("fail case %ld valence %d maxima %d intervals ", run->a->offset + i, n, r->maxima);
+    print_intervals(d, n);
+    print_later(run->a, r);
+    printf("\n");
+}
+
+/* Tallies the cases and lists the first --list failures. */
+static void maxima_tally(const exp_run *run, max_totals *t) {
     const exp_args *a = run->a;
-    long single = 0, fail = 0, errors = 0, fb_cases = 0, fb_total = 0, nonfin = 0, listed = 0;
-    long vfail[EXP_MAX_VALS] = {0}, vcases[EXP_MAX_VALS] = {0};
+    memset(t, 0, sizeof *t);
     for (long i = 0; i < a->cases; i++) {
         const max_result *r = &run->mres[i];
-        if (run->status[i]) { errors++; continue; }
-        int slot = (int)(a->nknots ? 0 : i % a->nval);
-        vcases[slot]++;
-        fb_cases += r->fallbacks > 0;
-        fb_total += r->fallbacks;
-        nonfin += r->nonfinite > 0;
-        if (r->maxima == 1 && !r->nonfinite) { single++; continue; }
-        fail++;
-        vfail[slot]++;
-        if (listed++ >= a->list) continue;
-        double d[EXP_MAX_N];
-        int n = case_setup(a, i, d);
-        printf("fail case %ld valence %d maxima %d intervals ", i, n, r->maxima);
-        print_intervals(d, n);
-        if (a->persist) print_persist(run, i);
-        printf("\n");
+        if (run->status[i]) { t->errors++; continue; }
+        int slot = (int)((a->offset + i) % a->nval);
+        t->vcases[slot]++;
+        t->fb_cases += r->fallbacks > 0;
+        t->fb_total += r->fallbacks;
+        t->nonfinite += r->nonfinite > 0;
+        if (r->maxima == 1 && !r->nonfinite) { t->single++; continue; }
+        t->vfail[slot]++;
+        t->persistent += r->nonfinite || !r->nlater || r->later[r->nlater - 1] != 1;
+        if (t->fail++ < a->list) maxima_fail_line(run, i);
     }
-    if (listed > a->list) printf("(%ld more failures not listed)\n", listed - a->list);
+    if (t->fail > a->list) printf("(%ld more failures not listed)\n", t->fail - a->list);
     for (long i = 0, shown = 0; i < a->cases && shown < a->list; i++)
         if (run->status[i]) { print_error_case(run, i); shown++; }
+}
+
+static long maxima_report(const exp_run *run) {
+    const exp_args *a = run->a;
+    max_totals t;
+    maxima_tally(run, &t);
+    double pc = 100.0 / (double)a->cases;
     printf("cases: %ld\n", a->cases);
-    printf("single maximum: %ld (%.4f%%)\n", single, 100.0 * (double)single / (double)a->cases);
-    printf("failures: %ld\n", fail);
-    if (!a->nknots) {
-        printf("failures by valence:");
-        for (int v = 0; v < a->nval; v++) printf(" %d:%ld/%ld", a->val[v], vfail[v], vcases[v]);
-        printf("\n");
-    }
-    printf("non-finite: %ld\n", nonfin);
-    printf("fallbacks: %ld cases (%ld EV matrices)\n", fb_cases, fb_total);
-    printf("errors: %ld\n", errors);
-    return errors;
+    printf("single maximum: %ld (%.4f%%)\n", t.single, pc * (double)t.single);
+    printf("failures: %ld\n", t.fail);
+    printf("failures by valence:");
+    for (int v = 0; v < a->nval; v++) printf(" %d:%ld/%ld", a->val[v], t.vfail[v], t.vcases[v]);
+    printf("\n");
+    if (a->persist > a->levels)
+        printf("persistent (!= 1 maximum also at level %d): %ld; single maximum at level %d or "
+               "by level %d: %ld (%.4f%%)\n", a->persist, t.persistent, a->levels, a->persist,
+               a->cases - t.errors - t.persistent, pc * (double)(a->cases - t.errors - t.persistent));
+    printf("non-finite: %ld\n", t.nonfinite);
+    printf("fallbacks: %ld cases (%ld EV matrices)\n", t.fb_cases, t.fb_total);
+    printf("errors: %ld\n", t.errors);
+    return t.errors;
+}
+
+static int cm_pass(const cm_result *r) {
+    return r->spectrum && r->regular && r->injective && r->matrix_ok;
 }
 
 static void cm_fail_line(const exp_run *run, long i, const char *tag) {
     const cm_result *r = &run->cres[i];
     double d[EXP_MAX_N];
     int n = case_setup(run->a, i, d);
-    printf("%s case %ld valence %d%s%s%s%s intervals ", tag, i, n, r->spectrum ? "" : " spectrum",
-           r->regular ? "" : " regularity", r->injective ? "" : " injectivity",
-           r->matrix_ok ? "" : " matrix");
+    printf("%s case %ld valence %d%s%s%s%s%s intervals ", tag, run->a->offset + i, n,
+           r->spectrum ? "" : " spectrum", r->regular ? "" : " regularity",
+           r->injective ? "" : " injectivity", r->matrix_ok ? "" : " matrix",
+           r->net_regular && r->net_injective ? "" : " (net)");
     print_intervals(d, n);
-    printf(" |mu|=%.6g,%.6g,%.6g,%.6g split %.2g im %.2g |mu4|/|mu2| %.6g bad_quads %d "
-           "crossings %d winding %d,%d%s fallbacks %d\n", r->mod[0], r->mod[1], r->mod[2],
-           r->mod[3], r->split, r->im2, r->ratio, r->bad_quads, r->crossings, r->wind_in,
-           r->wind_out, r->defective ? " defective" : "", r->fallbacks);
+    printf(" |mu|=%.6g,%.6g,%.6g,%.6g split %.2g im %.2g |mu4|/|mu2| %.6g%s fallbacks %d;"
+           " surface: bad patches %d undecided %d crossings %d winding %d,%d;"
+           " net: bad quads %d%s\n", r->mod[0], r->mod[1], r->mod[2], r->mod[3], r->split,
+           r->im2, r->ratio, r->defective ? " defective" : "", r->fallbacks, r->bad_patches,
+           r->undecided, r->crossings, r->wind_in, r->wind_out, r->net_bad_quads,
+           r->net_injective ? "" : " not injective");
 }
 
 typedef struct {
-    long spectrum, regular, injective, matrix, all, fb_cases, errors;
+    long spectrum, regular, injective, net_regular, net_injective, matrix, all, fb_cases, errors;
     double worst_ratio, worst_split, worst_lam, worst_rowsum, worst_m;
 } cm_totals;
 
@@ -1119,8 +1425,10 @@ static void cm_accumulate(const exp_run *run, cm_totals *t) {
         t->spectrum += r->spectrum;
         t->regular += r->regular;
         t->injective += r->injective;
+        t->net_regular += r->net_regular;
+        t->net_injective += r->net_injective;
         t->matrix += r->matrix_ok;
-        t->all += r->spectrum && r->regular && r->injective && r->matrix_ok;
+        t->all += cm_pass(r);
         t->fb_cases += r->fallbacks > 0;
         t->worst_ratio = fmax(t->worst_ratio, r->ratio);
         t->worst_split = fmax(t->worst_split, r->split);
@@ -1130,18 +1438,20 @@ static void cm_accumulate(const exp_run *run, cm_totals *t) {
     }
 }
 
-static long charmap_report(const exp_run *run) {
+static void cm_list(const exp_run *run) {
     const exp_args *a = run->a;
     long listed = 0;
-    for (long i = 0; i < a->cases; i++) {
-        const cm_result *r = &run->cres[i];
-        if (run->status[i] || (r->spectrum && r->regular && r->injective && r->matrix_ok)) continue;
-        if (listed++ < a->list) cm_fail_line(run, i, "fail");
-    }
+    for (long i = 0; i < a->cases; i++)
+        if (!run->status[i] && (!cm_pass(&run->cres[i]) || a->nknots))
+            if (listed++ < a->list) cm_fail_line(run, i, cm_pass(&run->cres[i]) ? "pass" : "fail");
     if (listed > a->list) printf("(%ld more failures not listed)\n", listed - a->list);
     for (long i = 0, shown = 0; i < a->cases && shown < a->list; i++)
         if (run->status[i]) { print_error_case(run, i); shown++; }
-    if (a->nknots && !run->status[0]) cm_fail_line(run, 0, "details:");
+}
+
+static long charmap_report(const exp_run *run) {
+    const exp_args *a = run->a;
+    cm_list(run);
     cm_totals t;
     cm_accumulate(run, &t);
     printf("cases: %ld\n", a->cases);
@@ -1149,8 +1459,12 @@ static long charmap_report(const exp_run *run) {
            t.matrix, t.worst_rowsum, t.worst_m);
     printf("spectrum ok: %ld (max |mu2-mu3|/|mu2| %.3g, max |mu4|/|mu2| %.6g, "
            "max |mu2,3 - lambda_n| %.3g)\n", t.spectrum, t.worst_split, t.worst_ratio, t.worst_lam);
-    printf("regular: %ld\n", t.regular);
+    printf("regular: %ld (limit surface: Bezier coefficients of det J, rings 2..4 of level 2)\n",
+           t.regular);
     printf("injective: %ld\n", t.injective);
+    printf("net regular: %ld (control-net quads, rings %d..%d of level %d)\n", t.net_regular,
+           1 << (a->charlevels - 1), 1 << a->charlevels, a->charlevels);
+    printf("net injective: %ld\n", t.net_injective);
     printf("all pass: %ld\n", t.all);
     printf("failures: %ld\n", a->cases - t.errors - t.all);
     printf("fallbacks: %ld cases\n", t.fb_cases);
@@ -1162,12 +1476,13 @@ static long charmap_report(const exp_run *run) {
 static int maxima_knots(const exp_run *run) {
     const exp_args *a = run->a;
     int per[16];
-    max_result r;
+    max_result r = {.show = 1};
     ccn_error err;
-    if (maxima_case(&run->cages[0], a->knots, a->scheme, a->levels, a->start, per, &r, &err))
+    if (maxima_case(&run->cages[0], a->knots, a, per, &r, &err))
         return ccn_cli_error("experiment", &err);
     printf("maxima per level 1..%d:", a->levels);
     for (int l = 0; l < a->levels; l++) printf(" %d", per[l]);
+    print_later(a, &r);
     printf("\nlevel %d: support %d vertices, sum z %.12g, max z %.15g, fallbacks %d\n", a->levels,
            (int)r.support, r.zsum, r.zmax, r.fallbacks);
     printf("cases: 1\nsingle maximum: %d\nfailures: %d\n", r.maxima == 1, r.maxima != 1);

@@ -1,0 +1,192 @@
+/* libFuzzer harness: bytes -> a cage (fuzz_cage.h) and options (including out-of-range
+ * scheme, cap, levels and corners) -> ccn_plan_create + ccn_plan_sizes + ccn_plan_evaluate
+ * (cage positions, then positions from the input, then with optional outputs left NULL).
+ * Checks: statuses in range, messages NUL-terminated, invalid options and cages rejected,
+ * sizes consistent, every position and normal finite (normals of unit length), indices in
+ * range, topology outputs identical between calls; ccn_plan_patches: degree 3 or 5, finite
+ * control points, cage face in range. Output buffers are allocated at exactly
+ * the sizes ccn_plan_sizes gives, so ASan catches any write past them.
+ * Input: byte 0 flags (as fuzz_mesh.c), the cage, then scheme, cap, levels, corners,
+ * threads bytes, then positions for the second evaluation. Built only once the library
+ * defines ccn_plan_evaluate (tests/fuzz/fuzz.mk). */
+#include "fuzz_cage.h"
+
+static void check_outputs(const ccn_sizes *z, const ccn_limit_mesh *out, int32_t cage_faces) {
+    fz_check_finite(out->positions, 3 * (size_t)z->num_verts, "limit position");
+    if (out->normals) {
+        fz_check_finite(out->normals, 3 * (size_t)z->num_verts, "limit normal");
+        for (int32_t v = 0; v < z->num_verts; v++) {
+            const double *n = out->normals + 3 * (size_t)v;
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            FZ_CHECK(fabs(len - 1.0) <= 1e-6, "normal %d has length %.17g", v, len);
+        }
+    }
+    if (out->face_verts)
+        for (int64_t i = 0; i < 4 * (int64_t)z->num_faces; i++)
+            FZ_CHECK(out->face_verts[i] >= 0 && out->face_verts[i] < z->num_verts,
+                     "face vertex %d out of [0, %d)", out->face_verts[i], z->num_verts);
+    if (out->face_origin)
+        for (int32_t f = 0; f < z->num_faces; f++)
+            FZ_CHECK(out->face_origin[f] >= 0 && out->face_origin[f] < cage_faces,
+                     "face origin %d out of [0, %d)", out->face_origin[f], cage_faces);
+}
+
+typedef struct { int32_t cage_faces, count, strict; } patch_ctx;
+
+static void on_patch(void *user, int32_t degree, const double *points, int32_t cage_face) {
+    patch_ctx *c = user;
+    FZ_CHECK(degree == 3 || degree == 5, "patch degree %d", degree);
+    FZ_CHECK(cage_face >= 0 && cage_face < c->cage_faces, "patch cage face %d of %d", cage_face,
+             c->cage_faces);
+    if (c->strict) /* KB2b */
+        fz_check_finite(points, 3 * (size_t)(degree + 1) * (size_t)(degree + 1), "patch point");
+    c->count++;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    rd r = {data, size, 0};
+    static soup s;
+    uint8_t flags = next(&r);
+    fz_fan_max = 40; /* valence 3..40: both sides of the cap's valence limit, fast enough */
+    fz_make_cage(&r, &s, flags);
+    ccn_cage c = {0};
+    c.num_verts = s.nv; c.num_faces = s.nf; c.num_edges = s.ne;
+    c.positions = s.pos; c.face_sizes = s.fs; c.face_verts = s.fv;
+    c.edge_verts = s.ne ? s.ev : NULL;
+    c.edge_knots = s.ne ? s.kn : NULL;
+    if ((flags & 16) && s.ne) c.edge_verts = NULL;
+
+    ccn_options o = {0};
+    o.scheme = (ccn_scheme)(next(&r) % 4);     /* 3: invalid */
+    o.cap = (ccn_cap)(next(&r) % 3);           /* 2: invalid */
+    uint8_t lb = next(&r);
+    o.levels = lb == 255 ? 1000 : lb == 254 ? INT32_MIN : (int32_t)(lb % 5) - 1; /* -1..3 */
+    o.boundary_corners = next(&r) % 3;         /* 2: invalid */
+    o.threads = next(&r) % 3;
+    int opts_bad = o.scheme > CCN_SCHEME_CATMULL_CLARK || o.cap > CCN_CAP_REFINE ||
+                   o.levels < 0 || o.boundary_corners > CCN_CORNERS_PINNED;
+    int levels_huge = o.levels == 1000; /* must be refused: CCN_ERR_ARGUMENT or _MEMORY */
+
+    /* Is the cage itself valid? (the plan must accept exactly the cages ccn_mesh_create does) */
+    ccn_mesh *m = NULL;
+    ccn_status mst = fz_create_check(&c, &m);
+    double maxabs = 0;
+    int interior_v2 = 0;
+    if (mst == CCN_OK) fz_mesh_facts(m, &maxabs, &interior_v2);
+    int strict = fz_known_bugs() || maxabs <= FZ_HUGE; /* KB2b */
+    ccn_mesh_destroy(m);
+
+    ccn_error e;
+    fz_err_init(&e);
+    ccn_plan *plan = (ccn_plan *)&e;
+    ccn_status st = ccn_plan_create(&c, &o, &plan, &e);
+    fz_check_status(st, &e, "ccn_plan_create");
+    if (st != CCN_OK) {
+        FZ_CHECK(plan == NULL, "plan_create failed but returned a plan");
+        int kb1 = !fz_known_bugs() && interior_v2 && st == CCN_ERR_ARGUMENT &&
+                  (strstr(e.message, "refinement matrix failed") ||
+                   strstr(e.message, "valence 2 outside"));
+        FZ_CHECK(opts_bad || levels_huge || mst != CCN_OK || st == CCN_ERR_MEMORY || kb1,
+                 "valid cage and options rejected: %d %s", (int)st, e.message);
+        return 0;
+    }
+    FZ_CHECK(plan != NULL, "plan_create OK without a plan");
+    FZ_CHECK(!opts_bad && !levels_huge, "invalid options accepted (scheme %d cap %d levels %d corners %d)",
+             (int)o.scheme, (int)o.cap, (int)o.levels, (int)o.boundary_corners);
+    FZ_CHECK(mst == CCN_OK, "a cage ccn_mesh_create rejects (%d) gave a plan", (int)mst);
+
+    ccn_sizes z;
+    memset(&z, 0x5A, sizeof z);
+    FZ_CHECK(ccn_plan_sizes(plan, &z) == CCN_OK, "ccn_plan_sizes");
+    FZ_CHECK(z.num_cage_verts == c.num_verts, "num_cage_verts %d, cage %d", z.num_cage_verts,
+             c.num_verts);
+    FZ_CHECK(z.num_verts > 0 && z.num_faces > 0, "sizes %d %d", z.num_verts, z.num_faces);
+    FZ_CHECK(z.levels == o.levels || (o.levels == 0 && z.levels == 1), "levels %d for %d",
+             z.levels, o.levels);
+    FZ_CHECK(z.refine_levels >= 0 && z.num_extraordinary >= 0 && z.num_caps >= 0 &&
+                 z.num_cap_fallbacks >= 0 && z.num_ev_fallbacks >= 0 &&
+                 z.num_ring_conflicts >= 0 && z.num_ignored_verts >= 0 &&
+                 z.num_ignored_edges >= 0,
+             "negative counts in ccn_sizes");
+    if (z.num_verts > 2000000 || z.num_faces > 2000000) { ccn_plan_destroy(plan); return 0; }
+
+    size_t nv3 = 3 * (size_t)z.num_verts, nf4 = 4 * (size_t)z.num_faces;
+    double *pos = malloc(sizeof(double) * nv3), *nrm = malloc(sizeof(double) * nv3);
+    int32_t *fv = malloc(sizeof(int32_t) * nf4), *fo = malloc(sizeof(int32_t) * z.num_faces);
+    int32_t *fv2 = malloc(sizeof(int32_t) * nf4), *fo2 = malloc(sizeof(int32_t) * z.num_faces);
+    FZ_CHECK(pos && nrm && fv && fo && fv2 && fo2, "harness out of memory");
+
+    /* 1: the cage's own positions, every output */
+    ccn_limit_mesh out = {pos, nrm, fv, fo};
+    fz_err_init(&e);
+    st = ccn_plan_evaluate(plan, NULL, &out, &e);
+    fz_check_status(st, &e, "ccn_plan_evaluate");
+    FZ_CHECK(st == CCN_OK || st == CCN_ERR_MEMORY, "evaluate failed: %d %s", (int)st, e.message);
+    if (st == CCN_OK && strict) check_outputs(&z, &out, c.num_faces);
+    double *pos1 = malloc(sizeof(double) * nv3);
+    FZ_CHECK(pos1 != NULL, "harness out of memory");
+    memcpy(pos1, pos, sizeof(double) * nv3);
+    if (st == CCN_OK) {
+        patch_ctx pc = {c.num_faces, 0, strict};
+        int32_t skipped = -1;
+        ccn_status pst = ccn_plan_patches(plan, on_patch, &pc, &skipped);
+        FZ_CHECK(pst == CCN_OK, "ccn_plan_patches: %d", (int)pst);
+        FZ_CHECK(skipped >= 0, "skipped %d", skipped);
+    }
+
+    /* 2: positions from the input (non-finite ones must be rejected), normals left NULL */
+    double *p2 = malloc(sizeof(double) * 3 * (size_t)(c.num_verts + 1));
+    FZ_CHECK(p2 != NULL, "harness out of memory");
+    int bad = 0;
+    for (int32_t k = 0; k < 3 * c.num_verts; k++) {
+        uint8_t b = next(&r);
+        p2[k] = b < 24 ? fz_special(b) : c.positions[k] + ((double)b - 140.0) / 64.0;
+        bad |= !isfinite(p2[k]) || fabs(p2[k]) > FZ_HUGE; /* rejected beyond 1e300 */
+    }
+    double maxabs2 = 0;
+    for (int32_t k = 0; k < 3 * c.num_verts; k++) maxabs2 = fmax(maxabs2, fabs(p2[k]));
+    int strict2 = fz_known_bugs() || maxabs2 <= FZ_HUGE; /* KB2b */
+    ccn_limit_mesh out2 = {pos, NULL, fv2, fo2};
+    fz_err_init(&e);
+    ccn_status st2 = ccn_plan_evaluate(plan, p2, &out2, &e);
+    fz_check_status(st2, &e, "ccn_plan_evaluate(positions)");
+    if (bad) FZ_CHECK(st2 == CCN_ERR_ARGUMENT, "non-finite positions gave %d", (int)st2);
+    else FZ_CHECK(st2 == CCN_OK || st2 == CCN_ERR_MEMORY, "evaluate(positions): %d %s",
+                  (int)st2, e.message);
+    if (st2 == CCN_OK) {
+        if (strict2) check_outputs(&z, &out2, c.num_faces);
+        if (st == CCN_OK) {
+            FZ_CHECK(memcmp(fv, fv2, sizeof(int32_t) * nf4) == 0, "face_verts changed");
+            FZ_CHECK(memcmp(fo, fo2, sizeof(int32_t) * z.num_faces) == 0, "face_origin changed");
+        }
+    }
+
+    /* 3: NULL positions again ("the cage's own positions"), positions output only; then a
+     * NULL positions buffer must be an argument error. KB3: the library reuses the positions
+     * of the previous call instead (KB3, fixed: strict). */
+    double *pos3 = malloc(sizeof(double) * nv3);
+    FZ_CHECK(pos3 != NULL, "harness out of memory");
+    ccn_limit_mesh out3 = {pos3, NULL, NULL, NULL};
+    fz_err_init(&e);
+    ccn_status st3 = ccn_plan_evaluate(plan, NULL, &out3, &e);
+    fz_check_status(st3, &e, "ccn_plan_evaluate(positions only)");
+    int strict3 = fz_known_bugs() || st2 != CCN_OK ? strict : strict2; /* KB3 */
+    if (st3 == CCN_OK && strict3) check_outputs(&z, &out3, c.num_faces);
+    if (st3 == CCN_OK && st == CCN_OK && fz_known_bugs() && strict)
+        FZ_CHECK(memcmp(pos1, pos3, sizeof(double) * nv3) == 0,
+                 "KB3: evaluate(NULL) after evaluate(positions) does not use the cage's own");
+    free(pos3);
+    ccn_limit_mesh out4 = {NULL, nrm, NULL, NULL};
+    fz_err_init(&e);
+    st = ccn_plan_evaluate(plan, NULL, &out4, &e);
+    fz_check_status(st, &e, "ccn_plan_evaluate(NULL positions)");
+    FZ_CHECK(st == CCN_ERR_ARGUMENT, "NULL out->positions gave %d", (int)st);
+    fz_err_init(&e);
+    st = ccn_plan_evaluate(plan, NULL, NULL, &e);
+    fz_check_status(st, &e, "ccn_plan_evaluate(NULL out)");
+    FZ_CHECK(st == CCN_ERR_ARGUMENT, "NULL out gave %d", (int)st);
+
+    free(p2); free(pos1); free(pos); free(nrm); free(fv); free(fo); free(fv2); free(fo2);
+    ccn_plan_destroy(plan);
+    return 0;
+}
