@@ -40,21 +40,39 @@ int ccn_cli_error(const char *what, const ccn_error *err) {
     return 2;
 }
 
-int ccn_cli_load_mesh(const char *path, ccn_mesh **out) {
+/* Parses an OBJ file; on success *obj holds the data viewed by *cage. */
+static int load_cage(const char *path, ccn_obj **obj, ccn_cage *cage) {
     size_t len = 0;
     char *text = ccn_cli_read_file(path, &len);
     if (!text) return 2;
-    ccn_obj *obj = NULL;
     ccn_error err;
-    ccn_status st = ccn_obj_parse(text, len, &obj, &err);
+    ccn_status st = ccn_obj_parse(text, len, obj, &err);
     free(text);
     if (st) return ccn_cli_error(path, &err);
-    ccn_cage cage;
-    ccn_obj_cage(obj, &cage);
-    st = ccn_mesh_create(&cage, out, &err);
-    ccn_obj_destroy(obj);
-    if (st) return ccn_cli_error(path, &err);
+    ccn_obj_cage(*obj, cage);
     return 0;
+}
+
+int ccn_cli_load_mesh(const char *path, ccn_mesh **out) {
+    ccn_obj *obj = NULL;
+    ccn_cage cage;
+    int rc = load_cage(path, &obj, &cage);
+    if (rc) return rc;
+    ccn_error err;
+    ccn_status st = ccn_mesh_create(&cage, out, &err);
+    ccn_obj_destroy(obj);
+    return st ? ccn_cli_error(path, &err) : 0;
+}
+
+int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan) {
+    ccn_obj *obj = NULL;
+    ccn_cage cage;
+    int rc = load_cage(path, &obj, &cage);
+    if (rc) return rc;
+    ccn_error err;
+    ccn_status st = ccn_plan_create(&cage, o, plan, &err);
+    ccn_obj_destroy(obj);
+    return st ? ccn_cli_error(path, &err) : 0;
 }
 
 static int write_body(FILE *f, const ccn_mesh *m, const char *header) {

@@ -37,23 +37,6 @@ static int parse_limit_args(int argc, char **argv, ccn_options *o, const char **
     return 0;
 }
 
-/* Loads an OBJ into a plan. */
-int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan) {
-    size_t len = 0;
-    char *text = ccn_cli_read_file(path, &len);
-    if (!text) return 2;
-    ccn_obj *obj = NULL;
-    ccn_error err;
-    ccn_status st = ccn_obj_parse(text, len, &obj, &err);
-    free(text);
-    if (st) return ccn_cli_error(path, &err);
-    ccn_cage cage;
-    ccn_obj_cage(obj, &cage);
-    st = ccn_plan_create(&cage, o, plan, &err);
-    ccn_obj_destroy(obj);
-    return st ? ccn_cli_error(path, &err) : 0;
-}
-
 static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm) {
     fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
                "%d EV fallbacks, %d ring conflicts\n", (int)s->levels, (int)s->num_verts,

@@ -171,18 +171,6 @@ static void test_random_fans(void) {
     report("200 random fans", &st);
 }
 
-static char *slurp(const char *path, size_t *len) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-    fclose(f);
-    if (b) { b[n] = 0; *len = (size_t)n; }
-    return b;
-}
 
 static void test_shipped_cages(void) {
     const char *names[] = {"cube.obj", "icosa_quad.obj", "pole12.obj", "pentaprism.obj", "jitter_sphere.obj", "flip35.obj", "ngon_prism.obj"};
@@ -191,7 +179,7 @@ static void test_shipped_cages(void) {
         char path[128];
         snprintf(path, sizeof path, "tests/data/%s", names[i]);
         size_t len;
-        char *t = slurp(path, &len);
+        char *t = tl_slurp(path, &len);
         ccn_obj *o = NULL;
         ccn_error err;
         if (!t || ccn_obj_parse(t, len, &o, &err)) { CHECK(0, "load %s", names[i]); free(t); continue; }

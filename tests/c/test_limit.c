@@ -6,24 +6,12 @@
 
 typedef struct { int32_t nv, nf; double *pos, *nrm; int32_t *fv, *origin; ccn_sizes s; } limit_mesh;
 
-static char *slurp(const char *path, size_t *len) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-    fclose(f);
-    if (b) { b[n] = 0; *len = (size_t)n; }
-    return b;
-}
 
 static ccn_obj *load(const char *name, ccn_cage *cage) {
     char path[256];
     snprintf(path, sizeof path, "tests/data/%s", name);
     size_t len = 0;
-    char *t = slurp(path, &len);
+    char *t = tl_slurp(path, &len);
     ccn_obj *o = NULL;
     ccn_error err;
     if (!t || ccn_obj_parse(t, len, &o, &err)) { free(t); return NULL; }
