@@ -362,8 +362,11 @@ void ccn__normalize(ccn_mesh *m, double centre[3], double *scale) {
         for (int k = 0; k < 3; k++) big = fmax(big, fabs(m->pos[3 * (size_t)v + k]));
     }
     centre[0] = centre[1] = centre[2] = 0;
-    *scale = big > 0 && isfinite(big) ? ldexp(1.0, ilogb(big) + 1) : 1.0;
-    double inv = 1.0 / *scale; /* a power of two: exact */
+    int e = big > 0 && isfinite(big) ? ilogb(big) + 1 : 0;
+    if (e < -1000) e = -1000; /* subnormal input: 2^-e must stay finite */
+    if (e > 1000) e = 1000;
+    *scale = ldexp(1.0, e);
+    double inv = ldexp(1.0, -e); /* powers of two: exact */
     for (size_t i = 0; i < 3 * (size_t)m->nv; i++) m->pos[i] *= inv;
 }
 

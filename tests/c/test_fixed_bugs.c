@@ -217,7 +217,20 @@ static void kb4_far_vertex_precision(void) {
     }
 }
 
+/* KB5 (fuzz_mesh, regressions/mesh/subnormal_coordinate): a triangle whose only non-zero
+ * coordinate is subnormal (5e-320) refined to NaN: the power-of-two scale's reciprocal
+ * overflowed. The exponent is now clamped. */
+static void kb5_subnormal_coordinates(void) {
+    static const double p[9] = {5.0710897889145545e-320, 0, 0, 0, 0, 0, 0, 0, 0};
+    int32_t fs[1] = {3}, fv[3] = {0, 1, 2};
+    ccn_cage c = {0};
+    c.num_verts = 3; c.num_faces = 1; c.positions = p; c.face_sizes = fs; c.face_verts = fv;
+    accepted_means_finite(&c, CCN_OK);
+    plan_accepted_means_finite(&c, CCN_OK);
+}
+
 int main(void) {
+    RUN(kb5_subnormal_coordinates);
     RUN(kb1_interior_valence2);
     RUN(kb2b_dbl_max_overshoot);
     RUN(kb3_plan_null_positions);
