@@ -134,3 +134,38 @@ int ccn_cli_int(const char *s, int lo, int hi, int *out) {
     *out = (int)x;
     return 0;
 }
+
+/* Shared option parser of refine / limit / patches (see cli.h). */
+int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_options *o,
+                  const char **in, const char **out) {
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--scheme") == 0 && val) {
+            if (ccn_cli_scheme(val, &o->scheme)) { fprintf(stderr, "ccnurbs: bad --scheme '%s'\n", val); return 2; }
+            i++;
+        } else if ((allowed & CCN_CLI_LEVELS) && strcmp(a, "--levels") == 0 && val) {
+            if (ccn_cli_int(val, 0, max_levels, &o->levels)) {
+                fprintf(stderr, "ccnurbs: --levels must be 0..%d\n", max_levels);
+                return 2;
+            }
+            i++;
+        } else if ((allowed & CCN_CLI_CAP) && strcmp(a, "--cap") == 0 && val) {
+            if (strcmp(val, "bi5") == 0) o->cap = CCN_CAP_GUIDED_BI5;
+            else if (strcmp(val, "refine") == 0) o->cap = CCN_CAP_REFINE;
+            else { fprintf(stderr, "ccnurbs: bad --cap '%s'\n", val); return 2; }
+            i++;
+        } else if (strcmp(a, "--corners") == 0 && val) {
+            if (strcmp(val, "smooth") == 0) o->boundary_corners = CCN_CORNERS_SMOOTH;
+            else if (strcmp(val, "pinned") == 0) o->boundary_corners = CCN_CORNERS_PINNED;
+            else { fprintf(stderr, "ccnurbs: bad --corners '%s'\n", val); return 2; }
+            i++;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);
+            return 2;
+        } else if (!*in) *in = a;
+        else if (!*out) *out = a;
+        else { fprintf(stderr, "ccnurbs: too many arguments\n"); return 2; }
+    }
+    if (!*in || !*out) { fprintf(stderr, "ccnurbs %s: need an input and an output file\n", argv[0]); return 2; }
+    return 0;
+}

@@ -26,4 +26,10 @@ int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header);
 int ccn_cli_error(const char *what, const ccn_error *err);
 /* Parses a non-negative int option value; returns 0 on success. */
 int ccn_cli_int(const char *s, int lo, int hi, int *out);
+/* Options of refine / limit / patches: --scheme and --corners always, --levels (0..max_levels)
+ * and --cap when allowed; then in and out paths. Prints the problem and returns 2 on error. */
+#define CCN_CLI_LEVELS 1u
+#define CCN_CLI_CAP 2u
+int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_options *o,
+                  const char **in, const char **out);
 #endif

@@ -5,38 +5,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static int parse_limit_args(int argc, char **argv, ccn_options *o, const char **in,
-                            const char **out) {
-    o->levels = 2;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--scheme") == 0 && val) {
-            if (ccn_cli_scheme(val, &o->scheme)) { fprintf(stderr, "ccnurbs: bad --scheme '%s'\n", val); return 2; }
-            i++;
-        } else if (strcmp(a, "--levels") == 0 && val) {
-            if (ccn_cli_int(val, 0, 10, &o->levels)) { fprintf(stderr, "ccnurbs: --levels must be 0..10\n"); return 2; }
-            i++;
-        } else if (strcmp(a, "--cap") == 0 && val) {
-            if (strcmp(val, "bi5") == 0) o->cap = CCN_CAP_GUIDED_BI5;
-            else if (strcmp(val, "refine") == 0) o->cap = CCN_CAP_REFINE;
-            else { fprintf(stderr, "ccnurbs: bad --cap '%s'\n", val); return 2; }
-            i++;
-        } else if (strcmp(a, "--corners") == 0 && val) {
-            if (strcmp(val, "smooth") == 0) o->boundary_corners = CCN_CORNERS_SMOOTH;
-            else if (strcmp(val, "pinned") == 0) o->boundary_corners = CCN_CORNERS_PINNED;
-            else { fprintf(stderr, "ccnurbs: bad --corners '%s'\n", val); return 2; }
-            i++;
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);
-            return 2;
-        } else if (!*in) *in = a;
-        else if (!*out) *out = a;
-        else { fprintf(stderr, "ccnurbs: too many arguments\n"); return 2; }
-    }
-    if (!*in || !*out) { fprintf(stderr, "ccnurbs limit: need in.obj and out.obj\n"); return 2; }
-    return 0;
-}
-
 static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm) {
     fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
                "%d EV fallbacks, %d ring conflicts\n", (int)s->levels, (int)s->num_verts,
@@ -73,7 +41,8 @@ static int write_atomic(const char *path, const ccn_sizes *s, const ccn_limit_me
 int ccn_cmd_limit(int argc, char **argv) {
     ccn_options o = {0};
     const char *in = NULL, *out = NULL;
-    int rc = parse_limit_args(argc, argv, &o, &in, &out);
+    o.levels = 2;
+    int rc = ccn_cli_parse(argc, argv, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, &in, &out);
     if (rc) return rc;
     ccn_plan *plan = NULL;
     if ((rc = ccn_cli_load_plan(in, &o, &plan))) return rc;

@@ -19,22 +19,8 @@ static void put_patch(void *user, int32_t degree, const double *pts, int32_t cag
 int ccn_cmd_patches(int argc, char **argv) {
     ccn_options o = {0};
     const char *in = NULL, *out = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--scheme") == 0 && val) {
-            if (ccn_cli_scheme(val, &o.scheme)) { fprintf(stderr, "ccnurbs: bad --scheme '%s'\n", val); return 2; }
-            i++;
-        } else if (strcmp(a, "--corners") == 0 && val) {
-            o.boundary_corners = strcmp(val, "pinned") == 0 ? CCN_CORNERS_PINNED : CCN_CORNERS_SMOOTH;
-            i++;
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);
-            return 2;
-        } else if (!in) in = a;
-        else if (!out) out = a;
-        else { fprintf(stderr, "ccnurbs: too many arguments\n"); return 2; }
-    }
-    if (!in || !out) { fprintf(stderr, "ccnurbs patches: need in.obj and out.bv\n"); return 2; }
+    int rc0 = ccn_cli_parse(argc, argv, 0, 0, &o, &in, &out);
+    if (rc0) return rc0;
     ccn_plan *plan = NULL;
     int rc = ccn_cli_load_plan(in, &o, &plan);
     if (rc) return rc;
