@@ -3,9 +3,12 @@
  * Rules (DESIGN §4.2, §4.3, §6.1 of Li 2016):
  *  - quads away from extraordinary vertices: tensor-product knot insertion (bspline.c);
  *  - faces with != 4 sides (level 0 only) and interior EVs: NURSS (nurss.c);
- *  - scheme EIGEN from level 1 on: the 2n+1 "red" points of every interior EV (its vertex
- *    point, its spoke edge points, the face points of its faces) come from the matrix M of
- *    eigen.c applied to its 1-ring; if M cannot be built the EV falls back to NURSS (counted);
+ *  - scheme EIGEN: the 2n+1 "red" points of every interior EV (its vertex point, its spoke
+ *    edge points, the face points of its faces) come from the matrix M of eigen.c applied to
+ *    its 1-ring (§6.1); if M cannot be built the EV falls back to NURSS (counted). From level
+ *    1 on this holds for every EV; at level 0 only for an EV that is already what the NURSS
+ *    step would make it (quad 1-ring, no other EV on its faces, e_i = d_i); the others get
+ *    the NURSS step first (DESIGN §4.3);
  *  - scheme CATMULL_CLARK: all intervals are 1, which makes every rule above Catmull-Clark.
  *  - boundaries: the boundary is a cubic B-spline curve of the boundary polygon; valence-2
  *    corners are smooth, or fixed with CCN_CORNERS_PINNED.
@@ -196,12 +199,42 @@ static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, cc
 
 /* ---- one level ---------------------------------------------------------------------- */
 
+static int regular_interior(const ccn_mesh *m, int32_t v) {
+    return !m->vboundary[v] && ccn__valence(m, v) == 4;
+}
+
+static int same_interval(double a, double b) {
+    return fabs(a - b) <= 1e-12 * fmax(a, b);
+}
+
+/* Level 0: may EV v take M already (Li 2016 §6.1), instead of the NURSS step that exists to
+ * split non-quads, separate EVs and make e_i = d_i? Only when all of that already holds: every
+ * face of v is a quad, every other corner of those faces is an interior valence-4 vertex (so no
+ * other EV or n-gon shares a face with v), and each spoke continues beyond its end E_i with the
+ * spoke's own interval (e_i = d_i, Fig. 3/5 — what M assumes). See README "Design notes". */
+static int ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t h = m->vfan[k];
+        if (ccn__fsize(m, m->hface[h]) != 4) return 0;
+        int32_t h1 = ccn__next(m, h), h2 = ccn__next(m, h1), h3 = ccn__next(m, h2);
+        if (!regular_interior(m, m->hvert[h1]) || !regular_interior(m, m->hvert[h2]) ||
+            !regular_interior(m, m->hvert[h3]))
+            return 0;
+        int32_t t = m->htwin[h]; /* E_i -> v: the edge beyond E_i is opposite in E_i's fan */
+        int32_t e = m->vfan_start[m->hvert[t]];
+        int32_t beyond = m->hedge[m->vfan[e + (m->hfanpos[t] + 2) % 4]];
+        if (!same_interval(m->eknot[m->hedge[h]], m->eknot[beyond])) return 0;
+    }
+    return 1;
+}
+
 static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
     const ccn_mesh *m = c->m;
     c->nev = 0;
     if (!c->red) return CCN_OK;
     for (int32_t v = 0; v < m->nv; v++) {
         if (!ccn__is_ev(m, v)) continue;
+        if (m->info.level == 0 && !ev_ready_at_level0(m, v)) continue; /* NURSS step */
         if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; continue; }
         c->ev_list[c->nev++] = v;
     }
@@ -219,7 +252,7 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
     memset(c, 0, sizeof *c);
     c->m = m;
     c->pinned = pinned;
-    c->red = scheme == CCN_SCHEME_EIGEN && m->info.level >= 1;
+    c->red = scheme == CCN_SCHEME_EIGEN;
     c->threads = 1;
     c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
     c->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));

