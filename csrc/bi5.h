@@ -48,7 +48,9 @@
  *         e_{s-2}: the two bicubic hole patches (and the bi-3 patches on either side of the
  *         spoke line) disagree along the spoke; no tensor-border joins such a ring C2:
  *         ccn__bi5_apply returns CCN_ERR_KNOTS. ccn__bi5_apply_border accepts any intervals
- *         when the caller supplies a consistent tensor-border of its own surrounding ring.
+ *         when the caller supplies a consistent tensor-border of its own surrounding ring, and
+ *         ccn__bi5_apply_pieces takes the exact surround one level finer ([R13]; the plan's
+ *         path).
  *  [R9] NU rings: the NU C2-rule with r = kappa_s at every level >= 1 (SPEC §9.3); the level-0
  *       border must already satisfy it (checked in apply_border; exact for the cases above).
  *  [R10] NU cap G1 form, per separator (spoke e_{s+1} between sectors s and s+1, k = kappa_{s+1}):
@@ -68,6 +70,20 @@
  *  [R12] NU cap black squares e_3, a_2, a_3, b_2, b_3 of each separator: the solution of the 4
  *       middle equations (2..5) of [R10] closest (Euclidean) to the jet map a (e_3's reference
  *       = mean of the two sectors' jet values); kappa = 1 gives SPEC §6.3's closed form.
+ *  [R13] Arbitrary NU spoke intervals (the third case of [R8]): the level-K faces next to the
+ *       hole are not tensor patches (their 4x4 nets contain V and the interval "beyond V" differs
+ *       row by row: d_{s-2} on one side, d_{s+2} on the other), but the level-(K+1) faces next
+ *       to the level-K hole are: their nets stop one level-(K+1) ring short of V, every interval
+ *       they need is a mesh edge, and the scheme refines them by knot insertion forever, so
+ *       their bicubic patches ARE the limit surface. Each leg of the hole meets two of them
+ *       (knot at 1/2). The cap takes those pieces as its border with a first ring of speed
+ *       sigma = 1/2 so that each ring-0 patch meets exactly one piece (the corner patch two,
+ *       which agree on its corner block because the surround is C2 there), followed by the
+ *       usual rings (3/4, 7/8, 7/8; n = 3: 15/16). Ring 0 joins the surround C2 by
+ *       construction; the pieces are C2 with ratio kappa_s across each spoke (one tensor
+ *       spline), as the NU C2-rule [R9] needs. The guide's least-squares target is t_CC with
+ *       the [R8] knots, which is only an approximation of the border here (it shapes the
+ *       guide, not the joins).
  *  Numerics: tau's equality-constrained minimum by the SVD null space of the constraints
  *  (they are redundant) and Cholesky on the reduced normal equations of F_5.
  */
@@ -99,7 +115,8 @@ int32_t ccn__bi5_num_patches(const ccn__bi5 *b); /* (3*nsig+1)*n */
  * Knots [R8]: kappa_s = 1 for all s -> the uniform operator (one stencil product per
  * coordinate). kappa != 1 and d_{s+2} = d_{s-2} for all s (n = 0 mod 4) -> the non-uniform
  * construction [R8]-[R12], recomputed per call (tau^s, guide fit; ~1-30 ms). Any other
- * intervals: CCN_ERR_KNOTS (caller uses another method, or ccn__bi5_apply_border). */
+ * intervals: CCN_ERR_KNOTS (caller uses ccn__bi5_apply_pieces or ccn__bi5_apply_border).
+ * Non-uniform tau that folds (Jacobian <= 0 somewhere, extreme kappa): CCN_ERR_KNOTS. */
 ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
                           const double *center, double *patches, ccn_error *err);
 /* Any intervals, given the caller's own surrounding ring: border[s][6][6][3] is the bi-5
@@ -112,6 +129,15 @@ ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *s
  * is fitted to this border; the rings use the NU C2-rule [R9], the cap [R10]-[R12]. */
 ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const double *spoke_knots,
                                  const double *center, double *patches, ccn_error *err);
+/* Any intervals, given the exact bicubic surround one level finer (bi5.h [R13]): b's first
+ * ring must have sigma = 1/2. pieces[(s*4 + k)*36*3]: sector s's four surround pieces as full
+ * bi-5 polynomials over the hole [0,1]^2 (k = 0: across u = 1, v in [0,1/2]; 1: across u = 1,
+ * v in [1/2,1]; 2: across v = 1, u in [0,1/2]; 3: across v = 1, u in [1/2,1]). The guide is
+ * fitted to t_CC of cnet with the [R8] knots (any d: a least-squares target only); ring 0 takes
+ * its outer layers from the pieces, the other rings and the cap are [R9]-[R12]. */
+ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
+                                 const double *spoke_knots, const double *center, double *patches,
+                                 ccn_error *err);
 /* Surface at sector s, hole coordinates (u,v) in [0,1]^2 ((0,0) = EV, u along spoke s, v along
  * spoke s+1): finds the ring / patch (SPEC §1.4, rho_r = 1 - sigma_r) and returns the position
  * and the derivatives with respect to u and v. */

@@ -33,7 +33,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
     for (int32_t c = 0; c < p->ncap; c++) {
         free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
-        free(p->caps[c].knots); free(p->caps[c].patches);
+        free(p->caps[c].knots); free(p->caps[c].patches); free(p->caps[c].pieces);
     }
 #if CCN_HAVE_BI5
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
@@ -135,18 +135,48 @@ static void cap_cnet(const ccn_mesh *m, int32_t ev, int32_t n, int32_t *cnet) {
 #endif
 
 #if CCN_HAVE_BI5
-static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, ccn_error *err) {
+/* The operator for valence n: the paper's ring speeds, or (exact_surround) a first ring of
+ * speed 1/2 in front of them (bi5.h [R13]). Shared by the caps of the plan. */
+static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround, ccn_error *err) {
+    int32_t key = exact_surround ? -n : n;
     for (int32_t i = 0; i < p->nops; i++)
-        if (p->op_n[i] == n) return p->ops[i];
+        if (p->op_n[i] == key) return p->ops[i];
     static const double s5[3] = {0.75, 0.875, 0.875}, s3[1] = {15.0 / 16.0};
+    static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
+    const double *sig = exact_surround ? (n == 3 ? h3 : h5) : (n == 3 ? s3 : s5);
+    int32_t nsig = (n == 3 ? 1 : 3) + (exact_surround ? 1 : 0);
     struct ccn__bi5 **ops = realloc(p->ops, sizeof(*ops) * ((size_t)p->nops + 1));
     if (ops) p->ops = ops;
     int32_t *op_n = realloc(p->op_n, sizeof(int32_t) * ((size_t)p->nops + 1));
     if (op_n) p->op_n = op_n;
     if (!ops || !op_n) return NULL;
-    if (ccn__bi5_create(n, n == 3 ? s3 : s5, n == 3 ? 1 : 3, &p->ops[p->nops], err)) return NULL;
-    p->op_n[p->nops] = n;
+    if (ccn__bi5_create(n, sig, nsig, &p->ops[p->nops], err)) return NULL;
+    p->op_n[p->nops] = key;
     return p->ops[p->nops++];
+}
+#endif
+
+static void cap_free(ccn__cap *c) {
+    free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
+    memset(c, 0, sizeof *c);
+}
+
+#if CCN_HAVE_BI5
+/* Arbitrary NU intervals: switch cap c to the exact level-(K+1) surround (bi5.h [R13]) and
+ * check that it exists and that the construction runs; 1 on success. */
+static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *zero, ccn_error *e2) {
+    if (p->R < p->K + 1 && build_levels(p, p->K + 1, e2)) return 0;
+    const struct ccn__bi5 *op = cap_op(p, c->n, 1, e2);
+    if (!op) return 0;
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    free(c->patches);
+    c->op = op;
+    c->exact_surround = 1;
+    c->patches = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(op));
+    c->pieces = calloc(432 * (size_t)c->n, sizeof(double));
+    return c->patches && c->pieces &&
+           ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], ev, pinned, NULL) &&
+           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, zero, c->patches, e2) == CCN_OK;
 }
 #endif
 
@@ -157,7 +187,7 @@ static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
     int32_t n = ccn__valence(m, ev);
     if (n > CCN_CAP_MAX_VALENCE) return 0;
     ccn_error e2;
-    const struct ccn__bi5 *op = cap_op(p, n, &e2);
+    const struct ccn__bi5 *op = cap_op(p, n, 0, &e2);
     if (!op) return 0;
     ccn__cap *c = &p->caps[p->ncap];
     memset(c, 0, sizeof *c);
@@ -177,12 +207,14 @@ static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
         for (int32_t k = 0; k < n; k++) c->knots[k] = m->eknot[ccn__fan_edge(m, ev, k)];
         ok = ccn__ev_limit(m, ev, p->opts.scheme, s, &e2) == CCN_OK;
         for (int32_t j = 0; ok && j < 2 * n + 1; j++) c->l0[j] = s->wp[j];
-        ok = ok && ccn__bi5_apply(op, zero, c->knots, zero, c->patches, &e2) == CCN_OK;
+        ccn_status st = ok ? ccn__bi5_apply(op, zero, c->knots, zero, c->patches, &e2) : CCN_ERR_ARGUMENT;
+        if (st == CCN_ERR_KNOTS) ok = cap_use_surround(p, c, ev, zero, &e2);
+        else ok = ok && st == CCN_OK;
     }
     free(zero);
     free(s);
     if (!ok) {
-        free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches);
+        cap_free(c);
         return 0;
     }
     p->ncap++;
@@ -428,7 +460,15 @@ static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
         for (int32_t j = 0; j < nc; j++) memcpy(net + 3 * j, P + 3 * (size_t)cp->cnet[j], sizeof(double) * 3);
         for (int32_t j = 0; j < 2 * n + 1; j++)
             for (int i = 0; i < 3; i++) ctr[i] += cp->l0[j] * P[3 * (size_t)cp->ring[j] + i];
-        ccn_status st = ccn__bi5_apply(cp->op, net, cp->knots, ctr, cp->patches, err);
+        ccn_status st;
+        if (cp->exact_surround) {
+            int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+            if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
+                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
+            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, ctr, cp->patches, err);
+        } else {
+            st = ccn__bi5_apply(cp->op, net, cp->knots, ctr, cp->patches, err);
+        }
         if (st) return st;
     }
     for (int32_t i = 0; i < p->nhv; i++) {

@@ -16,6 +16,8 @@ typedef struct {
     double *knots;      /* n spoke intervals at level K */
     const struct ccn__bi5 *op; /* shared per valence, owned by the plan */
     double *patches;    /* (3*nsig+1)*n bi-5 patches, 36*3 doubles each */
+    int exact_surround; /* 1: arbitrary NU intervals, border = level-(K+1) pieces (bi5.h [R13]) */
+    double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
 } ccn__cap;
 
 struct ccn_plan {
@@ -54,7 +56,8 @@ struct ccn_plan {
     int32_t *hv_out, *hv_cap, *hv_sector;
     double *hv_uv;
     /* ring around each cap: level-K faces touching the hole, evaluated as the bicubic patch
-     * of their level-K net (the spline the cap joins C2), not as the subdivision limit */
+     * of their level-K net (the spline the cap joins C2), not as the subdivision limit;
+     * not for exact_surround caps, whose surround is the limit itself */
     int32_t nrf, *rf_face;  /* distinct faces */
     double *rf_bez;         /* 48 doubles per face, filled by evaluate */
     int32_t nbv;            /* output vertices on those faces */
@@ -62,6 +65,12 @@ struct ccn_plan {
     double *bv_uv;
     ccn_sizes sizes;
 };
+
+/* surround.c: the exact level-(K+1) bicubic surround of the cap of EV ev (level K), as 4 bi-5
+ * pieces per sector over the hole (layout of ccn__bi5_apply_pieces); 0 if it is not there.
+ * pieces = NULL: check the topology only (reads no positions). */
+int ccn__cap_surround(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int pinned,
+                      double *pieces);
 
 /* tessellate.c */
 ccn_status ccn__tess_output(ccn_plan *p, ccn_error *err);

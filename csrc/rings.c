@@ -4,6 +4,8 @@
  * product per coordinate (the other sectors by cyclic relabelling of the net). */
 #include "bi5.h"
 
+#include <lapacke.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -214,6 +216,29 @@ static void ring_sector(const double *To, const double *Ti, double sigma, int32_
     tmul(P6, Ti, P6, 0, 3, 0, 3, 3, 3, m, B);   /* B[0..2][0..2] = PR Ti PR^T        */
 }
 
+/* Ring 0 of a sector with sigma = 1/2 from the exact surround pieces (bi5.h [R13]): P holds
+ * 4 full bi-5 polynomials (36 x m each) over the hole: 0 across u = 1 for v in [0,1/2], 1 across
+ * u = 1 for v in [1/2,1], 2 across v = 1 for u in [0,1/2], 3 across v = 1 for u in [1/2,1].
+ * Each patch takes its outer layers from the piece it borders (the split at 1/2 is the pieces'
+ * knot), its inner layers from Ti as in ring_sector. */
+static void ring_sector_pieces(const double *P, const double *Ti, int32_t m, double *A, double *B,
+                               double *C) {
+    double SR[36], SL[36], PR[9], P6[36] = {0}, Id[36] = {0};
+    size_t ps = 36 * (size_t)m;
+    ccn__bi5_split(0.5, SR, SL);
+    ccn__bi5_prolong(2.0, PR);
+    for (int32_t k = 0; k < 3; k++)
+        for (int32_t l = 0; l < 3; l++) P6[k * 6 + 3 + l] = PR[k * 3 + l];
+    for (int32_t k = 0; k < 6; k++) Id[k * 6 + k] = 1.0;
+    tmul(SR, P + 0 * ps, SL, 3, 6, 0, 6, 3, 0, m, A); /* A[3..5][.]: piece u, v <= 1/2 */
+    tmul(P6, Ti, Id, 0, 3, 0, 6, 3, 0, m, A);
+    tmul(SL, P + 2 * ps, SR, 0, 6, 3, 6, 0, 3, m, C); /* C[.][3..5]: piece v, u <= 1/2 */
+    tmul(Id, Ti, P6, 0, 6, 0, 3, 0, 3, m, C);
+    tmul(SR, P + 1 * ps, SR, 3, 6, 0, 6, 3, 0, m, B); /* B[3..5][.]: piece u, v >= 1/2 */
+    tmul(SR, P + 3 * ps, SR, 0, 3, 3, 6, 0, 3, m, B); /* B[0..2][3..5]: piece v, u >= 1/2 */
+    tmul(P6, Ti, P6, 0, 3, 0, 3, 3, 3, m, B);
+}
+
 /* T (n x 36 x m) = samp (36 x 28) applied to every sector of the guide gbb (n x 28 x m). */
 static void sample_border(int32_t n, const double *samp, const double *gbb, int32_t m, double *T) {
     memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
@@ -232,7 +257,8 @@ static void sample_border(int32_t n, const double *samp, const double *gbb, int3
  * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric). out: patches x 36 x m. */
 static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0,
                             const double *b600, int32_t m, const double *d, const double *kap,
-                            const double complex *taus, double *out, ccn_error *err) {
+                            const double complex *taus, const double *pieces, double *out,
+                            ccn_error *err) {
     int32_t n = b->n;
     size_t tsz = (size_t)n * 36 * (size_t)m, psz = 36 * (size_t)m;
     double *To = malloc(sizeof(double) * tsz), *Ti = malloc(sizeof(double) * tsz);
@@ -251,11 +277,13 @@ static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0
     for (int32_t r = 0; r < b->nsig; r++) {
         sample_border(n, b->samp[r], gbb, m, Ti);         /* t^{r+1} = [g^{r+1} o chi~] */
         ccn__bi5_c2_rule(n, kap, m, Ti);                           /* t~^{r+1} */
-        for (int32_t s = 0; s < n; s++)
-            ring_sector(To + (size_t)s * psz, Ti + (size_t)s * psz, b->sig[r], m,
-                        out + ((size_t)(3 * r + 0) * n + s) * psz,
-                        out + ((size_t)(3 * r + 1) * n + s) * psz,
-                        out + ((size_t)(3 * r + 2) * n + s) * psz);
+        for (int32_t s = 0; s < n; s++) {
+            double *A = out + ((size_t)(3 * r + 0) * n + s) * psz;
+            double *B = out + ((size_t)(3 * r + 1) * n + s) * psz;
+            double *C = out + ((size_t)(3 * r + 2) * n + s) * psz;
+            if (r == 0 && pieces) ring_sector_pieces(pieces + (size_t)s * 4 * psz, Ti + (size_t)s * psz, m, A, B, C);
+            else ring_sector(To + (size_t)s * psz, Ti + (size_t)s * psz, b->sig[r], m, A, B, C);
+        }
         double *tmp = To; To = Ti; Ti = tmp;
     }
     st = ccn__bi5_cap(b, gbb, To, m, kap, taus, out + (size_t)3 * b->nsig * n * psz, err);
@@ -320,7 +348,7 @@ static ccn_status build_stencil(ccn__bi5 *b, ccn_error *err) {
     if (!st) {
         for (int32_t k = 0; k < nc; k++) X[(size_t)k * m + k] = 1.0;
         c0[nc] = 1.0;
-        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, out, err);
+        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, NULL, out, err);
     }
     for (int32_t t = 0; !st && t < nt; t++) /* sector 0 patch of type t = patch index t*n */
         memcpy(b->stencil + (size_t)t * 36 * m, out + (size_t)t * n * 36 * m, sizeof(double) * 36 * (size_t)m);
@@ -442,7 +470,7 @@ ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *s
         double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
         st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
                   : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
-        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus, patches, err);
+        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus, NULL, patches, err);
         free(taus);
     }
     if (kap != kap_small) free(kap);
@@ -502,10 +530,95 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
         goto done;
     }
     if (nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
-    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, patches, err);
+    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, NULL, patches, err);
     if (!st) ccn__ok(err);
 done:
     free(T); free(kap); free(taus);
+    return st;
+}
+
+/* Least-squares degree-5 BB coefficients c[6][m] of the piecewise function that is lo(t) on
+ * [0,1/2] and hi(t) on [1/2,1] (each given by 6 BB coefficients of stride `st` doubles):
+ * 8 Gauss-Legendre-like nodes per half, normal equations solved by LAPACK (dposv). */
+static int fit_piecewise(const double *lo, const double *hi, size_t st, int32_t m, double *c) {
+    static const double g[4] = {0.0694318442029737, 0.3300094782075719, 0.6699905217924281,
+                                0.9305681557970263}; /* 4-point Gauss nodes on [0,1] */
+    double N[36] = {0}, R[6 * 3] = {0};
+    for (int half = 0; half < 2; half++)
+        for (int q = 0; q < 4; q++) {
+            double t = 0.5 * (half + g[q]), B[6], y[3] = {0, 0, 0};
+            for (int j = 0; j < 6; j++) B[j] = ccn__bi5_bern(5, j, t);
+            const double *P = half ? hi : lo;
+            for (int j = 0; j < 6; j++)
+                for (int k = 0; k < m; k++) y[k] += B[j] * P[(size_t)j * st + k];
+            for (int a = 0; a < 6; a++) {
+                for (int b2 = 0; b2 < 6; b2++) N[a * 6 + b2] += B[a] * B[b2];
+                for (int k = 0; k < m; k++) R[a * 3 + k] += B[a] * y[k];
+            }
+        }
+    if (LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', 6, m, N, 6, R, 3) != 0) return -1;
+    for (int a = 0; a < 6; a++)
+        for (int k = 0; k < m; k++) c[(size_t)a * m + k] = R[a * 3 + k];
+    return 0;
+}
+
+/* The guide's least-squares target from the pieces (bi5.h [R13]): per sector, rows 3..5 =
+ * the best single quintic in v of the two u-leg pieces' rows, columns 3..5 the same for the
+ * v-leg pieces in u, the corner block (both >= 3) the mean of the two. T: n x 36 x 3. */
+static int pieces_target(int32_t n, const double *pieces, double *T) {
+    memset(T, 0, sizeof(double) * (size_t)n * 108);
+    for (int32_t s = 0; s < n; s++) {
+        const double *P = pieces + (size_t)s * 432;
+        double *Ts = T + (size_t)s * 108, c[18];
+        for (int i = 3; i < 6; i++) { /* row i (u-jet), function of v: entries (i, j), stride 3 */
+            if (fit_piecewise(P + i * 18, P + 108 + i * 18, 3, 3, c)) return -1;
+            for (int j = 0; j < 6; j++)
+                for (int k = 0; k < 3; k++) Ts[(i * 6 + j) * 3 + k] = c[j * 3 + k];
+        }
+        for (int j = 3; j < 6; j++) { /* column j (v-jet), function of u: entries (i, j), stride 18 */
+            if (fit_piecewise(P + 216 + j * 3, P + 324 + j * 3, 18, 3, c)) return -1;
+            for (int i = 0; i < 6; i++)
+                for (int k = 0; k < 3; k++) {
+                    double *t = Ts + (i * 6 + j) * 3 + k;
+                    *t = i >= 3 ? 0.5 * (*t + c[i * 3 + k]) : c[i * 3 + k];
+                }
+        }
+    }
+    return 0;
+}
+
+ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
+                                 const double *spoke_knots, const double *center, double *patches,
+                                 ccn_error *err) {
+    ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
+    if (st) return st;
+    if (!pieces || !center || !spoke_knots)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL pieces, knots or centre");
+    if (b->sig[0] != 0.5)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                         "bi5: the pieces need a first ring with sigma = 1/2 (got %g)", b->sig[0]);
+    int32_t n = b->n;
+    for (int32_t k = 0; k < n * 4 * 108; k++)
+        if (!isfinite(pieces[k]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                             "bi5: surround piece of sector %d is not finite", (int)(k / 432));
+    double *kap = malloc(sizeof(double) * (size_t)n);
+    double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+    int nu = 0;
+    if (!kap || !taus) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
+    for (int32_t s = 0; !st && s < n; s++) {
+        kap[s] = spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n];
+        if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
+    }
+    double *T = st ? NULL : malloc(sizeof(double) * (size_t)n * 108);
+    if (!st && !T) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
+    if (!st && pieces_target(n, pieces, T))
+        st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "bi5: border fit failed");
+    if (!st && nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    if (!st) st = construct(b, NULL, T, center, 3, spoke_knots, nu ? kap : NULL, nu ? taus : NULL,
+                            pieces, patches, err);
+    free(kap); free(taus); free(T);
+    if (!st) ccn__ok(err);
     return st;
 }
 

@@ -227,6 +227,7 @@ static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
     ccn_plan *p = w->p;
     const ccn_mesh *mK = p->lev[p->K];
     const ccn__cap *cp = &p->caps[c];
+    if (cp->exact_surround) return 0; /* its surround is the limit itself (bi5.h [R13]) */
     w->mode = 1;
     for (int32_t j = 0; j < 2 * cp->n; j++) {
         int32_t v = cp->ring[j];
