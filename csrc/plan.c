@@ -542,9 +542,25 @@ static void export_bicubic(const ccn_plan *p, int32_t lvl, ccn_patch_fn fn, void
              k < p->lev[p->K]->vfan_start[p->caps[c].cnet[0] + 1]; k++)
             kind[p->lev[p->K]->hface[p->lev[p->K]->vfan[k]]] = 1;
     for (int32_t i = 0; i < p->nrf; i++) kind[p->rf_face[i]] = 2;
+    for (int32_t c = 0; c < p->ncap; c++) { /* exact surround: faces around the hole, 3 */
+        const ccn__cap *cp = &p->caps[c];
+        if (!cp->exact_surround || lvl != p->K) continue;
+        for (int32_t j = 0; j < 2 * cp->n; j++)
+            for (int32_t k = m->vfan_start[cp->ring[j]]; k < m->vfan_start[cp->ring[j] + 1]; k++)
+                if (kind[m->hface[m->vfan[k]]] == 0) kind[m->hface[m->vfan[k]]] = 3;
+    }
     double bez[4][4][3];
     for (int32_t f = 0; f < m->nf; f++) {
         if (kind[f] == 1) continue;
+        if (kind[f] == 3) { /* not a tensor patch at level K: its level-(K+1) children are */
+            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+                if (ccn__bicubic_patch(p->lev[lvl + 1], h, pinned, 1, bez))
+                    emit(p, fn, user, 3, &bez[0][0][0], cage_face_of(p, lvl + 1, h));
+                else
+                    (*skipped)++;
+            }
+            continue;
+        }
         if (ccn__bicubic_patch(m, f, pinned, kind[f] != 2, bez))
             emit(p, fn, user, 3, &bez[0][0][0], cage_face_of(p, lvl, f));
         else
