@@ -138,7 +138,7 @@ static double normal_fd_error(const limit_mesh *lm, int skip_boundary) {
 }
 
 static const char *CAGES[] = {"cube.obj", "torus.obj", "fan5.obj", "pole12.obj", "icosa_quad.obj",
-                              "pentaprism.obj", "cube_tri.obj", "grid4.obj", "lshape.obj", "fig16_v6.obj",
+                              "pentaprism.obj", "cube_tri.obj", "grid4.obj", "lshape.obj", "fig16_v6.obj", "nu8_v8.obj",
                               "jitter_sphere.obj", "fan64.obj"};
 
 static void test_watertight(void) {
@@ -189,7 +189,7 @@ static void test_watertight(void) {
 
 /* Exact normals vs the faces around each vertex: O(h) agreement that improves with L. */
 static void test_normals_vs_finite_differences(void) {
-    const char *closed[] = {"cube.obj", "torus.obj", "icosa_quad.obj", "pentaprism.obj", "jitter_sphere.obj", "fan5.obj", "fig16_v6.obj"};
+    const char *closed[] = {"cube.obj", "torus.obj", "icosa_quad.obj", "pentaprism.obj", "jitter_sphere.obj", "fan5.obj", "fig16_v6.obj", "nu8_v8.obj"};
     for (size_t c = 0; c < sizeof closed / sizeof *closed; c++) {
         ccn_cage cage;
         ccn_obj *obj = load(closed[c], &cage);
@@ -206,12 +206,14 @@ static void test_normals_vs_finite_differences(void) {
                 free_lm(&lm);
             }
             printf("  %s cap%d: normal vs faces, max angle L4 %.3g, L5 %.3g rad\n", closed[c], cap, err[0], err[1]);
-            /* fig16 (intervals 1:10 at a valence-6 EV, M from level 0): the face average next
-             * to the EV converges at ~0.72 per level (M has |mu4|/mu2 = 0.77), not 1/2, so it starts
-             * higher; the convergence check below still applies. */
-            double tol = strcmp(closed[c], "fig16_v6.obj") ? 0.05 : 0.06;
+            /* Next to a strongly non-uniform EV the face average converges at M's |mu4|/mu2 per
+             * level, not 1/2 (measured rates match): fig16 (1:10, valence 6, M from level 0)
+             * 0.77 -> ~0.72 per level; nu8 (1:3, valence 8) 0.84 -> ~0.82 with the exact limit
+             * (cap1); its bi-5 cap (cap0) converges at ~0.55. Tolerances follow those rates. */
+            int f16 = !strcmp(closed[c], "fig16_v6.obj"), nu8 = !strcmp(closed[c], "nu8_v8.obj");
+            double tol = f16 ? 0.06 : nu8 ? 0.07 : 0.05, rate = nu8 ? 0.9 : 0.75;
             CHECK(err[1] <= tol, "%s cap%d: max angle %g at level 5", closed[c], cap, err[1]);
-            CHECK(err[1] <= 0.75 * err[0], "%s cap%d: no convergence (%g -> %g)", closed[c], cap, err[0], err[1]);
+            CHECK(err[1] <= rate * err[0], "%s cap%d: no convergence (%g -> %g)", closed[c], cap, err[0], err[1]);
         }
         ccn_obj_destroy(obj);
     }

@@ -421,6 +421,9 @@ CAGES = [
 ]
 
 FIGS = [
+    # not a paper figure: valence 8 with d_{s+2} != d_{s-2} and ratios 1:3 (the bi-5 cap on the
+    # exact level-(K+1) surround, csrc/surround.c)
+    ("nu8_v8.obj", 8, (1, 3, 3, 1, 1, 1, 3, 1)),
     ("fig16_v6.obj", 6, (1, 10, 10, 1, 1, 10)),
     ("fig17_v7.obj", 7, (1, 8, 8, 1, 1, 1, 8)),
     ("fig18_v8.obj", 8, (1, 5, 5, 1, 1, 1, 5, 1)),

@@ -8,7 +8,7 @@ T=$(mktemp -d) || exit 2
 trap 'rm -rf "$T"' EXIT
 pass=0; fail=0
 for cage in tests/data/*.obj; do
-  case "$cage" in *fig1[678]_*) continue ;; esac
+  grep -q "^# knot" "$cage" && continue # non-uniform knots: not comparable with OpenSubdiv
   name=$(basename "$cage")
   for L in 1 2 3; do
     for corners in smooth pinned; do
