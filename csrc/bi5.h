@@ -136,7 +136,17 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
  * fitted to t_CC of cnet with the [R8] knots (any d: a least-squares target only); ring 0 takes
  * its outer layers from the pieces, the other rings and the cap are [R9]-[R12]. */
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
-                                 const double *spoke_knots, const double *center, double *patches,
+                                 const double *spoke_knots, const double complex *taus,
+                                 const double *center, double *patches, ccn_error *err);
+/* The per-sector taus of non-uniform spoke intervals ([R11]; n x 36, CCN_ERR_KNOTS if tau folds):
+ * they depend on the intervals only, so a caller that evaluates repeatedly computes them once
+ * and passes them to ccn__bi5_apply_cached / ccn__bi5_apply_pieces (NULL there: computed per
+ * call, the ~35 ms that dominate a non-uniform cap's construction). */
+ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double complex *taus,
+                            ccn_error *err);
+/* ccn__bi5_apply with precomputed taus (NULL: as ccn__bi5_apply). */
+ccn_status ccn__bi5_apply_cached(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                                 const double complex *taus, const double *center, double *patches,
                                  ccn_error *err);
 /* Surface at sector s, hole coordinates (u,v) in [0,1]^2 ((0,0) = EV, u along spoke s, v along
  * spoke s+1): finds the ring / patch (SPEC §1.4, rho_r = 1 - sigma_r) and returns the position

@@ -34,6 +34,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t c = 0; c < p->ncap; c++) {
         free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
         free(p->caps[c].knots); free(p->caps[c].patches); free(p->caps[c].pieces);
+        free(p->caps[c].taus);
     }
 #if CCN_HAVE_BI5
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
@@ -158,6 +159,7 @@ static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround,
 
 static void cap_free(ccn__cap *c) {
     free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
+    free(c->taus);
     memset(c, 0, sizeof *c);
 }
 
@@ -168,6 +170,8 @@ static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *
     if (p->R < p->K + 1 && build_levels(p, p->K + 1, e2)) return 0;
     const struct ccn__bi5 *op = cap_op(p, c->n, 1, e2);
     if (!op) return 0;
+    /* the taus depend on the last ring's speed only, which both operators share */
+    if (op->sig[op->nsig - 1] != c->op->sig[c->op->nsig - 1]) return 0;
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     free(c->patches);
     c->op = op;
@@ -176,7 +180,7 @@ static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *
     c->pieces = calloc(432 * (size_t)c->n, sizeof(double));
     return c->patches && c->pieces &&
            ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], ev, pinned, NULL) &&
-           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, zero, c->patches, e2) == CCN_OK;
+           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, c->taus, zero, c->patches, e2) == CCN_OK;
 }
 #endif
 
@@ -207,7 +211,15 @@ static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
         for (int32_t k = 0; k < n; k++) c->knots[k] = m->eknot[ccn__fan_edge(m, ev, k)];
         ok = ccn__ev_limit(m, ev, p->opts.scheme, s, &e2) == CCN_OK;
         for (int32_t j = 0; ok && j < 2 * n + 1; j++) c->l0[j] = s->wp[j];
-        ccn_status st = ok ? ccn__bi5_apply(op, zero, c->knots, zero, c->patches, &e2) : CCN_ERR_ARGUMENT;
+        int nu = 0; /* some kappa_s = d_{s+1}/d_{s-1} != 1: taus, once (they need no positions) */
+        for (int32_t k = 0; k < n; k++)
+            nu |= fabs(c->knots[(k + 1) % n] / c->knots[(k + n - 1) % n] - 1.0) > 1e-12;
+        if (ok && nu) {
+            c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+            ok = c->taus && ccn__bi5_nu_taus(op, c->knots, c->taus, &e2) == CCN_OK;
+        }
+        ccn_status st = ok ? ccn__bi5_apply_cached(op, zero, c->knots, c->taus, zero, c->patches, &e2)
+                           : CCN_ERR_ARGUMENT;
         if (st == CCN_ERR_KNOTS) ok = cap_use_surround(p, c, ev, zero, &e2);
         else ok = ok && st == CCN_OK;
     }
@@ -465,9 +477,9 @@ static ccn_status eval_caps(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
             int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
             if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
-            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, ctr, cp->patches, err);
+            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, cp->taus, ctr, cp->patches, err);
         } else {
-            st = ccn__bi5_apply(cp->op, net, cp->knots, ctr, cp->patches, err);
+            st = ccn__bi5_apply_cached(cp->op, net, cp->knots, cp->taus, ctr, cp->patches, err);
         }
         if (st) return st;
     }

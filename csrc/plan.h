@@ -18,6 +18,8 @@ typedef struct {
     double *patches;    /* (3*nsig+1)*n bi-5 patches, 36*3 doubles each */
     int exact_surround; /* 1: arbitrary NU intervals, border = level-(K+1) pieces (bi5.h [R13]) */
     double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
+    void *taus;         /* non-uniform (some kappa != 1): the n cap taus (double complex[36] each,
+                           bi5.h [R11]), computed once at create; NULL otherwise */
 } ccn__cap;
 
 struct ccn_plan {

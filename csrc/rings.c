@@ -448,8 +448,9 @@ static ccn_status check_apply_args(const ccn__bi5 *b, const double *cnet, int32_
     return CCN_OK;
 }
 
-ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
-                          const double *center, double *patches, ccn_error *err) {
+static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                             const double complex *taus_in, const double *center, double *patches,
+                             ccn_error *err) {
     ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
     if (st) return st;
     int32_t n = b->n, bad = -1;
@@ -467,14 +468,45 @@ ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *s
                        "sectors' bicubic tensor-borders disagree along the spoke (SPEC §9, bi5.h [R8])",
                        (int)((bad + 2) % n), (int)((bad + n - 2) % n), (int)bad);
     else {
-        double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
-        st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
-                  : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
-        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus, NULL, patches, err);
+        double complex *taus = taus_in ? NULL : malloc(sizeof(double complex) * 36 * (size_t)n);
+        if (!taus_in)
+            st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
+                      : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
+        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus_in ? taus_in : taus, NULL, patches, err);
         free(taus);
     }
     if (kap != kap_small) free(kap);
     if (!st) ccn__ok(err);
+    return st;
+}
+
+ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                          const double *center, double *patches, ccn_error *err) {
+    return apply_impl(b, cnet, spoke_knots, NULL, center, patches, err);
+}
+
+ccn_status ccn__bi5_apply_cached(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                                 const double complex *taus, const double *center, double *patches,
+                                 ccn_error *err) {
+    return apply_impl(b, cnet, spoke_knots, taus, center, patches, err);
+}
+
+ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double complex *taus,
+                            ccn_error *err) {
+    if (!b || !spoke_knots || !taus)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL argument to nu_taus");
+    int32_t n = b->n;
+    double *kap = malloc(sizeof(double) * (size_t)n);
+    if (!kap) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (nu_taus)");
+    ccn_status st = CCN_OK;
+    for (int32_t s = 0; s < n && !st; s++) {
+        if (!(spoke_knots[s] > 0.0 && isfinite(spoke_knots[s])))
+            st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, s, "bi5: spoke %d has knot interval %g",
+                           (int)s, spoke_knots[s]);
+        kap[s] = spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n];
+    }
+    if (!st) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    free(kap);
     return st;
 }
 
@@ -588,8 +620,8 @@ static int pieces_target(int32_t n, const double *pieces, double *T) {
 }
 
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
-                                 const double *spoke_knots, const double *center, double *patches,
-                                 ccn_error *err) {
+                                 const double *spoke_knots, const double complex *taus_in,
+                                 const double *center, double *patches, ccn_error *err) {
     ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
     if (st) return st;
     if (!pieces || !center || !spoke_knots)
@@ -603,9 +635,10 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
             return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                              "bi5: surround piece of sector %d is not finite", (int)(k / 432));
     double *kap = malloc(sizeof(double) * (size_t)n);
-    double complex *taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+    double complex *taus = taus_in ? NULL : malloc(sizeof(double complex) * 36 * (size_t)n);
     int nu = 0;
-    if (!kap || !taus) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
+    if (!kap || (!taus_in && !taus))
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
     for (int32_t s = 0; !st && s < n; s++) {
         kap[s] = spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n];
         if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
@@ -614,8 +647,9 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
     if (!st && !T) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
     if (!st && pieces_target(n, pieces, T))
         st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "bi5: border fit failed");
-    if (!st && nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
-    if (!st) st = construct(b, NULL, T, center, 3, spoke_knots, nu ? kap : NULL, nu ? taus : NULL,
+    if (!st && nu && !taus_in) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    const double complex *tu = taus_in ? taus_in : taus;
+    if (!st) st = construct(b, NULL, T, center, 3, spoke_knots, nu ? kap : NULL, nu ? tu : NULL,
                             pieces, patches, err);
     free(kap); free(taus); free(T);
     if (!st) ccn__ok(err);
