@@ -430,7 +430,49 @@ static void test_nonuniform_extreme(void) {
     }
 }
 
+/* Linear precision with arbitrary non-uniform intervals: a planar cage gives a planar surface,
+ * caps included (every rule and the cap construction are affine combinations). */
+static void test_nonuniform_planar(void) {
+    static const int valences[] = {3, 5, 6, 7, 8, 10, 16};
+    double worst = 0;
+    int caps = 0;
+    for (int k = 0; k < 14; k++) {
+        int n = valences[k % 7];
+        cage_buf c;
+        make_fan(n, 0.3, &c);
+        for (int v = 0; v < c.nv; v++) c.pos[3 * v + 2] = 0.25 * c.pos[3 * v] - 0.5 * c.pos[3 * v + 1] + 1;
+        double d[16];
+        for (int s = 0; s < n; s++) d[s] = 0.25 + tl_rand01();
+        ccn_cage cage;
+        int32_t *ev;
+        double *kn;
+        fan_knots(&c, n, d, &cage, &ev, &kn);
+        ccn_options o = {0};
+        o.levels = 3;
+        ccn_plan *p = NULL;
+        ccn_error err;
+        CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
+        if (p) {
+            ccn_sizes sz;
+            ccn_plan_sizes(p, &sz);
+            caps += sz.num_caps;
+            double *x = malloc(sizeof(double) * 3 * sz.num_verts);
+            ccn_limit_mesh lm = {x, NULL, NULL, NULL};
+            CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
+            for (int32_t v = 0; v < sz.num_verts; v++)
+                worst = fmax(worst, fabs(x[3 * v + 2] - (0.25 * x[3 * v] - 0.5 * x[3 * v + 1] + 1)));
+            free(x);
+            ccn_plan_destroy(p);
+        }
+        free(ev); free(kn); free(c.pos); free(c.fv); free(c.fs);
+    }
+    printf("  planar cages, random intervals: %d caps, largest distance from the plane %.1e\n", caps, worst);
+    CHECK(caps == 14, "caps built: %d", caps);
+    CHECK(worst <= 1e-12, "off-plane %g", worst);
+}
+
 int main(void) {
+    RUN(test_nonuniform_planar);
     RUN(test_nonuniform_extreme);
     RUN(test_nonuniform_general);
     RUN(test_random_fans);
