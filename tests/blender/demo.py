@@ -12,9 +12,9 @@ the labels, and renders a top view with Workbench and a highlight-line (stripe) 
 OUTDIR/demo.png: every maximum is a bullseye of closed stripes. Saves OUTDIR/demo.blend (it opens
 and renders without the add-on).
 
-Why not Fig. 1: its exact colouring is not known (DESIGN §4.3). Fig. 16 (valence 6) shows two
-local maxima under both schemes in this pipeline (level 0→1 always uses NURSS rules); Fig. 17
-gives two maxima with NURSS and one with the eigen rules at every level 3–6.
+Why not Fig. 1: its exact colouring is not known (DESIGN §4.3). Fig. 17 gives two maxima with
+NURSS and one with the eigen rules at every level 3–6 (Fig. 16 and 18 too, since the eigen rules
+act from level 0 on an extraordinary vertex that is ready for them, refine.c).
 """
 import os
 import sys
