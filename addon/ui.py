@@ -69,12 +69,17 @@ def _draw_status(layout, obj):
         if z.get("num_ev_fallbacks"):
             notes.append("%d eigen→NURSS fallbacks" % z["num_ev_fallbacks"])
         if z.get("num_cap_fallbacks"):
-            notes.append("%d cap fallbacks" % z["num_cap_fallbacks"])
+            notes.append("%d cap fallbacks (exact limit there: too close to another"
+                         " extraordinary point or a boundary, valence > 32, or spoke"
+                         " interval ratios beyond about 1:5)" % z["num_cap_fallbacks"])
         if z.get("num_ignored_verts") or z.get("num_ignored_edges"):
             notes.append("ignored: %d loose verts, %d loose edges"
                          % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))
         for n in notes:
-            box.label(text=n, icon='INFO')
+            lines = _wrap(n, 48)
+            box.label(text=lines[0], icon='INFO')
+            for line in lines[1:]:
+                box.label(text=line, icon='BLANK1')
         box.label(text="Updated in %.1f ms" % (1000 * st.seconds))
 
 
