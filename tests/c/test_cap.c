@@ -292,6 +292,25 @@ static void test_shipped_cages(void) {
     report("shipped cages", &st);
 }
 
+/* Fan cage whose edges parallel to spoke s carry d[s] (opposite edges of quads agree). */
+static void fan_knots(const cage_buf *c, int n, const double *d, ccn_cage *cage, int32_t **ev, double **kn) {
+    *ev = malloc(sizeof(int32_t) * 8 * c->nf);
+    *kn = malloc(sizeof(double) * 4 * c->nf);
+    int ne = 0;
+    for (int f = 0; f < c->nf; f++) {
+        int s = f / 9;
+        for (int j = 0; j < 4; j++) {
+            (*ev)[2 * ne] = c->fv[4 * f + j];
+            (*ev)[2 * ne + 1] = c->fv[4 * f + (j + 1) % 4];
+            (*kn)[ne++] = j % 2 == 0 ? d[s] : d[(s + 1) % n];
+        }
+    }
+    memset(cage, 0, sizeof *cage);
+    cage->num_verts = c->nv; cage->num_faces = c->nf; cage->positions = c->pos;
+    cage->face_sizes = c->fs; cage->face_verts = c->fv;
+    cage->num_edges = ne; cage->edge_verts = *ev; cage->edge_knots = *kn;
+}
+
 /* Non-uniform intervals with kappa != 1 that the cap supports (period 4, n = 8): G1 holds. */
 static void test_nonuniform_period4(void) {
     cap_stats st = {0};
@@ -299,22 +318,12 @@ static void test_nonuniform_period4(void) {
         cage_buf c;
         make_fan(8, 0.2, &c);
         double d[4] = {0.3 + tl_rand01(), 0.3 + tl_rand01(), 0.3 + tl_rand01(), 0.3 + tl_rand01()};
-        /* every edge parallel to spoke s carries d[s % 4] (opposite edges of quads agree) */
-        int32_t *ev = malloc(sizeof(int32_t) * 8 * c.nf);
-        double *kn = malloc(sizeof(double) * 4 * c.nf);
-        int ne = 0;
-        for (int f = 0; f < c.nf; f++) {
-            int s = f / 9;
-            for (int j = 0; j < 4; j++) {
-                ev[2 * ne] = c.fv[4 * f + j];
-                ev[2 * ne + 1] = c.fv[4 * f + (j + 1) % 4];
-                kn[ne++] = j % 2 == 0 ? d[s % 4] : d[(s + 1) % 4];
-            }
-        }
-        ccn_cage cage = {0};
-        cage.num_verts = c.nv; cage.num_faces = c.nf; cage.positions = c.pos;
-        cage.face_sizes = c.fs; cage.face_verts = c.fv;
-        cage.num_edges = ne; cage.edge_verts = ev; cage.edge_knots = kn;
+        double d8[8]; /* every edge parallel to spoke s carries d[s % 4] */
+        for (int s = 0; s < 8; s++) d8[s] = d[s % 4];
+        ccn_cage cage;
+        int32_t *ev;
+        double *kn;
+        fan_knots(&c, 8, d8, &cage, &ev, &kn);
         ccn_options o = {0};
         o.levels = 3;
         ccn_plan *p = NULL;
@@ -338,25 +347,6 @@ static void test_nonuniform_period4(void) {
            st.caps, st.sep_pos, st.sep_nrm, st.centre_nrm);
     CHECK(st.caps == 10, "caps built for supported non-uniform intervals: %d", st.caps);
     CHECK(st.sep_pos <= 1e-9 && st.sep_nrm <= 1e-9 && st.centre_nrm <= 1e-9, "G1");
-}
-
-/* Fan cage whose edges parallel to spoke s carry d[s] (opposite edges of quads agree). */
-static void fan_knots(const cage_buf *c, int n, const double *d, ccn_cage *cage, int32_t **ev, double **kn) {
-    *ev = malloc(sizeof(int32_t) * 8 * c->nf);
-    *kn = malloc(sizeof(double) * 4 * c->nf);
-    int ne = 0;
-    for (int f = 0; f < c->nf; f++) {
-        int s = f / 9;
-        for (int j = 0; j < 4; j++) {
-            (*ev)[2 * ne] = c->fv[4 * f + j];
-            (*ev)[2 * ne + 1] = c->fv[4 * f + (j + 1) % 4];
-            (*kn)[ne++] = j % 2 == 0 ? d[s] : d[(s + 1) % n];
-        }
-    }
-    memset(cage, 0, sizeof *cage);
-    cage->num_verts = c->nv; cage->num_faces = c->nf; cage->positions = c->pos;
-    cage->face_sizes = c->fs; cage->face_verts = c->fv;
-    cage->num_edges = ne; cage->edge_verts = *ev; cage->edge_knots = *kn;
 }
 
 /* Arbitrary non-uniform spoke intervals (bi5.h [R13]): the cap is built on the exact level-(K+1)
