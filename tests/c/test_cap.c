@@ -311,6 +311,22 @@ static void fan_knots(const cage_buf *c, int n, const double *d, ccn_cage *cage,
     cage->num_edges = ne; cage->edge_verts = *ev; cage->edge_knots = *kn;
 }
 
+/* Plan (levels 3, default options) of fan c with spoke intervals d; frees c and the knot arrays
+ * (the plan keeps its own copies). NULL after a failed CHECK. */
+static ccn_plan *fan_plan(cage_buf *c, int n, const double *d) {
+    ccn_cage cage;
+    int32_t *ev;
+    double *kn;
+    fan_knots(c, n, d, &cage, &ev, &kn);
+    ccn_options o = {0};
+    o.levels = 3;
+    ccn_plan *p = NULL;
+    ccn_error err;
+    CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
+    free(ev); free(kn); free(c->pos); free(c->fv); free(c->fs);
+    return p;
+}
+
 /* Non-uniform intervals with kappa != 1 that the cap supports (period 4, n = 8): G1 holds. */
 static void test_nonuniform_period4(void) {
     cap_stats st = {0};
@@ -320,15 +336,8 @@ static void test_nonuniform_period4(void) {
         double d[4] = {0.3 + tl_rand01(), 0.3 + tl_rand01(), 0.3 + tl_rand01(), 0.3 + tl_rand01()};
         double d8[8]; /* every edge parallel to spoke s carries d[s % 4] */
         for (int s = 0; s < 8; s++) d8[s] = d[s % 4];
-        ccn_cage cage;
-        int32_t *ev;
-        double *kn;
-        fan_knots(&c, 8, d8, &cage, &ev, &kn);
-        ccn_options o = {0};
-        o.levels = 3;
-        ccn_plan *p = NULL;
+        ccn_plan *p = fan_plan(&c, 8, d8);
         ccn_error err;
-        CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
         if (p) {
             ccn_sizes s;
             ccn_plan_sizes(p, &s);
@@ -341,7 +350,6 @@ static void test_nonuniform_period4(void) {
             free(x); free(nn);
             ccn_plan_destroy(p);
         }
-        free(ev); free(kn); free(c.pos); free(c.fv); free(c.fs);
     }
     printf("  period-4 non-uniform n = 8: %d caps; separators: pos %.2g, normal %.2g rad, centre %.2g rad\n",
            st.caps, st.sep_pos, st.sep_nrm, st.centre_nrm);
@@ -399,15 +407,7 @@ static void test_nonuniform_extreme(void) {
         make_fan(6, 0.0, &c);
         double d[6];
         for (int s = 0; s < 6; s++) d[s] = pat[s] ? 1 : ratios[q];
-        ccn_cage cage;
-        int32_t *ev;
-        double *kn;
-        fan_knots(&c, 6, d, &cage, &ev, &kn);
-        ccn_options o = {0};
-        o.levels = 3;
-        ccn_plan *p = NULL;
-        ccn_error err;
-        CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
+        ccn_plan *p = fan_plan(&c, 6, d);
         if (p) {
             ccn_sizes sz;
             ccn_plan_sizes(p, &sz);
@@ -416,7 +416,6 @@ static void test_nonuniform_extreme(void) {
                   "ratio %g: %d caps, %d fallbacks", ratios[q], sz.num_caps, sz.num_cap_fallbacks);
             ccn_plan_destroy(p);
         }
-        free(ev); free(kn); free(c.pos); free(c.fv); free(c.fs);
     }
 }
 
@@ -433,15 +432,8 @@ static void test_nonuniform_planar(void) {
         for (int v = 0; v < c.nv; v++) c.pos[3 * v + 2] = 0.25 * c.pos[3 * v] - 0.5 * c.pos[3 * v + 1] + 1;
         double d[16];
         for (int s = 0; s < n; s++) d[s] = 0.25 + tl_rand01();
-        ccn_cage cage;
-        int32_t *ev;
-        double *kn;
-        fan_knots(&c, n, d, &cage, &ev, &kn);
-        ccn_options o = {0};
-        o.levels = 3;
-        ccn_plan *p = NULL;
+        ccn_plan *p = fan_plan(&c, n, d);
         ccn_error err;
-        CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
         if (p) {
             ccn_sizes sz;
             ccn_plan_sizes(p, &sz);
@@ -454,7 +446,6 @@ static void test_nonuniform_planar(void) {
             free(x);
             ccn_plan_destroy(p);
         }
-        free(ev); free(kn); free(c.pos); free(c.fv); free(c.fs);
     }
     printf("  planar cages, random intervals: %d caps, largest distance from the plane %.1e\n", caps, worst);
     CHECK(caps == 14, "caps built: %d", caps);
