@@ -15,6 +15,9 @@
 #      ring regular and injective in every case except KNOWN_CHARMAP (valence 3 with one spoke
 #      ~ 0.005: det J of the limit surface provably changes sign, see RESULTS.md), which may fail.
 #  (d) maxima, NURSS rules, 2,000 cases: a higher failure rate than (a) (the contrast).
+#  (f) finding 3 (RESULTS.md): the first failure of (a) and of (c) are failures of the paper's
+#      polyhedron (e = 0) and pass everything with another member of the family l_i^(1-e) d_i^e
+#      (tests/experiments/shape_select.sh, a patched probe build; the library keeps e = 0).
 #  info: the library pipeline from a level-0 cage (NURSS rules at level 0, DESIGN 4.3) -- printed,
 #      not asserted (see RESULTS.md).
 # One line per check, then "N passed, N failed"; exit 0 only if every check passed.
@@ -166,6 +169,20 @@ if run "$i" maxima --scheme eigen --start cage --cases 2000 --seed 1 --levels 5 
     "$single / $cases single maximum at level 5 (need >= 99.8 %); $(grep '^failures by valence' "$i")"
 else
   report FAIL "maxima eigen from the cage" "experiment did not run"
+fi
+
+# ---- (f) finding 3: a per-vertex eigen polyhedron passes the failures of (a) and (c) ----------
+first_fail() { # experiment output -> "case d0,d1,..." of its first failure
+  sed -n 's/^fail case \([0-9]*\) .* intervals \([0-9.e,+-]*\).*/\1 \2/p' "$1" | head -n 1
+}
+{ first_fail "$a"; first_fail "$c"; } > "$tmp/f.txt"
+if [ "$(wc -l < "$tmp/f.txt")" = 2 ] &&
+   tests/experiments/shape_select.sh "$tmp/f.txt" > "$tmp/f.out" 2> "$tmp/f.err"; then
+  nres=$(wc -l < "$tmp/f.out"); nbad=$(awk '$2 == "none" || $2 == 0' "$tmp/f.out" | wc -l)
+  check "finding 3 (per-vertex polyhedron)" "[ $nres = 2 ] && [ $nbad = 0 ]" \
+    "case and first e that passes: $(tr '\n' ';' < "$tmp/f.out")"
+else
+  report FAIL "finding 3 (per-vertex polyhedron)" "no failures to try, or the probe did not build: $(head -c 300 "$tmp/f.err")"
 fi
 
 echo "$pass passed, $fail failed"
