@@ -581,7 +581,9 @@ class TestModifier(AddonTestCase):
         bm.to_mesh(ob2.data)
         bm.free()
         add_modifier(ob2)
-        self.assertTrue(ccn.sync.status(ob2).error)
+        st = ccn.sync.status(ob2)
+        self.assertIsNotNone(st, "no status for the non-manifold cage")
+        self.assertIn("non-manifold", (st.error or "").lower(), "no error reported")
         np.testing.assert_array_equal(evaluated_positions(ob2),
                                       cagelib.mesh_positions(ob2.data))
 
