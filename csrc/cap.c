@@ -303,24 +303,12 @@ ccn_status ccn__bi5_tau(int32_t n, const double complex chi[16], double complex 
 
 /* Smallest Jacobian Im(conj(tau_u) tau_v) of the planar bi-5 map tau on a 21 x 21 grid. */
 static double tau_min_jacobian(const double complex tau[36]) {
-    double jmin = INFINITY;
+    double P[72], du[2], dv[2], jmin = INFINITY;
+    for (int32_t k = 0; k < 36; k++) P[2 * k] = creal(tau[k]), P[2 * k + 1] = cimag(tau[k]);
     for (int32_t a = 0; a <= 20; a++)
         for (int32_t c = 0; c <= 20; c++) {
-            double u = a / 20.0, v = c / 20.0, Bu[6], Bv[6], Du[6], Dv[6];
-            for (int32_t i = 0; i < 6; i++) {
-                Bu[i] = ccn__bi5_bern(5, i, u);
-                Bv[i] = ccn__bi5_bern(5, i, v);
-                Du[i] = 5 * ((i > 0 ? ccn__bi5_bern(4, i - 1, u) : 0) - (i < 5 ? ccn__bi5_bern(4, i, u) : 0));
-                Dv[i] = 5 * ((i > 0 ? ccn__bi5_bern(4, i - 1, v) : 0) - (i < 5 ? ccn__bi5_bern(4, i, v) : 0));
-            }
-            double complex fu = 0, fv = 0;
-            for (int32_t i = 0; i < 6; i++)
-                for (int32_t j = 0; j < 6; j++) {
-                    fu += Du[i] * Bv[j] * tau[i * 6 + j];
-                    fv += Bu[i] * Dv[j] * tau[i * 6 + j];
-                }
-            double J = cimag(conj(fu) * fv);
-            if (J < jmin) jmin = J;
+            ccn__bi5_patch_eval(P, 2, a / 20.0, c / 20.0, NULL, du, dv);
+            jmin = fmin(jmin, du[0] * dv[1] - du[1] * dv[0]);
         }
     return jmin;
 }

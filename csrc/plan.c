@@ -23,6 +23,12 @@
 #define CCN_MAX_LEVELS 10
 #define CCN_CAP_MAX_VALENCE 32
 
+static void cap_free(ccn__cap *c) {
+    free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
+    free(c->taus);
+    memset(c, 0, sizeof *c);
+}
+
 void ccn_plan_destroy(ccn_plan *p) {
     if (!p) return;
     for (int32_t l = 0; l < p->R; l++) ccn__level_free(&p->prep[l]);
@@ -31,11 +37,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->cage_pos);
     free(p->cap_net);
     for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
-    for (int32_t c = 0; c < p->ncap; c++) {
-        free(p->caps[c].cnet); free(p->caps[c].ring); free(p->caps[c].l0);
-        free(p->caps[c].knots); free(p->caps[c].patches); free(p->caps[c].pieces);
-        free(p->caps[c].taus);
-    }
+    for (int32_t c = 0; c < p->ncap; c++) cap_free(&p->caps[c]);
 #if CCN_HAVE_BI5
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
 #endif
@@ -156,12 +158,6 @@ static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround,
     return p->ops[p->nops++];
 }
 #endif
-
-static void cap_free(ccn__cap *c) {
-    free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
-    free(c->taus);
-    memset(c, 0, sizeof *c);
-}
 
 #if CCN_HAVE_BI5
 /* Arbitrary NU intervals: switch cap c to the exact level-(K+1) surround (bi5.h [R13]) and
