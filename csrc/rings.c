@@ -413,14 +413,19 @@ static void apply_stencil(const ccn__bi5 *b, const double *X, const double ctr[3
             }
 }
 
-/* Knot classification (see bi5.h): 0 uniform-equivalent, 1 supported NU, -1 unsupported. */
-static int classify_knots(int32_t n, const double *d, double *kap, int32_t *bad) {
+/* kappa_s = d_{s+1} / d_{s-1} for every spoke (d = NULL: all 1); 1 if some kappa != 1. */
+static int spoke_kappas(int32_t n, const double *d, double *kap) {
     int nu = 0;
     for (int32_t s = 0; s < n; s++) {
-        kap[s] = d[(s + 1) % n] / d[(s + n - 1) % n];
+        kap[s] = d ? d[(s + 1) % n] / d[(s + n - 1) % n] : 1.0;
         if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
     }
-    if (!nu) return 0;
+    return nu;
+}
+
+/* Knot classification (see bi5.h): 0 uniform-equivalent, 1 supported NU, -1 unsupported. */
+static int classify_knots(int32_t n, const double *d, double *kap, int32_t *bad) {
+    if (!spoke_kappas(n, d, kap)) return 0;
     for (int32_t s = 0; s < n; s++)
         if (fabs(d[(s + 2) % n] - d[(s + n - 2) % n]) > 1e-12 * (d[(s + 2) % n] + d[(s + n - 2) % n])) {
             *bad = s;
@@ -499,12 +504,11 @@ ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double
     double *kap = malloc(sizeof(double) * (size_t)n);
     if (!kap) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (nu_taus)");
     ccn_status st = CCN_OK;
-    for (int32_t s = 0; s < n && !st; s++) {
+    for (int32_t s = 0; s < n && !st; s++)
         if (!(spoke_knots[s] > 0.0 && isfinite(spoke_knots[s])))
             st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, s, "bi5: spoke %d has knot interval %g",
                            (int)s, spoke_knots[s]);
-        kap[s] = spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n];
-    }
+    if (!st) spoke_kappas(n, spoke_knots, kap);
     if (!st) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
     free(kap);
     return st;
@@ -548,10 +552,7 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_border)");
         goto done;
     }
-    for (int32_t s = 0; s < n; s++) {
-        kap[s] = spoke_knots ? spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n] : 1.0;
-        if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
-    }
+    nu = spoke_kappas(n, spoke_knots, kap);
     for (int32_t k = 0; k < n * 108; k++) /* the mask only */
         T[k] = ccn__bi5_in_mask(k / 3 % 36 / 6, k / 3 % 6) ? border[k] : 0.0;
     double def = border_defect(n, T, kap, &spoke);
@@ -639,10 +640,7 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
     int nu = 0;
     if (!kap || (!taus_in && !taus))
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
-    for (int32_t s = 0; !st && s < n; s++) {
-        kap[s] = spoke_knots[(s + 1) % n] / spoke_knots[(s + n - 1) % n];
-        if (fabs(kap[s] - 1.0) > 1e-12) nu = 1;
-    }
+    if (!st) nu = spoke_kappas(n, spoke_knots, kap);
     double *T = st ? NULL : malloc(sizeof(double) * (size_t)n * 108);
     if (!st && !T) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
     if (!st && pieces_target(n, pieces, T))
