@@ -17,7 +17,8 @@ bl_info = {
     "doc_url": "",
 }
 
-_SUBMODULES = ("compat", "native", "cage", "props", "knots", "modifier", "sync", "overlay", "ui")
+_SUBMODULES = ("compat", "native", "cage", "props", "knots", "modifier", "sync", "operators",
+               "overlay", "ui")
 if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency order
     import importlib
     for _name in _SUBMODULES:
@@ -26,10 +27,11 @@ if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency ord
 
 import bpy  # noqa: E402
 
-from . import compat, native, cage, props, knots, modifier, sync, overlay, ui  # noqa: E402
+from . import (compat, native, cage, props, knots, modifier, sync, operators,  # noqa: E402
+               overlay, ui)
 
-_modules = (compat, native, cage, props, knots, modifier, sync, overlay, ui)
-_classes = props.classes + knots.classes + modifier.classes + ui.classes
+_modules = (compat, native, cage, props, knots, modifier, sync, operators, overlay, ui)
+_classes = props.classes + knots.classes + operators.classes + ui.classes
 
 
 def register():
