@@ -3,16 +3,17 @@ CC      ?= cc
 CXX     ?= c++
 CFLAGS  ?= -O2 -g
 WARN     = -std=c11 -Wall -Wextra -Werror -pedantic
-CPPFLAGS = -Icsrc/include -D_POSIX_C_SOURCE=200809L
+CPPFLAGS = -Icsrc/include -Icsrc -D_POSIX_C_SOURCE=200809L
 LDLIBS   = -llapacke -llapack -lm -lpthread
 B        = build
 
-LIB_SRC  = $(sort $(wildcard csrc/*.c))
+# The library: every csrc/<layer>/*.c except the CLI (csrc/tools); csrc/README.md names the layers.
+LIB_SRC  = $(sort $(filter-out csrc/tools/%,$(wildcard csrc/*/*.c)))
 LIB_OBJ  = $(LIB_SRC:csrc/%.c=$(B)/obj/%.o)
 PIC_OBJ  = $(LIB_SRC:csrc/%.c=$(B)/pic/%.o)
 TEST_SRC = $(sort $(wildcard tests/c/test_*.c))
 TEST_BIN = $(TEST_SRC:tests/c/%.c=$(B)/tests/%)
-HDRS     = $(wildcard csrc/*.h csrc/include/*.h tests/c/*.h)
+HDRS     = $(wildcard csrc/*/*.h tests/c/*.h)
 
 APT_PKGS = build-essential clang libclang-rt-14-dev libosd-dev liblapacke-dev liblapack-dev \
            python3 python3-numpy zip
@@ -37,6 +38,7 @@ $(B)/pic/%.o: csrc/%.c $(HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -fPIC -c $< -o $@
 $(B)/libccnurbs.a: $(LIB_OBJ)
+	@rm -f $@
 	ar rcs $@ $^
 $(B)/libccnurbs.so: $(PIC_OBJ)
 	$(CC) -shared -o $@ $^ $(LDLIBS)
@@ -45,7 +47,7 @@ $(B)/ccnurbs: $(wildcard csrc/tools/*.c) $(B)/libccnurbs.a $(HDRS)
 
 $(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) -Icsrc -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
 
 test: deps
 	@$(MAKE) --no-print-directory build $(TEST_BIN) $(TEST_DEPS)

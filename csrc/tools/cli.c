@@ -127,6 +127,18 @@ int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header) 
     return rc ? 2 : 0;
 }
 
+int ccn_cli_scheme(const char *s, ccn_scheme *out) {
+    if (strcmp(s, "eigen") == 0) *out = CCN_SCHEME_EIGEN;
+    else if (strcmp(s, "nurss") == 0) *out = CCN_SCHEME_NURSS;
+    else if (strcmp(s, "cc") == 0) *out = CCN_SCHEME_CATMULL_CLARK;
+    else return -1;
+    return 0;
+}
+
+const char *ccn_cli_scheme_name(ccn_scheme s) {
+    return s == CCN_SCHEME_EIGEN ? "eigen" : s == CCN_SCHEME_NURSS ? "nurss" : "cc";
+}
+
 int ccn_cli_int(const char *s, int lo, int hi, int *out) {
     char *e;
     long x = strtol(s, &e, 10);

@@ -1,24 +1,20 @@
-/* Shared helpers of the ccnurbs command-line tool. */
+/* Shared helpers of the ccnurbs command-line tool: used by the commands (cmd_*.c, exp_*.c);
+ * this module calls only the library, never a command. */
 #ifndef CCN_CLI_H
 #define CCN_CLI_H
 #include "ccnurbs.h"
 #include <stdio.h>
 
-/* Subcommands: argv[0] is the subcommand name; return the process exit code. */
-int ccn_cmd_refine(int argc, char **argv);
-int ccn_cmd_matrix(int argc, char **argv);
-int ccn_cmd_limit(int argc, char **argv);
-int ccn_cmd_patches(int argc, char **argv);
-/* Parses an OBJ and creates a plan; prints the error and returns 2 on failure. */
-int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan);
-int ccn_cmd_experiment(int argc, char **argv);
 /* "eigen" / "nurss" / "cc" -> scheme; returns 0 on success. */
 int ccn_cli_scheme(const char *s, ccn_scheme *out);
-
+/* scheme -> "eigen" / "nurss" / "cc". */
+const char *ccn_cli_scheme_name(ccn_scheme s);
 /* Reads a whole file (NUL-terminated); NULL on error with a message on stderr. */
 char *ccn_cli_read_file(const char *path, size_t *len);
 /* Parses an OBJ file and builds the mesh; prints the error and returns non-zero on failure. */
 int ccn_cli_load_mesh(const char *path, ccn_mesh **out);
+/* Parses an OBJ and creates a plan; prints the error and returns 2 on failure. */
+int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan);
 /* Writes a mesh as OBJ with "# knot" lines to path via a temporary file and rename, so no
  * partial output is left behind on failure. Returns 0 on success. */
 int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header);

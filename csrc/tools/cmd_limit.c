@@ -1,5 +1,6 @@
 /* ccnurbs limit: the limit mesh (positions + exact normals) as OBJ with vn lines. */
 #include "cli.h"
+#include "commands.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -8,6 +8,7 @@
  * stderr, exit status 2. Options may also be written --name=value.
  */
 #include "cli.h"
+#include "commands.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -96,14 +97,10 @@ static int matrix_parse_scheme(const char *s, ccn_scheme *scheme) {
     return 0;
 }
 
-static const char *matrix_scheme_name(ccn_scheme s) {
-    return s == CCN_SCHEME_EIGEN ? "eigen" : s == CCN_SCHEME_NURSS ? "nurss" : "cc";
-}
-
 static void matrix_print(long n, const double *d, ccn_scheme scheme, const double *M,
                          const ccn_ev_info *info, const ccn_error *err) {
     long r, c, N = 2 * n + 1;
-    printf("# scheme %s\n# valence %ld\n# knots", matrix_scheme_name(scheme), n);
+    printf("# scheme %s\n# valence %ld\n# knots", ccn_cli_scheme_name(scheme), n);
     for (r = 0; r < n; r++) printf("%s%.17g", r ? "," : " ", d[r]);
     printf("\n# lambda %.17g\n# T0 %.17g %.17g\n# fallback %d\n# residual %.3g\n",
            info->lambda, info->T0[0], info->T0[1], (int)info->fallback, info->residual);

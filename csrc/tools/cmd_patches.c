@@ -1,6 +1,7 @@
 /* ccnurbs patches: the finite patch set in BezierView format (type 4 = tensor patch of
  * degree d: a line "4", a line "d", then (d+1)^2 points), for public viewers. */
 #include "cli.h"
+#include "commands.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,15 +1,6 @@
 /* ccnurbs refine: K levels of control-mesh refinement, OBJ in and out. */
 #include "cli.h"
-
-#include <string.h>
-
-int ccn_cli_scheme(const char *s, ccn_scheme *out) {
-    if (strcmp(s, "eigen") == 0) *out = CCN_SCHEME_EIGEN;
-    else if (strcmp(s, "nurss") == 0) *out = CCN_SCHEME_NURSS;
-    else if (strcmp(s, "cc") == 0) *out = CCN_SCHEME_CATMULL_CLARK;
-    else return -1;
-    return 0;
-}
+#include "commands.h"
 
 int ccn_cmd_refine(int argc, char **argv) {
     ccn_options o = {0};

@@ -10,7 +10,7 @@ ASAN_CC     = clang-14
 ASAN_FLAGS  = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
               -O1 -g
 ASAN_WARN   = $(filter-out -Werror,$(WARN))
-ASAN_HDRS   = $(wildcard csrc/*.h csrc/include/*.h tests/c/*.h)
+ASAN_HDRS   = $(wildcard csrc/*/*.h tests/c/*.h)
 ASAN_OBJ    = $(LIB_SRC:csrc/%.c=$(B)/asan/obj/%.o)
 ASAN_TESTS  = $(TEST_SRC:tests/c/%.c=$(B)/asan/tests/%)
 
@@ -29,7 +29,7 @@ $(B)/asan/ccnurbs: $(wildcard csrc/tools/*.c) $(B)/asan/libccnurbs.a $(ASAN_HDRS
 	    $(B)/asan/libccnurbs.a $(LDLIBS)
 $(B)/asan/tests/%: tests/c/%.c $(B)/asan/libccnurbs.a $(ASAN_HDRS)
 	@mkdir -p $(@D)
-	$(ASAN_CC) $(CPPFLAGS) -Icsrc -Itests/c $(ASAN_WARN) $(ASAN_FLAGS) $< -o $@ \
+	$(ASAN_CC) $(CPPFLAGS) -Itests/c $(ASAN_WARN) $(ASAN_FLAGS) $< -o $@ \
 	    $(B)/asan/libccnurbs.a $(LDLIBS)
 
 TEST_DEPS += $(B)/asan/ccnurbs $(ASAN_TESTS)

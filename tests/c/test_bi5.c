@@ -1,4 +1,4 @@
-/* Tests of the guided rapidly-contracting bi-5 rings and G1 cap (csrc/bi5.h: charmap.c,
+/* Tests of the guided rapidly-contracting bi-5 rings and G1 cap (csrc/bi5/: charmap.c,
  * guide.c, rings.c, cap.c; Karciauskas & Peters 2018, reference/bi5/SPEC.md).
  *
  * Oracles written here, independently of the library:
@@ -15,7 +15,9 @@
 #include "testlib.h"
 
 #include "ccnurbs.h"
-#include "../../csrc/bi5.h"
+#include "bi5/bi5.h"
+#include "bi5/charmap.h"
+#include "bi5/tau.h"
 #include "bi5_props.h"
 
 #include <lapacke.h>

@@ -6,10 +6,10 @@
  *  - cap sectors meet G1: evaluating a separator from both sides gives one point and one
  *    normal (angle <= 1e-9 rad), and all sectors agree at the centre;
  *  - 200 random cages (valences 3, 5, 6, 7, 8, 10, 16, jittered) and the shipped cages. */
-#include "bi5.h"
+#include "bi5/bi5.h"
 #include "ccnurbs.h"
-#include "patches.h"
-#include "plan.h"
+#include "surface/patches.h"
+#include "surface/plan_types.h"
 #include "testlib.h"
 #include "bi5_props.h"
 

@@ -13,7 +13,8 @@
 #include "testlib.h"
 
 #include "ccnurbs.h"
-#include "../../csrc/eigen.h"
+#include "rules/bilinear.h"
+#include "rules/eigen.h"
 
 #include <lapacke.h>
 

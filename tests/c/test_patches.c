@@ -1,7 +1,7 @@
 /* Bicubic patches of regular faces vs de Boor evaluation of the tensor-product B-spline,
  * written here independently (issue 4 acceptance: <= 1e-12 relative at random parameters). */
 #include "ccnurbs.h"
-#include "patches.h"
+#include "surface/patches.h"
 #include "testlib.h"
 
 /* Periodic knot vector from intervals d[0..n-1]: t[k] for k in [-8, n+8]. */

@@ -11,7 +11,7 @@
 # "none" if no e of the list does.
 #
 # The library itself always uses e = 0 (the specification). The probe build is a patched copy:
-# tests/experiments/shape_probe.patch makes eigen.c read e from CCN_SHAPE_PROBE.
+# tests/experiments/shape_probe.patch makes csrc/rules/eigen.c read e from CCN_SHAPE_PROBE.
 #
 # usage: tests/experiments/shape_select.sh CASES_FILE [E_LIST]     (run from the repository root)
 #   CASES_FILE: lines "case d0,d1,..." (e.g. from the failure lists: see RESULTS.md)
@@ -27,7 +27,7 @@ build_probe() {
     cp -r csrc "$P/csrc"
     patch -s -d "$P" -p1 < tests/experiments/shape_probe.patch
     ${CC:-cc} -std=c11 -O2 -D_POSIX_C_SOURCE=200809L -I"$P/csrc/include" -I"$P/csrc" \
-        "$P"/csrc/*.c "$P"/csrc/tools/*.c -o "$bin" -llapacke -llapack -lm -lpthread
+        "$P"/csrc/*/*.c -o "$bin" -llapacke -llapack -lm -lpthread
 }
 # rebuilt when a source or the patch is newer than the probe
 [ -x "$bin" ] && [ -z "$(find csrc tests/experiments/shape_probe.patch -newer "$bin" -print -quit)" ] ||

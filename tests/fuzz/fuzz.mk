@@ -10,7 +10,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_CC      = clang-14
 FUZZ_SAN     = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 FUZZ_CFLAGS  = -O1 -g $(FUZZ_SAN) $(filter-out -Werror,$(WARN))
-FUZZ_HDRS    = $(wildcard csrc/*.h csrc/include/*.h tests/fuzz/*.h)
+FUZZ_HDRS    = $(wildcard csrc/*/*.h tests/fuzz/*.h)
 FUZZ_OBJ     = $(LIB_SRC:csrc/%.c=$(B)/fuzz/obj/%.o)
 FUZZ_BINS    = $(B)/fuzz/fuzz_obj $(B)/fuzz/fuzz_mesh $(B)/fuzz/fuzz_plan
 

@@ -1,0 +1,25 @@
+/* The guide of the bi-5 construction (internal; bi5/guide.c). */
+#ifndef CCN_BI5_GUIDE_H
+#define CCN_BI5_GUIDE_H
+
+#include "bi5/bi5_types.h"
+
+/* Index of the triangle coefficient b_{ijk} (i+j+k = 6; i <-> O, j <-> V_s, k <-> V_{s+1}). */
+static inline int32_t ccn__bi5_tri(int32_t i, int32_t j, int32_t k) {
+    (void)j;
+    return (6 - i) * (7 - i) / 2 + k;
+}
+/* Guide parameters -> BB coefficients, m columns: par (npar x m) -> bb (28n x m), row-major. */
+void ccn__bi5_guide_bb(int32_t n, const double *par, int32_t m, double *bb);
+/* Sampling matrix S (36 x 28): bi-5 coefficients of the corner jets [g o (mu phi)] for the
+ * sector-0 triangle piece g, phi a planar bi-d patch ((d+1)^2 complex, [i*(d+1)+j]); corners:
+ * bit 0 = (0,0), 1 = (1,0), 2 = (0,1), 3 = (1,1). Other rows are zero. */
+void ccn__bi5_sample(int32_t n, const double complex *phi, int32_t d, double mu,
+                     unsigned corners, double S[36 * 28]);
+/* Design matrix and its QR factorisation (SPEC §4.4). */
+ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err);
+/* Least-squares guide fit: tcc (n x 36 x m, raised t_CC), b600 (m) -> gbb (n x 28 x m). */
+ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double *b600,
+                              int32_t m, double *gbb, ccn_error *err);
+
+#endif

@@ -1,0 +1,357 @@
+/* One level of refinement: face, edge and vertex points, new topology, new intervals.
+ *
+ * Rules (DESIGN §4.2, §4.3, §6.1 of Li 2016):
+ *  - quads away from extraordinary vertices: tensor-product knot insertion (bspline.c);
+ *  - faces with != 4 sides (level 0 only) and interior EVs: NURSS (nurss.c);
+ *  - scheme EIGEN: the 2n+1 "red" points of every interior EV (its vertex point, its spoke
+ *    edge points, the face points of its faces) come from the matrix M of eigen.c applied to
+ *    its 1-ring (§6.1); if M cannot be built the EV falls back to NURSS (counted). From level
+ *    1 on this holds for every EV; at level 0 only for an EV that is already what the NURSS
+ *    step would make it (quad 1-ring, no other EV on its faces, e_i = d_i); the others get
+ *    the NURSS step first (DESIGN §4.3);
+ *  - scheme CATMULL_CLARK: all intervals are 1, which makes every rule above Catmull-Clark.
+ *  - boundaries: the boundary is a cubic B-spline curve of the boundary polygon; valence-2
+ *    corners are smooth, or fixed with CCN_CORNERS_PINNED.
+ *
+ * New numbering (documented in ccnurbs.h): vertices = face points (face order), edge points
+ * (edge order), vertex points (vertex order). Face f's corner j (half-edge h = fstart[f]+j)
+ * becomes quad h = (V_j, E(h_j), F, E(h_{j-1})), so new face index = old half-edge index.
+ * Edges: old edge e splits into 2e (at everts[2e]) and 2e+1 (at everts[2e+1]); the edge from
+ * the face point of f to the edge point of h_j is 2*ne + fstart[f] + j.
+ */
+#include "refine/level.h"
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "rules/bspline.h"
+#include "rules/nurss.h"
+#include "topology/knots.h"
+#include "topology/mesh.h"
+
+#include <math.h>
+#include <string.h>
+
+/* ---- points ----------------------------------------------------------------------- */
+
+typedef struct { const ccn__level *c; double *fp, *ep, *vp; } points_job;
+
+static void face_range(void *ctx, int32_t b, int32_t e) {
+    const points_job *j = ctx;
+    const ccn_mesh *m = j->c->m;
+    for (int32_t f = b; f < e; f++) {
+        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, j->c->pinned, j->fp + 3 * (size_t)f);
+        else ccn__ngon_face_point(m, f, j->fp + 3 * (size_t)f);
+    }
+}
+
+static void edge_range(void *ctx, int32_t b, int32_t end) {
+    const points_job *j = ctx;
+    const ccn__level *c = j->c;
+    for (int32_t e = b; e < end; e++) {
+        ccn__curve_edge_point(c->m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+        ccn__edge_point(c->m, c->erep[e], c->H, j->fp, j->ep + 3 * (size_t)e);
+    }
+}
+
+static void vertex_range(void *ctx, int32_t b, int32_t e) {
+    const points_job *j = ctx;
+    const ccn__level *c = j->c;
+    const ccn_mesh *m = c->m;
+    for (int32_t v = b; v < e; v++) {
+        double *out = j->vp + 3 * (size_t)v;
+        if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
+            memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        } else if (m->vboundary[v]) {
+            ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
+        } else {
+            ccn__nurss_vertex_point(m, v, c->H, j->fp, out);
+        }
+    }
+}
+
+/* ---- red points: the eigen matrix M at each EV ------------------------------------ */
+
+static ccn_status build_ev_matrices(ccn__level *c, ccn_error *err) {
+    const ccn_mesh *m = c->m;
+    size_t total = 0;
+    int32_t maxn = 0;
+    for (int32_t i = 0; i < c->nev; i++) {
+        int32_t n = ccn__valence(m, c->ev_list[i]);
+        c->Moff[i] = total;
+        total += (size_t)(2 * n + 1) * (size_t)(2 * n + 1);
+        if (n > maxn) maxn = n;
+    }
+    c->M = malloc(sizeof(double) * (total ? total : 1));
+    double *d = malloc(sizeof(double) * (size_t)(maxn ? maxn : 1));
+    if (!c->M || !d) {
+        free(d);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV matrices)");
+    }
+    for (int32_t i = 0; i < c->nev; i++) {
+        int32_t v = c->ev_list[i], n = ccn__valence(m, v);
+        for (int32_t k = 0; k < n; k++) d[k] = m->eknot[ccn__fan_edge(m, v, k)];
+        ccn_ev_info info;
+        ccn_status st = ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, c->M + c->Moff[i], &info, NULL);
+        if (st) {
+            free(d);
+            return ccn__fail(err, st, CCN_ELEM_VERTEX, v,
+                             "extraordinary vertex %d: refinement matrix failed", (int)v);
+        }
+        c->fallbacks += info.fallback != 0;
+    }
+    free(d);
+    return CCN_OK;
+}
+
+/* Index of 1-ring point j (F_0..F_{n-1}, E_0..E_{n-1}, V) of EV v in the old mesh. */
+static int32_t ring_point(const ccn_mesh *m, int32_t v, int32_t n, int32_t j) {
+    if (j == 2 * n) return v;
+    int32_t h = m->vfan[m->vfan_start[v] + (j % n)];
+    int32_t nh = ccn__next(m, h);
+    return j < n ? m->hvert[ccn__next(m, nh)] : m->hvert[nh];
+}
+
+/* Overwrites the red points of kind `which` (0 faces, 1 spokes, 2 vertex). */
+static void apply_red(const ccn__level *c, int which, double *fp, double *ep, double *vp) {
+    const ccn_mesh *m = c->m;
+    for (int32_t i = 0; i < c->nev; i++) {
+        int32_t v = c->ev_list[i], n = ccn__valence(m, v), sz = 2 * n + 1;
+        const double *M = c->M + c->Moff[i];
+        int32_t r0 = which == 0 ? 0 : which == 1 ? n : 2 * n, r1 = which == 2 ? sz : r0 + n;
+        for (int32_t r = r0; r < r1; r++) {
+            double acc[3] = {0, 0, 0};
+            for (int32_t j = 0; j < sz; j++) {
+                const double *p = m->pos + 3 * (size_t)ring_point(m, v, n, j);
+                double w = M[(size_t)r * sz + j];
+                acc[0] += w * p[0]; acc[1] += w * p[1]; acc[2] += w * p[2];
+            }
+            int32_t h = m->vfan[m->vfan_start[v] + (r % n)];
+            double *out = which == 0 ? fp + 3 * (size_t)m->hface[h]
+                        : which == 1 ? ep + 3 * (size_t)m->hedge[h]
+                                     : vp + 3 * (size_t)v;
+            memcpy(out, acc, sizeof acc);
+        }
+    }
+}
+
+/* ---- topology of the refined mesh -------------------------------------------------- */
+
+static int32_t child_edge(const ccn_mesh *m, int32_t e, int32_t v) {
+    return m->everts[2 * e] == v ? 2 * e : 2 * e + 1;
+}
+
+static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand) {
+    int32_t nf = m->nf, ne = m->ne;
+    for (int32_t e = 0; e < ne; e++) {
+        int32_t ep = nf + e;
+        r->everts[4 * e + 0] = nf + ne + m->everts[2 * e];
+        r->everts[4 * e + 1] = ep;
+        r->everts[4 * e + 2] = ep;
+        r->everts[4 * e + 3] = nf + ne + m->everts[2 * e + 1];
+        cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
+    }
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
+        for (int32_t j = 0; j < n; j++) {
+            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n;
+            int32_t v = m->hvert[h], q = 4 * h, inner = 2 * ne + h;
+            int32_t innerp = 2 * ne + hp;
+            r->hvert[q + 0] = nf + ne + v;
+            r->hvert[q + 1] = nf + m->hedge[h];
+            r->hvert[q + 2] = f;
+            r->hvert[q + 3] = nf + m->hedge[hp];
+            r->hedge[q + 0] = child_edge(m, m->hedge[h], v);
+            r->hedge[q + 1] = inner;
+            r->hedge[q + 2] = innerp;
+            r->hedge[q + 3] = child_edge(m, m->hedge[hp], v);
+            int32_t t = m->htwin[h], tp = m->htwin[hp];
+            r->htwin[q + 0] = t >= 0 ? 4 * ccn__next(m, t) + 3 : -1;
+            r->htwin[q + 1] = 4 * hn + 2;
+            r->htwin[q + 2] = 4 * hp + 1;
+            r->htwin[q + 3] = tp >= 0 ? 4 * tp : -1;
+            r->everts[2 * inner] = f;
+            r->everts[2 * inner + 1] = nf + m->hedge[h];
+            /* NURSS Fig. 10: half the mean of the two sides adjacent to edge j (for a quad
+             * with consistent rings: half the parallel ring's interval) */
+            cand[inner] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
+            for (int k = 0; k < 4; k++) r->hface[q + k] = h;
+        }
+    }
+    for (int32_t q = 0; q <= r->nf; q++) r->fstart[q] = 4 * q;
+}
+
+static int all_quads(const ccn_mesh *m) {
+    for (int32_t f = 0; f < m->nf; f++)
+        if (ccn__fsize(m, f) != 4) return 0;
+    return 1;
+}
+
+static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, ccn_error *err) {
+    if (all_quads(m)) { /* rings stay consistent: every interval halves */
+        memcpy(r->eknot, cand, sizeof(double) * (size_t)r->ne);
+        double mx = 0.0;
+        for (int32_t e = 0; e < r->ne; e++) mx = r->eknot[e] > mx ? r->eknot[e] : mx;
+        for (int32_t e = 0; e < r->ne; e++) r->eknot[e] /= mx;
+        r->knot_scale = m->knot_scale * mx;
+        r->info.num_rings = 2 * m->info.num_rings; /* each ring splits in two */
+        return CCN_OK;
+    }
+    for (int32_t e = 0; e < r->ne; e++) cand[e] *= m->knot_scale;
+    int32_t conflicts = m->info.num_ring_conflicts;
+    ccn_status st = ccn__resolve_rings(r, cand, NULL, err);
+    r->info.num_ring_conflicts = conflicts;
+    return st;
+}
+
+/* ---- one level ---------------------------------------------------------------------- */
+
+static int regular_interior(const ccn_mesh *m, int32_t v) {
+    return !m->vboundary[v] && ccn__valence(m, v) == 4;
+}
+
+static int same_interval(double a, double b) {
+    return fabs(a - b) <= 1e-12 * fmax(a, b);
+}
+
+/* Level 0: may EV v take M already (Li 2016 §6.1), instead of the NURSS step that exists to
+ * split non-quads, separate EVs and make e_i = d_i? Only when all of that already holds: every
+ * face of v is a quad, every other corner of those faces is an interior valence-4 vertex (so no
+ * other EV or n-gon shares a face with v), and each spoke continues beyond its end E_i with the
+ * spoke's own interval (e_i = d_i, Fig. 3/5 — what M assumes). See README "Design notes". */
+static int ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t h = m->vfan[k];
+        if (ccn__fsize(m, m->hface[h]) != 4) return 0;
+        int32_t h1 = ccn__next(m, h), h2 = ccn__next(m, h1), h3 = ccn__next(m, h2);
+        if (!regular_interior(m, m->hvert[h1]) || !regular_interior(m, m->hvert[h2]) ||
+            !regular_interior(m, m->hvert[h3]))
+            return 0;
+        int32_t t = m->htwin[h]; /* E_i -> v: the edge beyond E_i is opposite in E_i's fan */
+        int32_t e = m->vfan_start[m->hvert[t]];
+        int32_t beyond = m->hedge[m->vfan[e + (m->hfanpos[t] + 2) % 4]];
+        if (!same_interval(m->eknot[m->hedge[h]], m->eknot[beyond])) return 0;
+    }
+    return 1;
+}
+
+static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
+    const ccn_mesh *m = c->m;
+    c->nev = 0;
+    if (!c->red) return CCN_OK;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!ccn__is_ev(m, v)) continue;
+        if (m->info.level == 0 && !ev_ready_at_level0(m, v)) continue; /* NURSS step */
+        if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; continue; }
+        c->ev_list[c->nev++] = v;
+    }
+    return build_ev_matrices(c, err);
+}
+
+void ccn__level_free(ccn__level *c) {
+    if (!c) return;
+    free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
+    memset(c, 0, sizeof *c);
+}
+
+ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                              ccn_error *err) {
+    memset(c, 0, sizeof *c);
+    c->m = m;
+    c->pinned = pinned;
+    c->red = scheme == CCN_SCHEME_EIGEN;
+    c->threads = 1;
+    c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
+    c->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
+    c->ev_list = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    c->Moff = malloc(sizeof(size_t) * (size_t)(m->nv ? m->nv : 1));
+    if (!c->H || !c->erep || !c->ev_list || !c->Moff) {
+        ccn__level_free(c);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (refinement)");
+    }
+    for (int32_t e = 0; e < m->ne; e++) c->erep[e] = -1;
+    for (int32_t h = m->nh - 1; h >= 0; h--) c->erep[m->hedge[h]] = h;
+    ccn_status st = collect_evs(c, err);
+    if (st) ccn__level_free(c);
+    return st;
+}
+
+void ccn__level_points(const ccn__level *c, double *out) {
+    const ccn_mesh *m = c->m;
+    double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
+    points_job j = {c, fp, ep, vp};
+    ccn__parallel_for(c->threads, m->nf, face_range, &j);
+    apply_red(c, 0, fp, ep, vp);
+    ccn__parallel_for(c->threads, m->ne, edge_range, &j);
+    apply_red(c, 1, fp, ep, vp);
+    ccn__parallel_for(c->threads, m->nv, vertex_range, &j);
+    apply_red(c, 2, fp, ep, vp);
+}
+
+/* Only the points around the listed vertices: their vertex points, the edge points of
+ * their edges and the face points of their faces (plus every EV's red points). */
+void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
+                              double *out) {
+    const ccn_mesh *m = c->m;
+    double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i];
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
+            else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
+        }
+    }
+    apply_red(c, 0, fp, ep, vp);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i], n = ccn__valence(m, v);
+        for (int32_t k = 0; k < n; k++) {
+            int32_t e = ccn__fan_edge(m, v, k);
+            ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+            ccn__edge_point(m, c->erep[e], c->H, fp, ep + 3 * (size_t)e);
+        }
+    }
+    apply_red(c, 1, fp, ep, vp);
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i];
+        double *o = vp + 3 * (size_t)v;
+        if (m->vfan_start[v + 1] == m->vfan_start[v]) memcpy(o, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        else if (m->vboundary[v]) ccn__boundary_vertex_point(m, v, c->H, c->pinned, o);
+        else ccn__nurss_vertex_point(m, v, c->H, fp, o);
+    }
+    apply_red(c, 2, fp, ep, vp);
+}
+
+ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err) {
+    const ccn_mesh *m = c->m;
+    int64_t nv2 = (int64_t)m->nf + m->ne + m->nv, nh2 = 4 * (int64_t)m->nh;
+    int64_t ne2 = 2 * (int64_t)m->ne + m->nh;
+    *out = NULL;
+    if (nh2 > INT32_MAX / 8 || nv2 > INT32_MAX / 8 || ne2 > INT32_MAX / 8)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                         "refined mesh would have %lld face corners: too large", (long long)nh2);
+    ccn_mesh *r = ccn__mesh_alloc((int32_t)nv2, m->nh, (int32_t)nh2, (int32_t)ne2);
+    double *cand = malloc(sizeof(double) * (size_t)ne2);
+    ccn_status st = CCN_OK;
+    if (!r || !cand) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                       "out of memory for a refined mesh of %lld face corners", (long long)nh2);
+        goto done;
+    }
+    refine_topology(m, r, cand);
+    if (ccn__mesh_build_fans(r)) {
+        st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
+        goto done;
+    }
+    if ((st = new_intervals(m, r, cand, err))) goto done;
+    ccn__mesh_update_info(r);
+    r->info.num_ring_conflicts = m->info.num_ring_conflicts;
+    r->info.num_ignored_edges = m->info.num_ignored_edges;
+    r->info.num_ev_fallbacks = m->info.num_ev_fallbacks + c->fallbacks;
+    r->info.level = m->info.level + 1;
+    *out = r;
+    r = NULL;
+done:
+    free(cand);
+    ccn_mesh_destroy(r);
+    return st;
+}

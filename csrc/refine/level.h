@@ -1,0 +1,34 @@
+/* One refinement level, split so that a plan can re-run only the point arithmetic
+ * (internal; refine/level.c). */
+#ifndef CCN_REFINE_LEVEL_H
+#define CCN_REFINE_LEVEL_H
+
+#include "topology/halfedge.h"
+
+#include <stddef.h>
+
+#define CCN_EV_MATRIX_MAX_VALENCE 1024 /* above: NURSS rules (memory grows as valence^2) */
+
+typedef struct {
+    const ccn_mesh *m;   /* the level's topology, intervals and (input) positions */
+    int pinned, red;     /* red: eigen matrices at the EVs */
+    int threads;         /* for ccn__level_points (set by the owner; default 1) */
+    int32_t *erep;       /* a half-edge per edge */
+    int32_t nev, *ev_list;
+    double *M;           /* concatenated EV matrices ((2n+1)^2 each) */
+    size_t *Moff;
+    double *H;           /* scratch: 3*ne curve edge points */
+    int32_t fallbacks;
+} ccn__level;
+ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                              ccn_error *err);
+/* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
+void ccn__level_points(const ccn__level *c, double *out);
+/* Next-level points around the listed vertices only (see refine/level.c). */
+void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
+                              double *out);
+/* Topology and intervals of the next level (positions uninitialised). */
+ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
+void ccn__level_free(ccn__level *c);
+
+#endif

@@ -1,0 +1,105 @@
+/* Knot-insertion stencils on a quad mesh with ring intervals (DESIGN §4.2).
+ *
+ * Every rule is the tensor product of the curve rules
+ *   edge point   E_j = ((D_j + 2D_{j+1}) P_j + (D_j + 2D_{j-1}) P_{j+1}) / (2(D_{j-1}+D_j+D_{j+1}))
+ *   vertex point V_j = (D_j E_{j-1} + D_{j-1} E_j) / (2(D_{j-1}+D_j)) + P_j/2
+ * (Li 2016 eqs (5)-(7) are the case "e = d"). The intervals a stencil needs beyond the
+ * points it touches come from rings; where no ring exists they are defined by:
+ *  - straight through an interior valence-4 vertex: the opposite edge of the fan;
+ *  - straight through an interior EV: p_i = (d_{i-2} + d_{i+2}) / 2 (NURSS, SPEC A9);
+ *  - a boundary vertex, edge transverse to the boundary: the edge's own interval (mirror);
+ *  - a boundary vertex, edge along the boundary: the other boundary edge (the boundary is a
+ *    cubic B-spline curve), or the edge's own interval at a pinned valence-2 corner.
+ * Stencils read old control points only.
+ */
+#include "rules/bspline.h"
+
+double ccn__beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
+    int32_t n = ccn__valence(m, v);
+    int32_t e = ccn__fan_edge(m, v, k);
+    if (m->vboundary[v]) {
+        if (k != 0 && k != n - 1) return m->eknot[e];
+        if (pinned && n == 2) return m->eknot[e];
+        return m->eknot[ccn__fan_edge(m, v, k == 0 ? n - 1 : 0)];
+    }
+    if (n == 4) return m->eknot[ccn__fan_edge(m, v, (k + 2) & 3)];
+    return 0.5 * (m->eknot[ccn__fan_edge(m, v, (k + n - 2) % n)] +
+                  m->eknot[ccn__fan_edge(m, v, (k + 2) % n)]);
+}
+
+int32_t ccn__pos_at_end(const ccn_mesh *m, int32_t h) {
+    int32_t t = m->htwin[h];
+    if (t >= 0) return m->hfanpos[t];
+    return ccn__valence(m, m->hvert[ccn__next(m, h)]) - 1; /* incoming boundary edge */
+}
+
+double ccn__transverse(const ccn_mesh *m, int32_t h) {
+    if (ccn__fsize(m, m->hface[h]) == 4) return m->eknot[m->hedge[ccn__next(m, h)]];
+    return 0.5 * (m->eknot[m->hedge[ccn__next(m, h)]] + m->eknot[m->hedge[ccn__prev(m, h)]]);
+}
+
+double ccn__side(const ccn_mesh *m, int32_t h, int pinned) {
+    int32_t v0 = m->hvert[h], v1 = m->hvert[ccn__next(m, h)];
+    int ev0 = ccn__is_ev(m, v0), ev1 = ccn__is_ev(m, v1);
+    if (ev0 || ev1) {
+        /* NURSS: the interval straight through the EV along f's other edge at it */
+        double s = 0.0;
+        if (ev0) s += ccn__beyond(m, v0, m->hfanpos[m->htwin[ccn__prev(m, h)]], pinned);
+        if (ev1) s += ccn__beyond(m, v1, m->hfanpos[ccn__next(m, h)], pinned);
+        return ev0 && ev1 ? 0.5 * s : s;
+    }
+    int32_t t = m->htwin[h];
+    if (t >= 0) return ccn__transverse(m, t);
+    return m->eknot[m->hedge[ccn__next(m, h)]]; /* mirror across the boundary */
+}
+
+static void lerp3(const double *a, const double *b, double w, double out[3]) {
+    for (int k = 0; k < 3; k++) out[k] = (1.0 - w) * a[k] + w * b[k];
+}
+
+void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]) {
+    int32_t a = m->hvert[h], nh = ccn__next(m, h), b = m->hvert[nh];
+    double dp = ccn__beyond(m, a, m->hfanpos[h], pinned);
+    double dn = ccn__beyond(m, b, ccn__pos_at_end(m, h), pinned);
+    double w = ccn__edge_weight(dp, m->eknot[m->hedge[h]], dn);
+    lerp3(m->pos + 3 * (size_t)a, m->pos + 3 * (size_t)b, w, out);
+}
+
+void ccn__quad_face_point(const ccn_mesh *m, int32_t f, int pinned, double out[3]) {
+    int32_t h0 = m->fstart[f];
+    const double *p0 = m->pos + 3 * (size_t)m->hvert[h0], *p1 = m->pos + 3 * (size_t)m->hvert[h0 + 1],
+                 *p2 = m->pos + 3 * (size_t)m->hvert[h0 + 2], *p3 = m->pos + 3 * (size_t)m->hvert[h0 + 3];
+    double a = m->eknot[m->hedge[h0]], b = m->eknot[m->hedge[h0 + 1]];
+    double s = ccn__edge_weight(ccn__side(m, h0 + 3, pinned), a, ccn__side(m, h0 + 1, pinned));
+    double t = ccn__edge_weight(ccn__side(m, h0, pinned), b, ccn__side(m, h0 + 2, pinned));
+    double w0 = (1 - s) * (1 - t), w1 = s * (1 - t), w2 = s * t, w3 = (1 - s) * t;
+    for (int k = 0; k < 3; k++) out[k] = w0 * p0[k] + w1 * p1[k] + w2 * p2[k] + w3 * p3[k];
+}
+
+void ccn__edge_point(const ccn_mesh *m, int32_t h, const double *H, const double *fp,
+                     double out[3]) {
+    int32_t t = m->htwin[h], e = m->hedge[h];
+    const double *he = H + 3 * (size_t)e;
+    if (t < 0) {
+        for (int k = 0; k < 3; k++) out[k] = he[k];
+        return;
+    }
+    double bl = ccn__transverse(m, h), br = ccn__transverse(m, t);
+    const double *fl = fp + 3 * (size_t)m->hface[h], *fr = fp + 3 * (size_t)m->hface[t];
+    double s = 1.0 / (2.0 * (bl + br));
+    for (int k = 0; k < 3; k++) out[k] = 0.5 * he[k] + s * (br * fl[k] + bl * fr[k]);
+}
+
+void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, int pinned,
+                                double out[3]) {
+    const double *p = m->pos + 3 * (size_t)v;
+    if (pinned && ccn__valence(m, v) == 2) {
+        for (int k = 0; k < 3; k++) out[k] = p[k];
+        return;
+    }
+    int32_t eo = ccn__fan_edge(m, v, 0), ei = m->vlast_edge[v];
+    double dout = m->eknot[eo], din = m->eknot[ei];
+    const double *hi = H + 3 * (size_t)ei, *ho = H + 3 * (size_t)eo;
+    double s = 1.0 / (2.0 * (din + dout));
+    for (int k = 0; k < 3; k++) out[k] = 0.5 * p[k] + s * (dout * hi[k] + din * ho[k]);
+}

@@ -1,0 +1,38 @@
+/* Non-uniform cubic B-spline knot insertion in knot-interval form (DESIGN §4.2) and its
+ * tensor-product use on a quad mesh with ring intervals. Internal. */
+#ifndef CCN_RULES_BSPLINE_H
+#define CCN_RULES_BSPLINE_H
+
+#include "topology/halfedge.h"
+
+/* Curve edge point E_j = (1-w) P_j + w P_{j+1} for the midpoint of the span with interval d,
+ * dp the interval before P_j and dn the one after P_{j+1} (DESIGN §4.2, Li 2016 eq (5)). */
+static inline double ccn__edge_weight(double dp, double d, double dn) {
+    return (2.0 * dp + d) / (2.0 * (dp + d + dn));
+}
+
+/* Interval beyond vertex v along the k-th edge of its fan (straight through v). */
+double ccn__beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned);
+/* Interval of the quad f on the far side of edge(h) (h in f), measured transversally. */
+double ccn__side(const ccn_mesh *m, int32_t h, int pinned);
+/* Interval of face(h) transverse to edge(h). */
+double ccn__transverse(const ccn_mesh *m, int32_t h);
+/* Position of edge(h) in the fan of h's end vertex. */
+int32_t ccn__pos_at_end(const ccn_mesh *m, int32_t h);
+/* Is v an interior vertex of valence != 4? */
+static inline int ccn__is_ev(const ccn_mesh *m, int32_t v) {
+    return !m->vboundary[v] && m->vfan_start[v + 1] > m->vfan_start[v] && ccn__valence(m, v) != 4;
+}
+
+/* Curve edge point of edge(h) (knot insertion along the edge). */
+void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]);
+/* Tensor-product face point of quad face f (knot insertion in both directions). */
+void ccn__quad_face_point(const ccn_mesh *m, int32_t f, int pinned, double out[3]);
+/* Edge point of an interior edge: H/2 + transverse blend of the two new face points. */
+void ccn__edge_point(const ccn_mesh *m, int32_t h, const double *H, const double *fp,
+                     double out[3]);
+/* Boundary vertex: the curve vertex rule along the boundary (or pinned corner). */
+void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, int pinned,
+                                double out[3]);
+
+#endif

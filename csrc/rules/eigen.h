@@ -1,0 +1,36 @@
+/* Internal helpers of the extraordinary-vertex matrix (rules/eigen.c).
+ *
+ * Li, Finnigan, Sederberg 2016, "G1 non-uniform Catmull-Clark surfaces", sections 4-6, with
+ * the readings of shared/reference/eigen/SPEC.md section 2 (cited below as SPEC 2.x).
+ * Not part of the public API; every symbol is ccn__ prefixed.
+ */
+#ifndef CCN_RULES_EIGEN_H
+#define CCN_RULES_EIGEN_H
+
+#include "ccnurbs.h"
+
+/* Largest valence ccn_ev_matrix accepts. The eigen polyhedron costs O(n^2) and M itself has
+ * (2n+1)^2 entries (n = 65536 would already be a 34 GB matrix). */
+#define CCN__EV_MAX_VALENCE 65536
+
+/* Up to this valence ccn_ev_matrix uses stack scratch; above it one malloc. */
+#define CCN__EV_STACK_VALENCE 64
+
+/* Spoke intervals are divided by their maximum and clamped to at least this (DESIGN 4.5). */
+#define CCN__EV_MIN_INTERVAL 1e-6
+
+/* Eigen-rule sanity limits; outside them ccn_ev_matrix falls back to the NURSS rules. */
+#define CCN__EV_PARAM_LO (-0.5)
+#define CCN__EV_PARAM_HI 1.5
+#define CCN__EV_MAX_RESIDUAL 1e-8
+
+/* cos(2 pi k / n) and sin(2 pi k / n), with exact 0, +-1 at the quarter points (so n = 4
+ * reproduces the tensor rules exactly) and symmetric rounding elsewhere. n >= 1. */
+void ccn__cos_sin_2pi(int64_t k, int64_t n, double *c, double *s);
+
+/* Catmull-Clark's subdominant eigenvalue, eq (15): lambda = (5 + c + sqrt((c+9)(c+1)))/16,
+ * c = cos(2 pi / n); and gamma of eq (14) (F_i = gamma (E_i + E_{i+1}), eq (13)). n >= 3. */
+double ccn__ev_lambda(int32_t n);
+double ccn__ev_gamma(int32_t n);
+
+#endif

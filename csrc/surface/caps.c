@@ -1,0 +1,257 @@
+/* The guided bi-5 caps of a plan (K&P 2018, bi5/bi5.h): the cap level K (EVs isolated by three
+ * regular rings), each EV's c-net, 1-ring and limit weights, the shared operator per valence,
+ * the exact level-(K+1) surround for arbitrary non-uniform intervals (surface/surround.c), the
+ * fallbacks, and their evaluation (caps and the bicubic ring faces around them). */
+#include "surface/caps.h"
+
+#include "base/error.h"
+#include "base/vec3.h"
+#include "bi5/bi5.h"
+#include "rules/bspline.h"
+#include "surface/limit.h"
+#include "surface/patches.h"
+#include "surface/plan_levels.h"
+#include "surface/surround.h"
+
+#include <math.h>
+#include <string.h>
+
+#define CCN_CAP_MAX_VALENCE 32
+
+void ccn__cap_free(ccn__cap *c) {
+    free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
+    free(c->taus);
+    memset(c, 0, sizeof *c);
+}
+
+/* ---- caps ------------------------------------------------------------------------- */
+
+/* Is every vertex within three face rings of ev (except ev) interior and of valence 4? */
+static int cap_isolated(const ccn_mesh *m, int32_t ev, int32_t *stamp, int32_t *queue) {
+    int32_t qn = 0, qh = 0;
+    stamp[ev] = ev;
+    queue[qn++] = ev;
+    for (int ring = 0; ring < 3; ring++) {
+        int32_t end = qn;
+        for (; qh < end; qh++) {
+            int32_t v = queue[qh];
+            for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+                int32_t f = m->hface[m->vfan[k]];
+                for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+                    int32_t w = m->hvert[h];
+                    if (stamp[w] == ev) continue;
+                    stamp[w] = ev;
+                    if (m->vboundary[w] || ccn__valence(m, w) != 4) return 0;
+                    queue[qn++] = w;
+                }
+            }
+            if (m->vboundary[v] && v != ev) return 0;
+        }
+    }
+    return 1;
+}
+
+static int32_t count_evs(const ccn_mesh *m) {
+    int32_t n = 0;
+    for (int32_t v = 0; v < m->nv; v++) n += ccn__is_ev(m, v);
+    return n;
+}
+
+/* The c-net (SPEC §1.2): per sector k, grid nodes (2,0),(2,1),(2,2),(1,2),(1,1),(1,0). */
+static void cap_cnet(const ccn_mesh *m, int32_t ev, int32_t n, int32_t *cnet) {
+    cnet[0] = ev;
+    for (int32_t k = 0; k < n; k++) {
+        int32_t h = m->vfan[m->vfan_start[ev] + k];
+        int32_t g = ccn__next(m, h);        /* E_k -> F_k in face k */
+        int32_t t = m->htwin[g];            /* F_k -> E_k: face (1,1),(1,0),(2,0),(2,1) */
+        int32_t y = ccn__next(m, ccn__next(m, t));
+        int32_t t2 = m->htwin[ccn__prev(m, t)]; /* F_k -> (2,1): face (1,1),(2,1),(2,2),(1,2) */
+        int32_t *c = cnet + 1 + 6 * k;
+        c[0] = m->hvert[y];                            /* (2,0) */
+        c[1] = m->hvert[ccn__next(m, t2)];             /* (2,1) */
+        c[2] = m->hvert[ccn__next(m, ccn__next(m, t2))]; /* (2,2) */
+        c[3] = m->hvert[ccn__prev(m, t2)];             /* (1,2) */
+        c[4] = m->hvert[ccn__next(m, g)];              /* (1,1) = F_k */
+        c[5] = m->hvert[g];                            /* (1,0) = E_k */
+    }
+}
+
+/* The operator for valence n: the paper's ring speeds, or (exact_surround) a first ring of
+ * speed 1/2 in front of them (bi5.h [R13]). Shared by the caps of the plan. */
+static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround, ccn_error *err) {
+    int32_t key = exact_surround ? -n : n;
+    for (int32_t i = 0; i < p->nops; i++)
+        if (p->op_n[i] == key) return p->ops[i];
+    static const double s5[3] = {0.75, 0.875, 0.875}, s3[1] = {15.0 / 16.0};
+    static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
+    const double *sig = exact_surround ? (n == 3 ? h3 : h5) : (n == 3 ? s3 : s5);
+    int32_t nsig = (n == 3 ? 1 : 3) + (exact_surround ? 1 : 0);
+    struct ccn__bi5 **ops = realloc(p->ops, sizeof(*ops) * ((size_t)p->nops + 1));
+    if (ops) p->ops = ops;
+    int32_t *op_n = realloc(p->op_n, sizeof(int32_t) * ((size_t)p->nops + 1));
+    if (op_n) p->op_n = op_n;
+    if (!ops || !op_n) return NULL;
+    if (ccn__bi5_create(n, sig, nsig, &p->ops[p->nops], err)) return NULL;
+    p->op_n[p->nops] = key;
+    return p->ops[p->nops++];
+}
+
+/* Arbitrary NU intervals: switch cap c to the exact level-(K+1) surround (bi5.h [R13]) and
+ * check that it exists and that the construction runs; 1 on success. */
+static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *zero, ccn_error *e2) {
+    if (p->R < p->K + 1 && ccn__plan_build_levels(p, p->K + 1, e2)) return 0;
+    const struct ccn__bi5 *op = cap_op(p, c->n, 1, e2);
+    if (!op) return 0;
+    /* the taus depend on the last ring's speed only, which both operators share */
+    if (op->sig[op->nsig - 1] != c->op->sig[c->op->nsig - 1]) return 0;
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    free(c->patches);
+    c->op = op;
+    c->exact_surround = 1;
+    c->patches = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(op));
+    c->pieces = calloc(432 * (size_t)c->n, sizeof(double));
+    return c->patches && c->pieces &&
+           ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], ev, pinned, NULL) &&
+           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, c->taus, zero, c->patches, e2) == CCN_OK;
+}
+
+/* Sets up the cap of EV ev at level K; returns 1 if it was added, 0 for a fallback. */
+static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
+    const ccn_mesh *m = p->lev[p->K];
+    int32_t n = ccn__valence(m, ev);
+    if (n > CCN_CAP_MAX_VALENCE) return 0;
+    ccn_error e2;
+    const struct ccn__bi5 *op = cap_op(p, n, 0, &e2);
+    if (!op) return 0;
+    ccn__cap *c = &p->caps[p->ncap];
+    memset(c, 0, sizeof *c);
+    c->n = n;
+    c->op = op;
+    c->cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));
+    c->ring = malloc(sizeof(int32_t) * (2 * (size_t)n + 1));
+    c->l0 = malloc(sizeof(double) * (2 * (size_t)n + 1));
+    c->knots = malloc(sizeof(double) * (size_t)n);
+    c->patches = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(op));
+    double *zero = calloc(3 * (6 * (size_t)n + 1), sizeof(double));
+    ccn__stencil *s = malloc(sizeof *s);
+    int ok = c->cnet && c->ring && c->l0 && c->knots && c->patches && zero && s;
+    if (ok) {
+        cap_cnet(m, ev, n, c->cnet);
+        ccn__ev_ring(m, ev, c->ring);
+        for (int32_t k = 0; k < n; k++) c->knots[k] = m->eknot[ccn__fan_edge(m, ev, k)];
+        ok = ccn__ev_limit(m, ev, p->opts.scheme, s, &e2) == CCN_OK;
+        for (int32_t j = 0; ok && j < 2 * n + 1; j++) c->l0[j] = s->wp[j];
+        int nu = 0; /* some kappa_s = d_{s+1}/d_{s-1} != 1: taus, once (they need no positions) */
+        for (int32_t k = 0; k < n; k++)
+            nu |= fabs(c->knots[(k + 1) % n] / c->knots[(k + n - 1) % n] - 1.0) > 1e-12;
+        if (ok && nu) {
+            c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+            ok = c->taus && ccn__bi5_nu_taus(op, c->knots, c->taus, &e2) == CCN_OK;
+        }
+        ccn_status st = ok ? ccn__bi5_apply_cached(op, zero, c->knots, c->taus, zero, c->patches, &e2)
+                           : CCN_ERR_ARGUMENT;
+        if (st == CCN_ERR_KNOTS) ok = cap_use_surround(p, c, ev, zero, &e2);
+        else ok = ok && st == CCN_OK;
+    }
+    free(zero);
+    free(s);
+    if (!ok) {
+        ccn__cap_free(c);
+        return 0;
+    }
+    p->ncap++;
+    (void)err;
+    return 1;
+}
+
+/* Chooses K, builds the caps. */
+ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
+    p->K = -1;
+    if (p->opts.cap != CCN_CAP_GUIDED_BI5) return CCN_OK;
+    ccn_status st0 = ccn__plan_build_levels(p, 1, err);
+    if (st0) return st0;
+    if (count_evs(p->lev[1]) == 0) return CCN_OK;
+    int32_t K = 2;
+    for (; K <= 4; K++) {
+        ccn_status st = ccn__plan_build_levels(p, K, err);
+        if (st) return st;
+        const ccn_mesh *m = p->lev[K];
+        int32_t *stamp = malloc(sizeof(int32_t) * (size_t)m->nv), *q = malloc(sizeof(int32_t) * (size_t)m->nv);
+        if (!stamp || !q) { free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
+        for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
+        int all = 1;
+        for (int32_t v = 0; v < m->nv && all; v++)
+            if (ccn__is_ev(m, v) && !cap_isolated(m, v, stamp, q)) all = 0;
+        free(stamp); free(q);
+        if (all || K == 4) break;
+    }
+    p->K = K;
+    const ccn_mesh *m = p->lev[K];
+    int32_t nev = count_evs(m);
+    p->caps = calloc((size_t)(nev ? nev : 1), sizeof(ccn__cap));
+    int32_t *stamp = malloc(sizeof(int32_t) * (size_t)m->nv), *q = malloc(sizeof(int32_t) * (size_t)m->nv);
+    if (!p->caps || !stamp || !q) { free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
+    for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!ccn__is_ev(m, v)) continue;
+        if (!cap_isolated(m, v, stamp, q) || !cap_add(p, v, err)) p->sizes.num_cap_fallbacks++;
+    }
+    free(stamp); free(q);
+    p->sizes.num_caps = p->ncap;
+    int32_t maxn = 0;
+    for (int32_t c = 0; c < p->ncap; c++) maxn = p->caps[c].n > maxn ? p->caps[c].n : maxn;
+    p->cap_net = malloc(sizeof(double) * 3 * (6 * (size_t)maxn + 1));
+    if (!p->cap_net) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    return CCN_OK;
+}
+
+/* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h). */
+static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out) {
+    const ccn_mesh *mK = p->lev[p->K];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    for (int32_t i = 0; i < p->nrf; i++)
+        if (!ccn__bicubic_patch(mK, p->rf_face[i], pinned, 0, (double(*)[4][3])(p->rf_bez + 48 * (size_t)i)))
+            p->rf_bez[48 * (size_t)i] = NAN; /* not a patch: keep the limit stencil */
+    for (int32_t i = 0; i < p->nbv; i++) {
+        const double *b = p->rf_bez + 48 * (size_t)p->bv_rf[i];
+        if (isnan(b[0])) continue;
+        double x[3], du[3], dv[3];
+        ccn__bezier_eval(b, 3, p->bv_uv[2 * i], p->bv_uv[2 * i + 1], x, du, dv);
+        int32_t o = p->bv_out[i];
+        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
+        if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
+    }
+}
+
+ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
+    if (p->ncap == 0) return CCN_OK;
+    const double *P = p->lev[p->K]->pos;
+    for (int32_t c = 0; c < p->ncap; c++) {
+        ccn__cap *cp = &p->caps[c];
+        int32_t n = cp->n, nc = 6 * n + 1;
+        double *net = p->cap_net, ctr[3] = {0, 0, 0}; /* sized for the largest cap at create */
+        for (int32_t j = 0; j < nc; j++) memcpy(net + 3 * j, P + 3 * (size_t)cp->cnet[j], sizeof(double) * 3);
+        for (int32_t j = 0; j < 2 * n + 1; j++)
+            for (int i = 0; i < 3; i++) ctr[i] += cp->l0[j] * P[3 * (size_t)cp->ring[j] + i];
+        ccn_status st;
+        if (cp->exact_surround) {
+            int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+            if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
+                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
+            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, cp->taus, ctr, cp->patches, err);
+        } else {
+            st = ccn__bi5_apply_cached(cp->op, net, cp->knots, cp->taus, ctr, cp->patches, err);
+        }
+        if (st) return st;
+    }
+    for (int32_t i = 0; i < p->nhv; i++) {
+        const ccn__cap *cp = &p->caps[p->hv_cap[i]];
+        double x[3], du[3], dv[3];
+        ccn__bi5_eval(cp->op, cp->patches, p->hv_sector[i], p->hv_uv[2 * i], p->hv_uv[2 * i + 1], x, du, dv);
+        int32_t o = p->hv_out[i];
+        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
+        if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
+    }
+    eval_ring_faces(p, out);
+    return CCN_OK;
+}

@@ -1,0 +1,345 @@
+/* Exact limit position and tangents of a refined vertex, as a stencil over its neighbours.
+ *
+ * Used on the last refinement level R = L+1 (or deeper), where every output vertex except
+ * an irregular vertex itself is at least two rings away from any irregular vertex, so its
+ * 1-ring refines by tensor knot insertion forever and its limit is the B-spline value at
+ * its knot (and the derivatives there):
+ *  - interior valence 4: tensor product of the 1-D limit stencils below;
+ *  - boundary valence 3 and pinned corners: the same with mirrored ghost points
+ *    P(i,-1) = 2P(i,0) - P(i,1) (the boundary is the B-spline of the mirror extension,
+ *    SPEC [1d]);
+ *  - other boundary vertices (smooth corners, boundary EVs): the boundary curve's limit and
+ *    tangent (exact: boundary rules read boundary points only); the cross-boundary tangent
+ *    is approximated by the direction to the interior neighbours (documented limit);
+ *  - interior EVs: left eigenvectors of the refinement matrix M of the 1-ring (stationary
+ *    from level 1): eigenvalue 1 gives the limit point, the subdominant pair the tangents.
+ *
+ * 1-D limit at knot t_0 of a cubic B-spline with control points P_-1, P_0, P_1 (blossoms
+ * f(t_-2,t_-1,t_0), f(t_-1,t_0,t_1), f(t_0,t_1,t_2)) and intervals D_-2, D_-1, D_0, D_1:
+ *   A = f(t_-1,t_0,t_0) = P_-1 + a (P_0 - P_-1),  a = (D_-2 + D_-1)/(D_-2 + D_-1 + D_0)
+ *   B = f(t_0,t_0,t_1)  = P_0 + b (P_1 - P_0),    b = D_-1/(D_-1 + D_0 + D_1)
+ *   f(t_0) = A + g (B - A), g = D_-1/(D_-1 + D_0);  f'(t_0) = 3 (B - A)/(D_-1 + D_0).
+ */
+#include "surface/limit.h"
+
+#include "base/error.h"
+#include "rules/bspline.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <string.h>
+
+/* 1-D value (w) and derivative (dw) weights on (P_-1, P_0, P_1). */
+void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
+                                double dw[3]) {
+    double a = (dm2 + dm1) / (dm2 + dm1 + d0), b = dm1 / (dm1 + d0 + d1);
+    double g = dm1 / (dm1 + d0), s = 3.0 / (dm1 + d0);
+    double A[3] = {1 - a, a, 0}, B[3] = {0, 1 - b, b};
+    for (int i = 0; i < 3; i++) {
+        w[i] = A[i] + g * (B[i] - A[i]);
+        dw[i] = s * (B[i] - A[i]);
+    }
+}
+
+static ccn__vpoint vp1(int32_t v) {
+    ccn__vpoint p = {{v, 0, 0, 0}, {1, 0, 0, 0}, 1};
+    return p;
+}
+
+/* 2a - b */
+static ccn__vpoint mirror(ccn__vpoint a, ccn__vpoint b) {
+    ccn__vpoint p = a;
+    for (int i = 0; i < p.n; i++) p.w[i] *= 2;
+    for (int i = 0; i < b.n; i++) { p.v[p.n] = b.v[i]; p.w[p.n] = -b.w[i]; p.n++; }
+    return p;
+}
+
+static void stencil_add(ccn__stencil *s, int32_t v, double wp, double wu, double wv) {
+    for (int i = 0; i < s->n; i++)
+        if (s->v[i] == v) { s->wp[i] += wp; s->wu[i] += wu; s->wv[i] += wv; return; }
+    if (s->n >= CCN_STENCIL_MAX) return; /* cannot happen for the shapes built here */
+    s->v[s->n] = v; s->wp[s->n] = wp; s->wu[s->n] = wu; s->wv[s->n] = wv; s->n++;
+}
+
+/* End vertex of the k-th fan edge of v (k may be the boundary's last edge). */
+static int32_t fan_end(const ccn_mesh *m, int32_t v, int32_t k) {
+    int32_t e = ccn__fan_edge(m, v, k);
+    return m->everts[2 * e] == v ? m->everts[2 * e + 1] : m->everts[2 * e];
+}
+/* Diagonal vertex of fan face k. */
+static int32_t fan_diag(const ccn_mesh *m, int32_t v, int32_t k) {
+    int32_t h = m->vfan[m->vfan_start[v] + k];
+    return m->hvert[ccn__next(m, ccn__next(m, h))];
+}
+/* Interval straight beyond the end of fan edge k (away from v). */
+static double beyond_end(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
+    int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v];
+    int32_t end = fan_end(m, v, k), pos;
+    if (k < nfan) pos = ccn__pos_at_end(m, m->vfan[m->vfan_start[v] + k]);
+    else pos = 0; /* the incoming boundary edge is its origin's outgoing boundary edge */
+    return ccn__beyond(m, end, pos, pinned);
+}
+
+/* Tensor stencil over a 3x3 grid of virtual points g[i+1][j+1], i along u, j along v. */
+static void tensor_stencil(ccn__vpoint g[3][3], const double wu[3], const double dwu[3],
+                           const double wv[3], const double dwv[3], ccn__stencil *s) {
+    s->n = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            for (int k = 0; k < g[i][j].n; k++) {
+                double c = g[i][j].w[k];
+                stencil_add(s, g[i][j].v[k], c * wu[i] * wv[j], c * dwu[i] * wv[j],
+                            c * wu[i] * dwv[j]);
+            }
+}
+
+/* Fan edge of slot s (0: +u, 1: +v, 2: -u, 3: -v) for a grid whose +u is fan edge k0; -1
+ * when the slot does not exist (boundary: mirrored). */
+static int32_t slot_edge(const ccn_mesh *m, int32_t v, int32_t k0, int s) {
+    int32_t n = ccn__valence(m, v), k = s == 3 ? k0 - 1 : k0 + s;
+    if (!m->vboundary[v]) return (k % n + n) % n;
+    return k >= 0 && k < n ? k : -1;
+}
+
+void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g) {
+    int32_t sl[4];
+    for (int s = 0; s < 4; s++) sl[s] = slot_edge(m, v, k0, s);
+    /* fan face k lies between fan edges k and k+1: quadrant (+u,+v) is face sl[0],
+     * (-u,+v) face sl[1], (-u,-v) face sl[2], (+u,-v) face sl[3] */
+    ccn__vpoint (*p)[3] = g->p;
+    int has2 = sl[2] >= 0, has3 = sl[3] >= 0;
+    p[1][1] = vp1(v);
+    p[2][1] = vp1(fan_end(m, v, sl[0]));
+    p[1][2] = vp1(fan_end(m, v, sl[1]));
+    p[2][2] = vp1(fan_diag(m, v, sl[0]));
+    if (has2) {
+        p[0][1] = vp1(fan_end(m, v, sl[2]));
+        p[0][2] = vp1(fan_diag(m, v, sl[1]));
+    } else {
+        p[0][1] = mirror(p[1][1], p[2][1]);
+        p[0][2] = mirror(p[1][2], p[2][2]);
+    }
+    if (has3) {
+        p[1][0] = vp1(fan_end(m, v, sl[3]));
+        p[2][0] = vp1(fan_diag(m, v, sl[3]));
+        p[0][0] = has2 ? vp1(fan_diag(m, v, sl[2])) : mirror(p[1][0], p[2][0]);
+    } else {
+        for (int i = 0; i < 3; i++) p[i][0] = mirror(p[i][1], p[i][2]);
+    }
+    double d0 = m->eknot[ccn__fan_edge(m, v, sl[0])], e0 = m->eknot[ccn__fan_edge(m, v, sl[1])];
+    double d1 = beyond_end(m, v, sl[0], pinned), e1 = beyond_end(m, v, sl[1], pinned);
+    g->du[2] = d0; g->du[3] = d1;
+    g->du[1] = sl[2] >= 0 ? m->eknot[ccn__fan_edge(m, v, sl[2])] : d0;
+    g->du[0] = sl[2] >= 0 ? beyond_end(m, v, sl[2], pinned) : d1;
+    g->dv[2] = e0; g->dv[3] = e1;
+    g->dv[1] = sl[3] >= 0 ? m->eknot[ccn__fan_edge(m, v, sl[3])] : e0;
+    g->dv[0] = sl[3] >= 0 ? beyond_end(m, v, sl[3], pinned) : e1;
+}
+
+/* Interior valence 4, boundary valence 3 or pinned corner. */
+static void regular_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    ccn__vgrid g;
+    ccn__vertex_grid(m, v, 0, pinned, &g);
+    double wu[3], dwu[3], wv[3], dwv[3];
+    ccn__curve_limit_weights(g.du[0], g.du[1], g.du[2], g.du[3], wu, dwu);
+    ccn__curve_limit_weights(g.dv[0], g.dv[1], g.dv[2], g.dv[3], wv, dwv);
+    tensor_stencil(g.p, wu, dwu, wv, dwv, s);
+}
+
+/* Smooth corners and boundary EVs: boundary curve limit, interior direction. */
+static void boundary_curve_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    int32_t n = ccn__valence(m, v);
+    int32_t next = fan_end(m, v, 0), prev = fan_end(m, v, n - 1);
+    double d0 = m->eknot[ccn__fan_edge(m, v, 0)], dm1 = m->eknot[ccn__fan_edge(m, v, n - 1)];
+    double d1 = beyond_end(m, v, 0, pinned), dm2 = beyond_end(m, v, n - 1, pinned);
+    double w[3], dw[3];
+    ccn__curve_limit_weights(dm2, dm1, d0, d1, w, dw);
+    s->n = 0;
+    int32_t pts[3] = {prev, v, next};
+    for (int i = 0; i < 3; i++) stencil_add(s, pts[i], w[i], dw[i], -w[i]);
+    /* cross-boundary direction: mean of the interior neighbours (and diagonals) minus the
+     * limit point; approximate, see the file comment */
+    int32_t cnt = 0, tmp[2 * CCN_STENCIL_MAX];
+    for (int32_t k = 1; k < n - 1 && cnt < CCN_STENCIL_MAX; k++) tmp[cnt++] = fan_end(m, v, k);
+    for (int32_t k = 0; k < n - 1 && cnt < CCN_STENCIL_MAX; k++) tmp[cnt++] = fan_diag(m, v, k);
+    for (int32_t i = 0; i < cnt; i++) stencil_add(s, tmp[i], 0, 0, 1.0 / cnt);
+}
+
+int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned) {
+    if (m->vfan_start[v + 1] == m->vfan_start[v]) return CCN_LIMIT_ISOLATED;
+    int32_t n = ccn__valence(m, v);
+    if (!m->vboundary[v]) return n == 4 ? CCN_LIMIT_REGULAR : CCN_LIMIT_EV;
+    if (n == 3 || (n == 2 && pinned)) return CCN_LIMIT_REGULAR;
+    return CCN_LIMIT_BOUNDARY_CURVE;
+}
+
+int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    int kind = ccn__limit_kind(m, v, pinned);
+    s->n = 0;
+    if (kind == CCN_LIMIT_REGULAR) regular_stencil(m, v, pinned, s);
+    else if (kind == CCN_LIMIT_BOUNDARY_CURVE) boundary_curve_stencil(m, v, pinned, s);
+    else if (kind == CCN_LIMIT_ISOLATED) stencil_add(s, v, 1, 0, 0);
+    return kind;
+}
+
+/* ---- extraordinary vertices: eigenvectors of M ------------------------------------ */
+
+int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring) {
+    int32_t n = ccn__valence(m, v);
+    for (int32_t k = 0; k < n; k++) {
+        int32_t h = m->vfan[m->vfan_start[v] + k], nh = ccn__next(m, h);
+        ring[k] = m->hvert[ccn__next(m, nh)];
+        ring[n + k] = m->hvert[nh];
+    }
+    ring[2 * n] = v;
+    return 2 * n + 1;
+}
+
+/* Left eigenvectors of M (sz x sz, row-major): l0 for eigenvalue 1 (sum 1), l1/l2 spanning
+ * the subdominant pair (real pair or real/imaginary parts of a complex pair). */
+static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *l1, double *l2,
+                               ccn_error *err) {
+    size_t s2 = (size_t)sz * sz;
+    double *A = malloc(sizeof(double) * (s2 + s2 + 2 * (size_t)sz));
+    if (!A) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
+    double *VL = A + s2, *wr = VL + s2, *wi = wr + sz, dummy = 0;
+    memcpy(A, M, sizeof(double) * s2);
+    lapack_int info = LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'V', 'N', sz, A, sz, wr, wi, VL, sz,
+                                    &dummy, 1);
+    if (info != 0) {
+        free(A);
+        return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "eigen decomposition failed");
+    }
+    int32_t i0 = 0;
+    for (int32_t i = 1; i < sz; i++)
+        if (fabs(wr[i] - 1) + fabs(wi[i]) < fabs(wr[i0] - 1) + fabs(wi[i0])) i0 = i;
+    int32_t i1 = -1, i2 = -1;
+    for (int32_t i = 0; i < sz; i++) {
+        if (i == i0) continue;
+        double mod = hypot(wr[i], wi[i]);
+        if (i1 < 0 || mod > hypot(wr[i1], wi[i1])) { i2 = i1; i1 = i; }
+        else if (i2 < 0 || mod > hypot(wr[i2], wi[i2])) i2 = i;
+    }
+    double sum = 0;
+    for (int32_t r = 0; r < sz; r++) sum += VL[(size_t)r * sz + i0];
+    int cplx = wi[i1] != 0.0;
+    if (cplx && wi[i1] < 0) i1 = i1 - 1; /* LAPACK stores a pair as (re, im) columns i, i+1 */
+    for (int32_t r = 0; r < sz; r++) {
+        l0[r] = VL[(size_t)r * sz + i0] / sum;
+        l1[r] = VL[(size_t)r * sz + i1];
+        l2[r] = cplx ? VL[(size_t)r * sz + i1 + 1] : VL[(size_t)r * sz + i2];
+    }
+    free(A);
+    if (!(fabs(sum) > 1e-300))
+        return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "no eigenvalue 1 in M");
+    return CCN_OK;
+}
+
+static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
+                               ccn__stencil *s, ccn_error *err);
+
+ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
+                         ccn_error *err) {
+    return ev_limit_ring(m, v, scheme, 0, s, err);
+}
+
+/* child: the ring is that of v's vertex point one level finer (same spoke ratios). */
+static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
+                               ccn__stencil *s, ccn_error *err) {
+    int32_t n = ccn__valence(m, v), sz = 2 * n + 1;
+    if (sz > CCN_STENCIL_MAX)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                         "vertex %d has valence %d; at most %d is supported for limits", (int)v,
+                         (int)n, (CCN_STENCIL_MAX - 1) / 2);
+    double *buf = malloc(sizeof(double) * ((size_t)sz * sz + 4 * (size_t)sz));
+    int32_t ring[CCN_STENCIL_MAX];
+    if (!buf) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
+    double *M = buf, *d = M + (size_t)sz * sz, *l0 = d + sz, *l1 = l0 + sz, *l2 = l1 + sz;
+    for (int32_t k = 0; k < n; k++) d[k] = m->eknot[ccn__fan_edge(m, v, k)];
+    ccn_status st = ccn_ev_matrix(n, d, (ccn_scheme)scheme, M, NULL, err);
+    if (!st) st = left_eigvecs(M, sz, l0, l1, l2, err);
+    if (!st) {
+        ccn__ev_ring(m, v, ring);
+        if (child) {
+            for (int32_t k = 0; k < n; k++) {
+                int32_t h = m->vfan[m->vfan_start[v] + k];
+                ring[k] = m->hface[h];           /* face point */
+                ring[n + k] = m->nf + m->hedge[h]; /* edge point */
+            }
+            ring[2 * n] = m->nf + m->ne + v;
+        }
+        s->n = 0;
+        for (int32_t j = 0; j < sz; j++) stencil_add(s, ring[j], l0[j], l1[j], l2[j]);
+    }
+    free(buf);
+    return st;
+}
+
+/* ---- stencils one level finer, from this level's topology ------------------------ */
+/* Level l+1 numbering: face point f -> f, edge point e -> nf + e, vertex point v -> nf+ne+v.
+ * Around the vertex point of v every interval along a spoke is the spoke's (halved: only
+ * ratios matter), so no level-(l+1) topology is needed. */
+
+static void child_regular(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+    int32_t sl[4];
+    for (int k = 0; k < 4; k++) sl[k] = slot_edge(m, v, 0, k);
+    int has2 = sl[2] >= 0, has3 = sl[3] >= 0;
+    int32_t nf = m->nf, ne = m->ne;
+#define CE(k) vp1(nf + ccn__fan_edge(m, v, k))
+#define CF(k) vp1(m->hface[m->vfan[m->vfan_start[v] + (k)]])
+    ccn__vpoint p[3][3];
+    p[1][1] = vp1(nf + ne + v);
+    p[2][1] = CE(sl[0]);
+    p[1][2] = CE(sl[1]);
+    p[2][2] = CF(sl[0]);
+    if (has2) { p[0][1] = CE(sl[2]); p[0][2] = CF(sl[1]); }
+    else { p[0][1] = mirror(p[1][1], p[2][1]); p[0][2] = mirror(p[1][2], p[2][2]); }
+    if (has3) {
+        p[1][0] = CE(sl[3]);
+        p[2][0] = CF(sl[3]);
+        p[0][0] = has2 ? CF(sl[2]) : mirror(p[1][0], p[2][0]);
+    } else {
+        for (int i = 0; i < 3; i++) p[i][0] = mirror(p[i][1], p[i][2]);
+    }
+#undef CE
+#undef CF
+    double d0 = m->eknot[ccn__fan_edge(m, v, sl[0])], d1 = m->eknot[ccn__fan_edge(m, v, sl[1])];
+    double d2 = has2 ? m->eknot[ccn__fan_edge(m, v, sl[2])] : d0;
+    double d3 = has3 ? m->eknot[ccn__fan_edge(m, v, sl[3])] : d1;
+    double wu[3], dwu[3], wv[3], dwv[3];
+    ccn__curve_limit_weights(d2, d2, d0, d0, wu, dwu);
+    ccn__curve_limit_weights(d3, d3, d1, d1, wv, dwv);
+    tensor_stencil(p, wu, dwu, wv, dwv, s);
+}
+
+static void child_boundary_curve(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+    int32_t n = ccn__valence(m, v), nf = m->nf, nfan = m->vfan_start[v + 1] - m->vfan_start[v];
+    double d0 = m->eknot[ccn__fan_edge(m, v, 0)], dm = m->eknot[ccn__fan_edge(m, v, n - 1)];
+    double w[3], dw[3];
+    ccn__curve_limit_weights(dm, dm, d0, d0, w, dw);
+    s->n = 0;
+    int32_t pts[3] = {nf + ccn__fan_edge(m, v, n - 1), nf + m->ne + v, nf + ccn__fan_edge(m, v, 0)};
+    for (int i = 0; i < 3; i++) stencil_add(s, pts[i], w[i], dw[i], -w[i]);
+    int32_t cnt = (n - 2) + nfan;
+    for (int32_t k = 1; k < n - 1; k++) stencil_add(s, nf + ccn__fan_edge(m, v, k), 0, 0, 1.0 / cnt);
+    for (int32_t k = 0; k < nfan; k++) stencil_add(s, m->hface[m->vfan[m->vfan_start[v] + k]], 0, 0, 1.0 / cnt);
+}
+
+ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
+                                    ccn__stencil *s, int32_t orient[3], ccn_error *err) {
+    int kind = ccn__limit_kind(m, v, pinned);
+    orient[0] = -1;
+    s->n = 0;
+    if (kind == CCN_LIMIT_REGULAR) child_regular(m, v, s);
+    else if (kind == CCN_LIMIT_BOUNDARY_CURVE) child_boundary_curve(m, v, s);
+    else if (kind == CCN_LIMIT_ISOLATED) stencil_add(s, m->nf + m->ne + v, 1, 0, 0);
+    else {
+        ccn_status st = ev_limit_ring(m, v, scheme, 1, s, err);
+        if (st) return st;
+        int32_t h = m->vfan[m->vfan_start[v]];
+        orient[0] = m->nf + m->ne + v;
+        orient[1] = m->nf + m->hedge[h];
+        orient[2] = m->nf + m->hedge[m->vfan[m->vfan_start[v] + 1]];
+    }
+    return CCN_OK;
+}

@@ -1,0 +1,52 @@
+/* Exact limit stencils at refined vertices (limit.c). Internal. */
+#ifndef CCN_SURFACE_LIMIT_H
+#define CCN_SURFACE_LIMIT_H
+
+#include "topology/halfedge.h"
+
+#define CCN_STENCIL_MAX 2049 /* 2n+1 for valence n <= 1024 */
+
+/* Weights over vertices of one mesh level: position (wp) and two tangents (wu, wv) whose
+ * cross product wu x wv points along the outward normal (except for EVs: see ev_limit). */
+typedef struct {
+    int n;
+    int32_t v[CCN_STENCIL_MAX];
+    double wp[CCN_STENCIL_MAX], wu[CCN_STENCIL_MAX], wv[CCN_STENCIL_MAX];
+} ccn__stencil;
+
+enum {
+    CCN_LIMIT_REGULAR = 0,     /* tensor B-spline limit (mirror ghosts on the boundary) */
+    CCN_LIMIT_BOUNDARY_CURVE,  /* smooth corner or boundary EV */
+    CCN_LIMIT_EV,              /* interior extraordinary vertex: use ccn__ev_limit */
+    CCN_LIMIT_ISOLATED
+};
+
+/* A virtual grid point: up to 4 real vertices with weights (mirror ghosts). */
+typedef struct { int32_t v[4]; double w[4]; int n; } ccn__vpoint;
+/* The 3x3 grid around a regular vertex v (interior valence 4, boundary valence 3 or pinned
+ * corner) with +u along fan edge k0 and +v along fan edge k0+1: p[i+1][j+1] is grid point
+ * (i,j); missing points across the boundary are mirror ghosts. du[0..3] = intervals
+ * D_-2, D_-1, D_0, D_1 along u (D_0 between (0,0) and (1,0)); dv likewise. */
+typedef struct { ccn__vpoint p[3][3]; double du[4], dv[4]; } ccn__vgrid;
+void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g);
+/* 1-D limit value (w) and derivative (dw) weights on (P_-1, P_0, P_1) at knot t_0. */
+void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
+                              double dw[3]);
+
+int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
+/* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the
+ * stencil is left empty). */
+int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s);
+/* 1-ring of an interior vertex in M's order (F_0..F_{n-1}, E_0..E_{n-1}, V); returns 2n+1. */
+int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring);
+/* Limit point and tangent directions of an interior EV from the left eigenvectors of M
+ * (scheme's matrix). The tangent pair's orientation is arbitrary: callers orient the
+ * normal with the 1-ring. */
+ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
+                         ccn_error *err);
+/* Limit stencil of the vertex point of v one level finer, in level-(l+1) numbering (face
+ * point f -> f, edge point e -> nf+e, vertex point v -> nf+ne+v), built from this level's
+ * topology. orient: for EVs the (v, a, b) whose (a-v) x (b-v) orients the normal, else -1. */
+ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
+                                    ccn__stencil *s, int32_t orient[3], ccn_error *err);
+#endif

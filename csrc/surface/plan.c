@@ -1,0 +1,234 @@
+/* Public limit-surface API: ccn_plan_create / sizes / evaluate / destroy.
+ *
+ * create: validate the cage, choose the output level L (>= 1 if the cage has non-quads),
+ * the cap level K (EVs isolated by three regular rings, K >= 2) and the refinement depth
+ * R = max(L+1, K); build every level's topology and rules once; build the limit stencil of
+ * every output vertex (limit.c) and, for cap = GUIDED_BI5, the c-net of every EV and the
+ * output vertices inside its hole (tessellate.c).
+ * evaluate: refine positions through the stored levels (no topology work), apply the
+ * stencils, and evaluate the bi-5 caps for the hole vertices.
+ */
+#include "surface/plan_types.h"
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "base/vec3.h"
+#include "bi5/bi5.h"
+#include "surface/caps.h"
+#include "surface/plan_levels.h"
+#include "surface/tessellate.h"
+#include "topology/mesh.h"
+
+#include <math.h>
+#include <string.h>
+
+#define CCN_MAX_LEVELS 10
+
+void ccn_plan_destroy(ccn_plan *p) {
+    if (!p) return;
+    for (int32_t l = 0; l < p->R; l++) ccn__level_free(&p->prep[l]);
+    if (p->has_sub) { ccn__level_free(&p->sub); free(p->posS); }
+    free(p->near);
+    free(p->cage_pos);
+    free(p->cap_net);
+    for (int32_t l = 0; p->lev && l <= p->R; l++) ccn_mesh_destroy(p->lev[l]);
+    for (int32_t c = 0; c < p->ncap; c++) ccn__cap_free(&p->caps[c]);
+    for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
+    free(p->ops); free(p->op_n); free(p->caps); free(p->prep); free(p->lev);
+    free(p->vmapL); free(p->out_fv); free(p->out_origin);
+    free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
+    free(p->orient); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
+    free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
+    free(p);
+}
+
+static ccn_status check_options(const ccn_options *o, ccn_error *err) {
+    if (o->scheme < CCN_SCHEME_EIGEN || o->scheme > CCN_SCHEME_CATMULL_CLARK)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown scheme %d", (int)o->scheme);
+    if (o->cap < CCN_CAP_GUIDED_BI5 || o->cap > CCN_CAP_REFINE)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown cap %d", (int)o->cap);
+    if (o->boundary_corners < CCN_CORNERS_SMOOTH || o->boundary_corners > CCN_CORNERS_PINNED)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown boundary_corners %d",
+                         (int)o->boundary_corners);
+    if (o->levels < 0 || o->levels > CCN_MAX_LEVELS)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "levels must be in [0, %d], got %d",
+                         CCN_MAX_LEVELS, (int)o->levels);
+    return CCN_OK;
+}
+
+/* ---- create ----------------------------------------------------------------------- */
+
+/* Level L+1: the built lev[L+1] when caps needed it, else computed around irregular
+ * vertices only (evaluate) from a prepared level L. */
+static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
+    if (p->R > p->L) { p->posS = p->lev[p->L + 1]->pos; return CCN_OK; }
+    const ccn_mesh *m = p->lev[p->L];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, err);
+    if (st) return st;
+    p->has_sub = 1;
+    p->sub.threads = 1; /* a few points only */
+    p->posS = malloc(sizeof(double) * 3 * ((size_t)m->nf + m->ne + m->nv));
+    if (!p->posS) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    return CCN_OK;
+}
+
+static int has_non_quads(const ccn_mesh *m) {
+    for (int32_t f = 0; f < m->nf; f++)
+        if (ccn__fsize(m, f) != 4) return 1;
+    return 0;
+}
+
+static void fill_sizes(ccn_plan *p) {
+    ccn_sizes *s = &p->sizes;
+    const ccn_mesh_info *c = &p->lev[0]->info, *r = &p->lev[p->R]->info;
+    s->num_verts = p->nout_v;
+    s->num_faces = p->nout_f;
+    s->num_cage_verts = p->ncage;
+    s->levels = p->L;
+    s->refine_levels = p->R;
+    s->num_extraordinary = p->R >= 1 ? p->lev[1]->info.num_extraordinary : c->num_extraordinary;
+    s->num_ev_fallbacks = r->num_ev_fallbacks;
+    s->num_ring_conflicts = c->num_ring_conflicts;
+    s->num_ignored_verts = c->num_ignored_verts;
+    s->num_ignored_edges = c->num_ignored_edges;
+}
+
+ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
+                           ccn_error *err) {
+    ccn__ok(err);
+    if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
+    *out = NULL;
+    ccn_options o = {0};
+    if (opts) o = *opts;
+    ccn_status st = check_options(&o, err);
+    if (st) return st;
+    ccn_plan *p = calloc(1, sizeof *p);
+    if (!p) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    p->opts = o;
+    p->threads = ccn__thread_count(o.threads);
+    p->lev = calloc(1, sizeof(ccn_mesh *));
+    if (!p->lev) { free(p); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
+    ccn_mesh *cage_mesh = NULL;
+    if ((st = ccn_mesh_create(cage, &cage_mesh, err))) { ccn_plan_destroy(p); return st; }
+    if (o.scheme == CCN_SCHEME_CATMULL_CLARK) {
+        for (int32_t e = 0; e < cage_mesh->ne; e++) cage_mesh->eknot[e] = 1.0;
+        cage_mesh->knot_scale = 1.0;
+    }
+    p->lev[0] = cage_mesh;
+    p->ncage = cage->num_verts;
+    p->scale = 1.0;
+    p->cage_pos = malloc(sizeof(double) * 3 * (size_t)(p->ncage ? p->ncage : 1));
+    if (!p->cage_pos) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto fail; }
+    memcpy(p->cage_pos, cage_mesh->pos, sizeof(double) * 3 * (size_t)p->ncage);
+    for (int32_t v = 0; v < cage_mesh->nv && !st; v++)
+        if (cage_mesh->vfan_start[v + 1] > cage_mesh->vfan_start[v] &&
+            ccn__valence(cage_mesh, v) > CCN_EV_MATRIX_MAX_VALENCE)
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
+                           "vertex %d has valence %d; the limit surface supports at most %d",
+                           (int)v, (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE);
+    for (int32_t f = 0; f < cage_mesh->nf && !st; f++)
+        if (ccn__fsize(cage_mesh, f) > CCN_EV_MATRIX_MAX_VALENCE)
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                           "face %d has %d sides; the limit surface supports at most %d",
+                           (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE);
+    if (st) goto fail;
+    p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
+    int64_t corners = cage_mesh->nh; /* fail before any work if the output cannot be indexed */
+    for (int32_t l = 0; l < p->L + 1 && !st; l++)
+        if ((corners *= 4) > INT32_MAX / 8)
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
+                           "%d levels of a %d-corner cage would exceed %d face corners",
+                           (int)p->L, (int)cage_mesh->nh, INT32_MAX / 8);
+    if (st) goto fail;
+    if ((st = ccn__caps_setup(p, err))) goto fail;
+    if ((st = ccn__plan_build_levels(p, p->R > p->L ? p->R : p->L, err))) goto fail;
+    if ((st = setup_level_s(p, err))) goto fail;
+    if ((st = ccn__tess_output(p, err))) goto fail;
+    if (p->ncap && (st = ccn__tess_holes(p, err))) goto fail;
+    fill_sizes(p);
+    *out = p;
+    return CCN_OK;
+fail:
+    ccn_plan_destroy(p);
+    return st;
+}
+
+ccn_status ccn_plan_sizes(const ccn_plan *p, ccn_sizes *s) {
+    if (!p || !s) return CCN_ERR_ARGUMENT;
+    *s = p->sizes;
+    return CCN_OK;
+}
+
+/* ---- evaluate --------------------------------------------------------------------- */
+
+#define SPOINT(i) ((i) < nvL ? PL + 3 * (size_t)(i) : PS + 3 * ((size_t)(i) - nvL))
+
+typedef struct { const ccn_plan *p; ccn_limit_mesh *out; } stencil_job;
+
+static void stencil_range(void *ctx, int32_t begin, int32_t end) {
+    const stencil_job *j = ctx;
+    const ccn_plan *p = j->p;
+    ccn_limit_mesh *out = j->out;
+    const double *PL = p->lev[p->L]->pos, *PS = p->posS;
+    int32_t nvL = p->lev[p->L]->nv;
+    for (int32_t o = begin; o < end; o++) {
+        double x[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+        for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
+            const double *q = SPOINT(p->st_v[k]);
+            for (int i = 0; i < 3; i++) {
+                x[i] += p->st_wp[k] * q[i];
+                du[i] += p->st_wu[k] * q[i];
+                dv[i] += p->st_wv[k] * q[i];
+            }
+        }
+        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
+        if (!out->normals) continue;
+        double *n = out->normals + 3 * (size_t)o;
+        ccn__unit_normal(du, dv, n);
+        const int32_t *r = p->orient + 3 * (size_t)o;
+        if (r[0] >= 0) { /* EV: agree with the first face of the 1-ring */
+            double a[3], b[3], c[3];
+            const double *r0 = SPOINT(r[0]), *r1 = SPOINT(r[1]), *r2 = SPOINT(r[2]);
+            for (int i = 0; i < 3; i++) {
+                a[i] = r1[i] - r0[i];
+                b[i] = r2[i] - r0[i];
+            }
+            ccn__cross3(a, b, c);
+            if (c[0] * n[0] + c[1] * n[1] + c[2] * n[2] < 0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+        }
+    }
+}
+
+static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
+    stencil_job j = {p, out};
+    ccn__parallel_for(p->threads, p->nout_v, stencil_range, &j);
+}
+
+ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh *out,
+                             ccn_error *err) {
+    ccn__ok(err);
+    if (!p || !out || !out->positions)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "plan, out or out->positions is NULL");
+    if (positions) {
+        ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
+        if (st) return st;
+    } else { /* the cage's own positions, as given to ccn_plan_create */
+        memcpy(p->lev[0]->pos, p->cage_pos, sizeof(double) * 3 * (size_t)p->ncage);
+    }
+    /* every rule is affine-invariant: work in a unit box so that huge coordinates (1e300)
+     * cannot overflow, and map back at the end */
+    double *centre = p->centre, scale;
+    ccn__normalize(p->lev[0], centre, &scale);
+    p->scale = scale;
+    for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
+    if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
+    eval_stencils(p, out);
+    ccn_status st = ccn__caps_evaluate(p, out, err);
+    if (st) return st;
+    for (int32_t o = 0; o < p->nout_v; o++)
+        for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
+    if (out->face_verts) memcpy(out->face_verts, p->out_fv, sizeof(int32_t) * 4 * (size_t)p->nout_f);
+    if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
+    return CCN_OK;
+}

@@ -1,0 +1,72 @@
+/* The plan: everything that depends on topology, intervals and options (internal data of
+ * surface/plan.c, caps.c, tessellate.c, patch_set.c; no code of its own). */
+#ifndef CCN_SURFACE_PLAN_TYPES_H
+#define CCN_SURFACE_PLAN_TYPES_H
+
+#include "refine/level.h"
+#include "topology/halfedge.h"
+
+struct ccn__bi5;
+
+/* One extraordinary vertex filled by the guided bi-5 cap (K&P 2018). */
+typedef struct {
+    int32_t n;          /* valence */
+    int32_t *cnet;      /* 6n+1 level-K vertex indices, SPEC §1.2 order */
+    int32_t *ring;      /* 2n+1 level-K 1-ring (centre stencil support) */
+    double *l0;         /* 2n+1 limit weights (centre point) */
+    double *knots;      /* n spoke intervals at level K */
+    const struct ccn__bi5 *op; /* shared per valence, owned by the plan */
+    double *patches;    /* (3*nsig+1)*n bi-5 patches, 36*3 doubles each */
+    int exact_surround; /* 1: arbitrary NU intervals, border = level-(K+1) pieces (bi5.h [R13]) */
+    double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
+    void *taus;         /* non-uniform (some kappa != 1): the n cap taus (double complex[36] each,
+                           bi5.h [R11]), computed once at create; NULL otherwise */
+} ccn__cap;
+
+struct ccn_plan {
+    ccn_options opts;
+    int threads;
+    int32_t L, R, K;        /* output level, levels built (max(L, K)), cap level (-1: none) */
+    ccn_mesh **lev;         /* R+1 meshes: lev[0] is the cage */
+    ccn__level *prep;       /* R prepared levels */
+    /* level L+1, needed only around irregular vertices: either lev[L+1] (R > L) or computed
+     * partially into posS from level L by `sub` around the vertices in near[] */
+    ccn__level sub;
+    int has_sub;
+    double *posS;
+    int32_t nnear, *near;
+    int32_t ncage;
+    double *cage_pos;       /* the caller's cage positions (evaluate works on a normalised copy) */
+    double centre[3], scale; /* normalisation of the last evaluate */
+    /* output mesh = level L without isolated vertices */
+    int32_t nout_v, nout_f;
+    int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */
+    int32_t *out_fv, *out_origin;
+    /* limit stencils, CSR; index < lev[L]->nv: a level-L vertex, else (index - lev[L]->nv)
+     * is a level-(L+1) point (face points, edge points, vertex points) */
+    int32_t *st_start, *st_v;
+    double *st_wp, *st_wu, *st_wv;
+    int32_t *orient;        /* 3 stencil indices per output vertex (v, a, b) or -1: flip the
+                               normal to agree with (a-v) x (b-v) */
+    /* caps */
+    int32_t ncap;
+    ccn__cap *caps;
+    struct ccn__bi5 **ops;  /* one per valence used, nops entries */
+    int32_t *op_n;          /* valence of each op */
+    int32_t nops;
+    double *cap_net;        /* evaluate's c-net buffer (largest cap) */
+    int32_t nhv;            /* output vertices evaluated on a cap */
+    int32_t *hv_out, *hv_cap, *hv_sector;
+    double *hv_uv;
+    /* ring around each cap: level-K faces touching the hole, evaluated as the bicubic patch
+     * of their level-K net (the spline the cap joins C2), not as the subdivision limit;
+     * not for exact_surround caps, whose surround is the limit itself */
+    int32_t nrf, *rf_face;  /* distinct faces */
+    double *rf_bez;         /* 48 doubles per face, filled by evaluate */
+    int32_t nbv;            /* output vertices on those faces */
+    int32_t *bv_out, *bv_rf;
+    double *bv_uv;
+    ccn_sizes sizes;
+};
+
+#endif

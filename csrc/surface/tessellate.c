@@ -1,0 +1,271 @@
+/* The output mesh: the level-L refinement of the cage (a (2^L+1)^2 grid per cage quad,
+ * shared samples along edges), its per-face origin, the limit stencil of every output
+ * vertex, and the vertices that lie in a guided-cap hole with their hole coordinates. */
+#include "surface/tessellate.h"
+
+#include "base/error.h"
+#include "surface/limit.h"
+
+#include <string.h>
+
+static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L];
+    p->vmapL = malloc(sizeof(int32_t) * (size_t)mL->nv);
+    p->out_fv = malloc(sizeof(int32_t) * (size_t)mL->nh);
+    p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
+    if (!p->vmapL || !p->out_fv || !p->out_origin)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    int32_t no = 0;
+    for (int32_t v = 0; v < mL->nv; v++)
+        p->vmapL[v] = mL->vfan_start[v + 1] > mL->vfan_start[v] ? no++ : -1;
+    p->nout_v = no;
+    p->nout_f = mL->nf;
+    for (int32_t h = 0; h < mL->nh; h++) p->out_fv[h] = p->vmapL[mL->hvert[h]];
+    for (int32_t f = 0; f < mL->nf; f++) {
+        int32_t g = f;
+        for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
+        p->out_origin[f] = g;
+    }
+    return CCN_OK;
+}
+
+typedef struct { int32_t n, cap; int32_t *v; double *wp, *wu, *wv; } csr_buf;
+
+static int csr_push(csr_buf *b, const ccn__stencil *s) {
+    if (b->n + s->n > b->cap) {
+        int64_t nc = 2 * (int64_t)b->cap + s->n + 1024;
+        if (nc > INT32_MAX) return -1;
+        int32_t *v = realloc(b->v, sizeof(int32_t) * (size_t)nc);
+        if (v) b->v = v;
+        double *a = realloc(b->wp, sizeof(double) * (size_t)nc);
+        if (a) b->wp = a;
+        double *c = realloc(b->wu, sizeof(double) * (size_t)nc);
+        if (c) b->wu = c;
+        double *d = realloc(b->wv, sizeof(double) * (size_t)nc);
+        if (d) b->wv = d;
+        if (!v || !a || !c || !d) return -1;
+        b->cap = (int32_t)nc;
+    }
+    memcpy(b->v + b->n, s->v, sizeof(int32_t) * (size_t)s->n);
+    memcpy(b->wp + b->n, s->wp, sizeof(double) * (size_t)s->n);
+    memcpy(b->wu + b->n, s->wu, sizeof(double) * (size_t)s->n);
+    memcpy(b->wv + b->n, s->wv, sizeof(double) * (size_t)s->n);
+    b->n += s->n;
+    return 0;
+}
+
+/* Is v, or a vertex of one of its faces, irregular (then its level-L box does not refine by
+ * knot insertion and its limit needs level L+1)? */
+static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irregular) {
+    if (irregular[v]) return 1;
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t f = m->hface[m->vfan[k]];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
+            if (irregular[m->hvert[h]]) return 1;
+    }
+    return 0;
+}
+
+static void offset_stencil(ccn__stencil *s, int32_t off) {
+    for (int i = 0; i < s->n; i++) s->v[i] += off;
+}
+
+static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    ccn__stencil *s = malloc(sizeof *s);
+    csr_buf b = {0, 0, NULL, NULL, NULL, NULL};
+    p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
+    p->orient = malloc(sizeof(int32_t) * 3 * (size_t)(p->nout_v ? p->nout_v : 1));
+    p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    uint8_t *irr = malloc((size_t)(mL->nv ? mL->nv : 1));
+    ccn_status st = CCN_OK;
+    if (!s || !p->st_start || !p->orient || !p->near || !irr) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+        goto done;
+    }
+    p->st_start[0] = 0;
+    p->nnear = 0;
+    for (int32_t v = 0; v < mL->nv; v++) irr[v] = ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_REGULAR;
+    for (int32_t v = 0; v < mL->nv; v++) {
+        int32_t o = p->vmapL[v];
+        if (o < 0) continue;
+        int32_t *ori = p->orient + 3 * o;
+        if (!near_irregular(mL, v, irr)) {
+            ccn__limit_stencil(mL, v, pinned, s);
+            ori[0] = -1;
+        } else {
+            p->near[p->nnear++] = v;
+            if ((st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, s, ori, err))) goto done;
+            offset_stencil(s, mL->nv);
+            if (ori[0] >= 0) for (int k = 0; k < 3; k++) ori[k] += mL->nv;
+        }
+        if (csr_push(&b, s)) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+            goto done;
+        }
+        p->st_start[o + 1] = b.n;
+    }
+done:
+    p->st_v = b.v; p->st_wp = b.wp; p->st_wu = b.wu; p->st_wv = b.wv;
+    free(s);
+    free(irr);
+    return st;
+}
+
+ccn_status ccn__tess_output(ccn_plan *p, ccn_error *err) {
+    ccn_status st = output_topology(p, err);
+    if (!st) st = output_stencils(p, err);
+    return st;
+}
+
+/* ---- cap holes ---------------------------------------------------------------------- */
+
+typedef struct {
+    ccn_plan *p;
+    int mode;              /* 0: cap hole vertex, 1: vertex on a ring face */
+    int32_t cap, sector;   /* mode 0 */
+    int32_t rf;            /* mode 1 */
+    uint8_t *seen;         /* per level-L vertex */
+    int32_t n[2], capacity[2];
+} hole_walk;
+
+static int grow_i32(int32_t **a, int32_t nc) {
+    int32_t *b = realloc(*a, sizeof(int32_t) * (size_t)nc);
+    if (b) *a = b;
+    return b ? 0 : -1;
+}
+static int grow_f64(double **a, int32_t nc) {
+    double *b = realloc(*a, sizeof(double) * (size_t)nc);
+    if (b) *a = b;
+    return b ? 0 : -1;
+}
+
+static int record(hole_walk *w, int32_t vL, const double uv[2]) {
+    ccn_plan *p = w->p;
+    int md = w->mode;
+    if (w->seen[vL] || p->vmapL[vL] < 0) return 0;
+    w->seen[vL] = 1;
+    if (w->n[md] >= w->capacity[md]) {
+        int32_t nc = 2 * w->capacity[md] + 64;
+        int bad = md == 0 ? grow_i32(&p->hv_out, nc) | grow_i32(&p->hv_cap, nc) |
+                                grow_i32(&p->hv_sector, nc) | grow_f64(&p->hv_uv, 2 * nc)
+                          : grow_i32(&p->bv_out, nc) | grow_i32(&p->bv_rf, nc) |
+                                grow_f64(&p->bv_uv, 2 * nc);
+        if (bad) return -1;
+        w->capacity[md] = nc;
+    }
+    int32_t i = w->n[md]++;
+    if (md == 0) {
+        p->hv_out[i] = p->vmapL[vL];
+        p->hv_cap[i] = w->cap;
+        p->hv_sector[i] = w->sector;
+        p->hv_uv[2 * i] = uv[0];
+        p->hv_uv[2 * i + 1] = uv[1];
+    } else {
+        p->bv_out[i] = p->vmapL[vL];
+        p->bv_rf[i] = w->rf;
+        p->bv_uv[2 * i] = uv[0];
+        p->bv_uv[2 * i + 1] = uv[1];
+    }
+    return 0;
+}
+
+/* Level-L vertex whose vertex-point chain is level-K vertex v, or -1. */
+static int32_t ancestor_at_L(const ccn_plan *p, int32_t v) {
+    for (int32_t l = p->K; l > p->L; l--) {
+        v -= p->lev[l - 1]->nf + p->lev[l - 1]->ne;
+        if (v < 0) return -1;
+    }
+    return v;
+}
+
+/* Face f of level l with corner coordinates c[k] (in f's half-edge order). */
+static int walk_face(hole_walk *w, int32_t l, int32_t f, double c[][2]) {
+    const ccn_mesh *m = w->p->lev[l];
+    int32_t s0 = m->fstart[f], n = ccn__fsize(m, f);
+    if (l == w->p->L || w->p->L < w->p->K) { /* record what exists at the output level */
+        for (int32_t j = 0; j < n; j++) {
+            int32_t v = l == w->p->L ? m->hvert[s0 + j] : ancestor_at_L(w->p, m->hvert[s0 + j]);
+            if (v >= 0 && record(w, v, c[j])) return -1;
+        }
+        return 0;
+    }
+    double ctr[2] = {0, 0};
+    for (int32_t j = 0; j < n; j++) { ctr[0] += c[j][0] / n; ctr[1] += c[j][1] / n; }
+    for (int32_t j = 0; j < n; j++) {
+        int32_t jn = (j + 1) % n, jp = (j + n - 1) % n;
+        double cc[4][2] = {{c[j][0], c[j][1]},
+                           {(c[j][0] + c[jn][0]) / 2, (c[j][1] + c[jn][1]) / 2},
+                           {ctr[0], ctr[1]},
+                           {(c[j][0] + c[jp][0]) / 2, (c[j][1] + c[jp][1]) / 2}};
+        if (walk_face(w, l + 1, s0 + j, cc)) return -1;
+    }
+    return 0;
+}
+
+static const double UNIT[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+
+static int walk_cap(hole_walk *w, int32_t c) {
+    const ccn_mesh *mK = w->p->lev[w->p->K];
+    int32_t ev = w->p->caps[c].cnet[0], n = w->p->caps[c].n;
+    w->mode = 0;
+    w->cap = c;
+    for (int32_t k = 0; k < n; k++) {
+        int32_t h = mK->vfan[mK->vfan_start[ev] + k], f = mK->hface[h];
+        int32_t j0 = h - mK->fstart[f];
+        double cc[4][2];
+        for (int j = 0; j < 4; j++) {
+            cc[(j0 + j) % 4][0] = UNIT[j][0];
+            cc[(j0 + j) % 4][1] = UNIT[j][1];
+        }
+        w->sector = k;
+        if (walk_face(w, w->p->K, f, cc)) return -1;
+    }
+    return 0;
+}
+
+/* Faces touching the cap's 1-ring vertices but not the EV (the ring around the hole). */
+static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
+    ccn_plan *p = w->p;
+    const ccn_mesh *mK = p->lev[p->K];
+    const ccn__cap *cp = &p->caps[c];
+    if (cp->exact_surround) return 0; /* its surround is the limit itself (bi5.h [R13]) */
+    w->mode = 1;
+    for (int32_t j = 0; j < 2 * cp->n; j++) {
+        int32_t v = cp->ring[j];
+        for (int32_t k = mK->vfan_start[v]; k < mK->vfan_start[v + 1]; k++) {
+            int32_t f = mK->hface[mK->vfan[k]], touches = 0;
+            for (int32_t h = mK->fstart[f]; h < mK->fstart[f + 1]; h++) touches |= mK->hvert[h] == cp->cnet[0];
+            if (touches || face_done[f]) continue;
+            face_done[f] = 1;
+            if (grow_i32(&p->rf_face, p->nrf + 1)) return -1;
+            p->rf_face[p->nrf] = f;
+            w->rf = p->nrf++;
+            double cc[4][2];
+            memcpy(cc, UNIT, sizeof cc);
+            if (walk_face(w, p->K, f, cc)) return -1;
+        }
+    }
+    return 0;
+}
+
+ccn_status ccn__tess_holes(ccn_plan *p, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L], *mK = p->lev[p->K];
+    hole_walk w;
+    memset(&w, 0, sizeof w);
+    w.p = p;
+    w.seen = calloc((size_t)mL->nv, 1);
+    uint8_t *face_done = calloc((size_t)mK->nf, 1);
+    int bad = !w.seen || !face_done;
+    for (int32_t c = 0; !bad && c < p->ncap; c++) bad = walk_cap(&w, c) != 0;
+    for (int32_t c = 0; !bad && c < p->ncap; c++) bad = walk_ring_faces(&w, c, face_done) != 0;
+    if (!bad) p->rf_bez = malloc(sizeof(double) * 48 * (size_t)(p->nrf ? p->nrf : 1));
+    bad = bad || !p->rf_bez;
+    p->nhv = w.n[0];
+    p->nbv = w.n[1];
+    free(w.seen);
+    free(face_done);
+    if (bad) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (holes)");
+    return CCN_OK;
+}

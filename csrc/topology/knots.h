@@ -1,0 +1,14 @@
+/* Knot intervals of edge rings (internal). */
+#ifndef CCN_TOPOLOGY_KNOTS_H
+#define CCN_TOPOLOGY_KNOTS_H
+
+#include "topology/halfedge.h"
+
+/* Resolves ring intervals from per-edge candidate values (<= 0 / non-finite = unset) and
+ * normalises them (largest = 1, clamped to >= 1e-6). Writes m->eknot, m->knot_scale and the
+ * ring counts in m->info. `source` (may be NULL) tags each edge's value with the identity of
+ * where it came from; a ring's value is the mean over distinct sources (NULL: over edges). */
+ccn_status ccn__resolve_rings(ccn_mesh *m, const double *edge_values, const int32_t *source,
+                              ccn_error *err);
+
+#endif

@@ -1,0 +1,380 @@
+/* Cage topology: half-edge mesh from a polygon soup, with validation.
+ *
+ * Rejected (CCN_ERR_TOPOLOGY, the message names the element): a face with < 3 vertices or a
+ * repeated vertex, an index out of range, an edge shared by more than two faces, two faces
+ * using an edge in the same direction (inconsistent orientation), a vertex whose faces form
+ * more than one fan (non-manifold vertex), an interior vertex of valence 2. Rejected
+ * (CCN_ERR_ARGUMENT): negative counts, NULL arrays, NaN/Inf coordinates or beyond
+ * +-CCN_COORD_MAX, no faces. Ignored and counted: isolated vertices, knot
+ * values given for vertex pairs that are not edges of any face (loose edges).
+ */
+#include "topology/mesh.h"
+
+#include "base/error.h"
+#include "topology/knots.h"
+
+#include <math.h>
+#include <string.h>
+
+ccn_mesh *ccn__mesh_alloc(int32_t nv, int32_t nf, int32_t nh, int32_t ne) {
+    ccn_mesh *m = calloc(1, sizeof *m);
+    if (!m) return NULL;
+    m->nv = nv; m->nf = nf; m->nh = nh; m->ne = ne;
+    m->knot_scale = 1.0;
+    m->pos = malloc(sizeof(double) * 3 * (size_t)(nv ? nv : 1));
+    m->fstart = malloc(sizeof(int32_t) * ((size_t)nf + 1));
+    m->hvert = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->htwin = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->hedge = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->hface = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->everts = malloc(sizeof(int32_t) * 2 * (size_t)(ne ? ne : 1));
+    m->eknot = malloc(sizeof(double) * (size_t)(ne ? ne : 1));
+    m->vfan_start = malloc(sizeof(int32_t) * ((size_t)nv + 1));
+    m->vfan = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->hfanpos = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+    m->vlast_edge = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1));
+    m->vboundary = malloc((size_t)(nv ? nv : 1));
+    if (!m->pos || !m->fstart || !m->hvert || !m->htwin || !m->hedge || !m->hface ||
+        !m->everts || !m->eknot || !m->vfan_start || !m->vfan || !m->hfanpos ||
+        !m->vlast_edge || !m->vboundary) {
+        ccn_mesh_destroy(m);
+        return NULL;
+    }
+    return m;
+}
+
+void ccn_mesh_destroy(ccn_mesh *m) {
+    if (!m) return;
+    free(m->pos); free(m->fstart); free(m->hvert); free(m->htwin); free(m->hedge);
+    free(m->hface); free(m->everts); free(m->eknot); free(m->vfan_start); free(m->vfan);
+    free(m->hfanpos); free(m->vlast_edge); free(m->vboundary);
+    free(m);
+}
+
+/* ---- fans ----------------------------------------------------------------------- */
+
+/* Walks v's fan from `start` by h -> twin(prev(h)) (counter-clockwise); returns the count
+ * of outgoing half-edges visited and writes them to out (if not NULL). */
+static int32_t walk_fan(const ccn_mesh *m, int32_t start, int32_t *out, int32_t cap,
+                        int32_t *last) {
+    int32_t h = start, k = 0;
+    for (;;) {
+        if (out && k < cap) out[k] = h;
+        k++;
+        int32_t p = ccn__prev(m, h);
+        int32_t t = m->htwin[p];
+        if (t < 0) { *last = m->hedge[p]; return k; }
+        if (t == start || k > cap) { *last = -1; return k; }
+        h = t;
+    }
+}
+
+int32_t ccn__mesh_build_fans(ccn_mesh *m) {
+    int32_t nv = m->nv, nh = m->nh;
+    int32_t *start = m->vlast_edge; /* scratch: a starting half-edge per vertex */
+    memset(m->vfan_start, 0, sizeof(int32_t) * ((size_t)nv + 1));
+    for (int32_t v = 0; v < nv; v++) start[v] = -1;
+    for (int32_t h = 0; h < nh; h++) {
+        int32_t v = m->hvert[h];
+        m->vfan_start[v + 1]++;
+        if (start[v] < 0 || m->htwin[h] < 0) {
+            if (start[v] >= 0 && m->htwin[start[v]] < 0 && m->htwin[h] < 0) return v + 1;
+            start[v] = h;
+        }
+    }
+    for (int32_t v = 0; v < nv; v++) m->vfan_start[v + 1] += m->vfan_start[v];
+    for (int32_t v = 0; v < nv; v++) {
+        int32_t s = start[v], cnt = m->vfan_start[v + 1] - m->vfan_start[v], last = -1;
+        m->vboundary[v] = 0;
+        if (cnt == 0) { m->vlast_edge[v] = -1; continue; }
+        int32_t got = walk_fan(m, s, m->vfan + m->vfan_start[v], cnt, &last);
+        if (got != cnt) return v + 1;
+        m->vboundary[v] = (uint8_t)(m->htwin[s] < 0);
+        m->vlast_edge[v] = m->vboundary[v] ? last : -1;
+        for (int32_t k = 0; k < cnt; k++) m->hfanpos[m->vfan[m->vfan_start[v] + k]] = k;
+    }
+    return 0;
+}
+
+void ccn__mesh_update_info(ccn_mesh *m) {
+    ccn_mesh_info *in = &m->info;
+    in->num_verts = m->nv; in->num_faces = m->nf; in->num_edges = m->ne;
+    in->num_face_verts = m->nh;
+    in->num_boundary_edges = 0;
+    for (int32_t h = 0; h < m->nh; h++) in->num_boundary_edges += m->htwin[h] < 0;
+    in->num_extraordinary = 0; in->max_valence = 0; in->num_ignored_verts = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v];
+        if (nfan == 0) { in->num_ignored_verts++; continue; }
+        int32_t val = ccn__valence(m, v);
+        if (val > in->max_valence) in->max_valence = val;
+        if (!m->vboundary[v] && val != 4) in->num_extraordinary++;
+    }
+}
+
+/* ---- building from a polygon soup ----------------------------------------------- */
+
+typedef struct { int32_t a, b, h; } hkey;
+
+static int cmp_hkey(const void *x, const void *y) {
+    const hkey *p = x, *q = y;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    return (p->h > q->h) - (p->h < q->h);
+}
+
+static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err) {
+    if (!c) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "cage is NULL");
+    if (c->num_verts < 0 || c->num_faces < 0 || c->num_edges < 0)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                         "negative count (verts %d, faces %d, edges %d)", (int)c->num_verts,
+                         (int)c->num_faces, (int)c->num_edges);
+    if (c->num_faces == 0)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "cage has no faces");
+    if (!c->positions || !c->face_sizes || !c->face_verts)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                         "cage positions, face_sizes or face_verts is NULL");
+    if (c->num_edges > 0 && !c->edge_verts)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                         "num_edges is %d but edge_verts is NULL", (int)c->num_edges);
+    for (int32_t v = 0; v < c->num_verts; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = c->positions[3 * (size_t)v + k];
+            if (!isfinite(x))
+                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                 "vertex %d has a non-finite coordinate (NaN or Inf)", (int)v);
+            if (fabs(x) > CCN_COORD_MAX)
+                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                 "vertex %d has a coordinate beyond +-%g", (int)v, CCN_COORD_MAX);
+        }
+    int64_t nh = 0;
+    for (int32_t f = 0; f < c->num_faces; f++) {
+        int32_t s = c->face_sizes[f];
+        if (s < 3)
+            return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                             "face %d has %d vertices (at least 3 needed)", (int)f, (int)s);
+        nh += s;
+        if (nh > INT32_MAX / 8)
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_FACE, f,
+                             "cage too large: more than %d face corners", INT32_MAX / 8);
+    }
+    *nh_out = nh;
+    return CCN_OK;
+}
+
+static ccn_status fill_faces(ccn_mesh *m, const ccn_cage *c, ccn_error *err) {
+    int32_t h = 0;
+    for (int32_t f = 0; f < m->nf; f++) {
+        int32_t s = c->face_sizes[f];
+        m->fstart[f] = h;
+        for (int32_t k = 0; k < s; k++, h++) {
+            int32_t v = c->face_verts[h];
+            if (v < 0 || v >= m->nv)
+                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                 "face %d uses vertex index %d, out of range [0, %d)", (int)f,
+                                 (int)v, (int)m->nv);
+            for (int32_t j = 0; j < k; j++)
+                if (c->face_verts[m->fstart[f] + j] == v)
+                    return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                     "face %d repeats vertex %d", (int)f, (int)v);
+            m->hvert[h] = v;
+            m->hface[h] = f;
+        }
+    }
+    m->fstart[m->nf] = h;
+    return CCN_OK;
+}
+
+/* Pairs half-edges into edges (sorted keys), numbering edges by first appearance. */
+static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, ccn_error *err) {
+    int32_t nh = m->nh;
+    for (int32_t h = 0; h < nh; h++) {
+        int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
+        keys[h].a = a < b ? a : b;
+        keys[h].b = a < b ? b : a;
+        keys[h].h = h;
+    }
+    qsort(keys, (size_t)nh, sizeof *keys, cmp_hkey);
+    int32_t ng = 0;
+    for (int32_t i = 0; i < nh;) {
+        int32_t j = i + 1;
+        while (j < nh && keys[j].a == keys[i].a && keys[j].b == keys[i].b) j++;
+        for (int32_t k = i; k < j; k++) grp[keys[k].h] = ng;
+        m->htwin[keys[i].h] = -1;
+        if (j - i == 2) {
+            int32_t h0 = keys[i].h, h1 = keys[i + 1].h;
+            if (m->hvert[h0] == m->hvert[h1]) {
+                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, m->hface[h1],
+                                 "edge %d-%d is used in the same direction by faces %d and %d "
+                                 "(inconsistent orientation)", (int)keys[i].a, (int)keys[i].b,
+                                 (int)m->hface[h0], (int)m->hface[h1]);
+            }
+            m->htwin[h0] = h1;
+            m->htwin[h1] = h0;
+        } else if (j - i > 2) {
+            return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_EDGE, ng,
+                             "edge %d-%d is shared by %d faces (faces %d, %d, %d): non-manifold",
+                             (int)keys[i].a, (int)keys[i].b, (int)(j - i),
+                             (int)m->hface[keys[i].h], (int)m->hface[keys[i + 1].h],
+                             (int)m->hface[keys[i + 2].h]);
+        }
+        ng++;
+        i = j;
+    }
+    /* grp ids -> edge ids by first appearance; reuse keys[].a as the map */
+    for (int32_t g = 0; g < ng; g++) keys[g].a = -1;
+    int32_t ne = 0;
+    for (int32_t h = 0; h < nh; h++) {
+        int32_t g = grp[h];
+        if (keys[g].a < 0) {
+            keys[g].a = ne;
+            m->everts[2 * ne] = m->hvert[h];
+            m->everts[2 * ne + 1] = m->hvert[ccn__next(m, h)];
+            ne++;
+        }
+        m->hedge[h] = keys[g].a;
+    }
+    m->ne = ne;
+    return CCN_OK;
+}
+
+/* Finds edge (a,b) by binary search in keys sorted by (min,max); -1 if absent. */
+static int32_t find_edge(const ccn_mesh *m, const hkey *sorted, int32_t a, int32_t b) {
+    hkey k = {a < b ? a : b, a < b ? b : a, -1};
+    size_t lo = 0, hi = (size_t)m->nh;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        const hkey *s = &sorted[mid];
+        if (s->a < k.a || (s->a == k.a && s->b < k.b)) lo = mid + 1; else hi = mid;
+    }
+    if (lo < (size_t)m->nh && sorted[lo].a == k.a && sorted[lo].b == k.b)
+        return m->hedge[sorted[lo].h];
+    return -1;
+}
+
+static ccn_status apply_knots(ccn_mesh *m, const ccn_cage *c, hkey *keys, ccn_error *err) {
+    double *val = malloc(sizeof(double) * (size_t)(m->ne ? m->ne : 1));
+    if (!val) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    for (int32_t e = 0; e < m->ne; e++) val[e] = 0.0;
+    m->info.num_ignored_edges = 0;
+    if (c->edge_knots && c->edge_verts) {
+        /* keys must be sorted by (a,b): rebuild them (pair_edges reused .a as a map) */
+        for (int32_t h = 0; h < m->nh; h++) {
+            int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
+            keys[h].a = a < b ? a : b; keys[h].b = a < b ? b : a; keys[h].h = h;
+        }
+        qsort(keys, (size_t)m->nh, sizeof *keys, cmp_hkey);
+        for (int32_t i = 0; i < c->num_edges; i++) {
+            int32_t a = c->edge_verts[2 * i], b = c->edge_verts[2 * i + 1];
+            int32_t e = (a >= 0 && b >= 0 && a < m->nv && b < m->nv) ? find_edge(m, keys, a, b)
+                                                                      : -1;
+            if (e < 0) { m->info.num_ignored_edges++; continue; }
+            val[e] = c->edge_knots[i];
+        }
+    }
+    ccn_status st = ccn__resolve_rings(m, val, NULL, err);
+    free(val);
+    return st;
+}
+
+ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err) {
+    ccn__ok(err);
+    if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
+    *out = NULL;
+    int64_t nh = 0;
+    ccn_status st = check_args(cage, &nh, err);
+    if (st) return st;
+    ccn_mesh *m = ccn__mesh_alloc(cage->num_verts, cage->num_faces, (int32_t)nh, (int32_t)nh);
+    hkey *keys = malloc(sizeof(hkey) * (size_t)nh);
+    int32_t *grp = malloc(sizeof(int32_t) * (size_t)nh);
+    if (!m || !keys || !grp) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory for %lld corners",
+                       (long long)nh);
+        goto done;
+    }
+    memcpy(m->pos, cage->positions, sizeof(double) * 3 * (size_t)m->nv);
+    if ((st = fill_faces(m, cage, err))) goto done;
+    if ((st = pair_edges(m, keys, grp, err))) goto done;
+    int32_t bad = ccn__mesh_build_fans(m);
+    if (bad) {
+        st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, bad - 1,
+                       "vertex %d is non-manifold: its faces form more than one fan",
+                       (int)(bad - 1));
+        goto done;
+    }
+    for (int32_t v = 0; v < m->nv; v++)
+        if (!m->vboundary[v] && m->vfan_start[v + 1] - m->vfan_start[v] == 2) {
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
+                           "vertex %d is an interior vertex with only 2 edges (two faces share "
+                           "two consecutive edges): not supported", (int)v);
+            goto done;
+        }
+    if ((st = apply_knots(m, cage, keys, err))) goto done;
+    ccn__mesh_update_info(m);
+    m->info.level = 0;
+    *out = m;
+    m = NULL;
+done:
+    free(keys);
+    free(grp);
+    ccn_mesh_destroy(m);
+    return st;
+}
+
+ccn_status ccn_mesh_info_get(const ccn_mesh *m, ccn_mesh_info *info) {
+    if (!m || !info) return CCN_ERR_ARGUMENT;
+    *info = m->info;
+    return CCN_OK;
+}
+
+ccn_status ccn_mesh_copy(const ccn_mesh *m, double *positions, int32_t *face_sizes,
+                         int32_t *face_verts, int32_t *edge_verts, double *edge_knots) {
+    if (!m) return CCN_ERR_ARGUMENT;
+    if (positions) memcpy(positions, m->pos, sizeof(double) * 3 * (size_t)m->nv);
+    if (face_sizes)
+        for (int32_t f = 0; f < m->nf; f++) face_sizes[f] = ccn__fsize(m, f);
+    if (face_verts) memcpy(face_verts, m->hvert, sizeof(int32_t) * (size_t)m->nh);
+    if (edge_verts) memcpy(edge_verts, m->everts, sizeof(int32_t) * 2 * (size_t)m->ne);
+    if (edge_knots)
+        for (int32_t e = 0; e < m->ne; e++) edge_knots[e] = m->eknot[e] * m->knot_scale;
+    return CCN_OK;
+}
+
+ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_error *err) {
+    ccn__ok(err);
+    if (!m || !positions)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "mesh or positions is NULL");
+    for (int32_t i = 0; i < 3 * m->nv; i++) {
+        if (!isfinite(positions[i]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
+                             "vertex %d has a non-finite coordinate (NaN or Inf)", (int)(i / 3));
+        if (fabs(positions[i]) > CCN_COORD_MAX)
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
+                             "vertex %d has a coordinate beyond +-%g", (int)(i / 3), CCN_COORD_MAX);
+    }
+    memcpy(m->pos, positions, sizeof(double) * 3 * (size_t)m->nv);
+    return CCN_OK;
+}
+
+/* Exact scaling by a power of two (no centre shift: no precision is lost) so that the largest
+ * coordinate of the vertices in faces is below 1; isolated vertices do not count. */
+void ccn__normalize(ccn_mesh *m, double centre[3], double *scale) {
+    double big = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (m->vfan_start[v + 1] == m->vfan_start[v]) continue;
+        for (int k = 0; k < 3; k++) big = fmax(big, fabs(m->pos[3 * (size_t)v + k]));
+    }
+    centre[0] = centre[1] = centre[2] = 0;
+    int e = big > 0 && isfinite(big) ? ilogb(big) + 1 : 0;
+    if (e < -1000) e = -1000; /* subnormal input: 2^-e must stay finite */
+    if (e > 1000) e = 1000;
+    *scale = ldexp(1.0, e);
+    double inv = ldexp(1.0, -e); /* powers of two: exact */
+    for (size_t i = 0; i < 3 * (size_t)m->nv; i++) m->pos[i] *= inv;
+}
+
+void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale) {
+    for (int32_t v = 0; v < m->nv; v++)
+        for (int k = 0; k < 3; k++)
+            m->pos[3 * (size_t)v + k] = centre[k] + scale * m->pos[3 * (size_t)v + k];
+}

@@ -1,0 +1,17 @@
+/* Cage topology (internal): allocation, vertex fans, info, unit-box normalisation of a
+ * ccn_mesh (topology/halfedge.h). ccn_mesh_create and friends are public (ccnurbs.h). */
+#ifndef CCN_TOPOLOGY_MESH_H
+#define CCN_TOPOLOGY_MESH_H
+
+#include "topology/halfedge.h"
+
+ccn_mesh *ccn__mesh_alloc(int32_t nv, int32_t nf, int32_t nh, int32_t ne);
+/* Builds vfan / hfanpos / vboundary / valence info from hvert/htwin/fstart. Returns 0 on
+ * success, or the index + 1 of a vertex whose faces form more than one fan (non-manifold). */
+int32_t ccn__mesh_build_fans(ccn_mesh *m);
+void ccn__mesh_update_info(ccn_mesh *m);
+/* Affine normalisation of positions to a unit box (the rules are affine-invariant). */
+void ccn__normalize(ccn_mesh *m, double centre[3], double *scale);
+void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale);
+
+#endif
