@@ -1,6 +1,6 @@
 /* objdiff: compares two OBJ meshes whose vertex and face order may differ (test oracle).
  *
- *   objdiff [--tol-rel T] a.obj b.obj
+ *   objdiff [--tol-rel T] [--normals T] a.obj b.obj
  *
  * Needs equal vertex and face counts. Every vertex of a is matched to the nearest vertex of
  * b (k-d tree); the match must be a bijection. The error is max |a_i - b_match(i)| divided
@@ -9,7 +9,11 @@
  * rotation, same orientation).
  * Prints one line to stdout ("ok: ..." or "FAIL: ..."). Exit 0 if error <= T (default 1e-9)
  * and faces match, 1 otherwise, 2 on usage/parse errors or count mismatch.
- * Only `v` and `f` lines are read (1-based or negative indices, `a/b/c` tolerated).
+ * Only `v` and `f` lines are read (1-based or negative indices, `a/b/c` tolerated), and
+ * with --normals T also `vn` lines: each file needs one `vn` per `v` (the i-th belongs to the
+ * i-th vertex, as `ccnurbs limit` and `osd_refine --limit-normals` write them); for every
+ * matched pair whose normals are both non-zero the unit normals must differ by <= T (length
+ * of the difference); a zero normal (`vn 0 0 0`: undefined there) is skipped and counted.
  */
 #include <errno.h>
 #include <math.h>
@@ -22,6 +26,8 @@ typedef struct {
     const char *path;
     int nv, nf;
     double *pos;  /* 3*nv */
+    double *nrm;  /* 3*nn */
+    int nn;
     int *fsize;   /* nf */
     int *foff;    /* nf */
     int *fverts;  /* sum fsize, 0-based */
@@ -79,7 +85,18 @@ static void parse_obj(const char *path, Mesh *m) {
         if (eol) *eol = '\0';
         lineno++;
         while (is_space(*p)) p++;
-        if (p[0] == 'v' && is_space(p[1])) {
+        if (p[0] == 'v' && p[1] == 'n' && is_space(p[2])) {
+            if (m->nn % 1024 == 0) m->nrm = xrealloc(m->nrm, sizeof(double) * 3 * ((size_t)m->nn + 1024));
+            char *s = p + 2;
+            for (int k = 0; k < 3; k++) {
+                char *end;
+                double x = strtod(s, &end);
+                if (end == s || !isfinite(x)) die("%s:%ld: bad normal line", path, lineno);
+                m->nrm[3 * m->nn + k] = x;
+                s = end;
+            }
+            m->nn++;
+        } else if (p[0] == 'v' && is_space(p[1])) {
             if (m->nv == capv) {
                 capv = capv ? 2 * capv : 1024;
                 m->pos = xrealloc(m->pos, sizeof(double) * 3 * (size_t)capv);
@@ -244,25 +261,42 @@ static Face *canon_faces(const Mesh *m, const int *map, int **store) {
     return f;
 }
 
+/* Unit vector of n (3 doubles) into u; returns 0 for a zero vector. */
+static int unit(const double *n, double *u) {
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) return 0;
+    for (int k = 0; k < 3; k++) u[k] = n[k] / len;
+    return 1;
+}
+
 int main(int argc, char **argv) {
-    double tol = 1e-9;
+    double tol = 1e-9, ntol = -1.0;
     const char *pa = NULL, *pb = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--tol-rel") && i + 1 < argc) {
             char *end;
             tol = strtod(argv[++i], &end);
             if (*end || !(tol >= 0)) die("bad --tol-rel '%s'", argv[i]);
+        } else if (!strcmp(argv[i], "--normals") && i + 1 < argc) {
+            char *end;
+            ntol = strtod(argv[++i], &end);
+            if (*end || !(ntol >= 0)) die("bad --normals '%s'", argv[i]);
         } else if (argv[i][0] == '-' && argv[i][1]) {
-            die("usage: objdiff [--tol-rel T] a.obj b.obj (unknown option %s)", argv[i]);
+            die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj (unknown option %s)", argv[i]);
         } else if (!pa) pa = argv[i];
         else if (!pb) pb = argv[i];
-        else die("usage: objdiff [--tol-rel T] a.obj b.obj");
+        else die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj");
     }
-    if (!pa || !pb) die("usage: objdiff [--tol-rel T] a.obj b.obj");
+    if (!pa || !pb) die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj");
 
     Mesh a, b;
     parse_obj(pa, &a);
     parse_obj(pb, &b);
+    if (ntol >= 0 && (a.nn != a.nv || b.nn != b.nv)) {
+        printf("FAIL: --normals needs one vn per v: %s has %d v %d vn, %s has %d v %d vn\n", pa, a.nv,
+               a.nn, pb, b.nv, b.nn);
+        return 2;
+    }
     if (a.nv != b.nv || a.nf != b.nf) {
         fprintf(stderr, "objdiff: count mismatch: %s has %d verts %d faces, %s has %d verts %d faces\n",
                 pa, a.nv, a.nf, pb, b.nv, b.nf);
@@ -332,16 +366,38 @@ int main(int argc, char **argv) {
     if (ia < a.nf && !first_missing) first_missing = &fa[ia];
     missing += a.nf - ia;
 
-    int ok = rel <= tol && dup == 0 && missing == 0;
+    /* normals of matched vertices */
+    int ncmp = 0, nskip = 0, nworst_i = -1;
+    double nworst = 0.0;
+    char ntext[160] = "";
+    if (ntol >= 0) {
+        for (int i = 0; i < a.nv; i++) {
+            double ua[3], ub[3];
+            if (!unit(a.nrm + 3 * i, ua) || !unit(b.nrm + 3 * map[i], ub)) { nskip++; continue; }
+            double d = sqrt((ua[0] - ub[0]) * (ua[0] - ub[0]) + (ua[1] - ub[1]) * (ua[1] - ub[1]) +
+                            (ua[2] - ub[2]) * (ua[2] - ub[2]));
+            ncmp++;
+            if (d > nworst || nworst_i < 0) { nworst = d; nworst_i = i; }
+        }
+        snprintf(ntext, sizeof ntext, ", normals %d compared (%d zero, skipped), max_diff %.3g", ncmp,
+                 nskip, nworst);
+    }
+    int nok = ntol < 0 || nworst <= ntol;
+    int ok = rel <= tol && dup == 0 && missing == 0 && nok;
     if (ok) {
-        printf("ok: %d verts, %d faces, max_rel %.3g\n", a.nv, a.nf, rel);
+        printf("ok: %d verts, %d faces, max_rel %.3g%s\n", a.nv, a.nf, rel, ntext);
         return 0;
     }
     const double *p = a.pos + 3 * worst_i, *q = b.pos + 3 * map[worst_i];
-    printf("FAIL: %d verts, %d faces, max_rel %.3g", a.nv, a.nf, rel);
+    printf("FAIL: %d verts, %d faces, max_rel %.3g%s", a.nv, a.nf, rel, ntext);
     if (!(rel <= tol))
         printf(" > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
                tol, worst_i + 1, p[0], p[1], p[2], map[worst_i] + 1, q[0], q[1], q[2]);
+    if (!nok) {
+        const double *na = a.nrm + 3 * nworst_i, *nb = b.nrm + 3 * map[nworst_i];
+        printf("; normal > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
+               ntol, nworst_i + 1, na[0], na[1], na[2], map[nworst_i] + 1, nb[0], nb[1], nb[2]);
+    }
     if (dup) printf("; not a bijection: %d b-vertices matched more than once (a-vertex %d)", dup, first_dup + 1);
     if (missing) {
         printf("; %d of %d faces of a not in b (e.g. b-vertices", missing, a.nf);
