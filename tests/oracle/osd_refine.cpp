@@ -48,7 +48,8 @@
 //     refines it one level with the same options, takes the child vertex's one-ring, and so
 //     on: until no semi-sharp value is left around it (the mask is then exact), and at a dart
 //     or valence-2 vertex until the point moves by <= 1e-16 of the level-K one-ring's size
-//     (the environment variable OSD_REFINE_SETTLE changes 1e-16; at most 120 levels). A
+//     or 4 ulps of its coordinates (the environment variable OSD_REFINE_SETTLE changes
+//     1e-16; at most 120 levels). A
 //     vertex's next one-ring depends only on its one-ring and the sharpness of its edges,
 //     so nothing else is needed. Checked: equal (<= 2e-16 of the bounding box) to
 //     PrimvarRefiner::Limit after refining the whole mesh past every semi-sharp value.
@@ -72,6 +73,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -602,12 +604,14 @@ LimitPoint localLimit(Far::TopologyLevel const &lev, std::vector<Vertex3> const 
         Far::PrimvarRefinerReal<double> pr(*ref);
         pr.Interpolate(1, c.pos, next);
         const int child = ref->GetLevel(0).GetVertexChildVertex(center);
-        double d2 = 0.0;
+        double d2 = 0.0, mag = 0.0;
         for (int k = 0; k < 3; k++) {
             const double d = next[(size_t)child].p[k] - c.pos[(size_t)center].p[k];
             d2 += d * d;
+            mag = std::max(mag, std::fabs(next[(size_t)child].p[k]));
         }
-        settled = std::sqrt(d2) <= g_settle * scale;
+        // the move cannot get below the rounding of the coordinates themselves
+        settled = std::sqrt(d2) <= std::max(g_settle * scale, 4 * DBL_EPSILON * mag);
         Cage nc;
         center = extractRing(ref->GetLevel(1), next, child, nc);
         c.pos.swap(nc.pos);
