@@ -53,6 +53,8 @@
 //     vertex's next one-ring depends only on its one-ring and the sharpness of its edges,
 //     so nothing else is needed. Checked: equal (<= 2e-16 of the bounding box) to
 //     PrimvarRefiner::Limit after refining the whole mesh past every semi-sharp value.
+//     A vertex of a non-quad face (--levels 0) is refined the same way, so --limit works at
+//     level 0 on any mesh.
 //   --limit-normals: --limit plus `vn` lines (one per `v`, unit length): the normalised
 //     cross product Tan1 x Tan2 of PrimvarRefiner::Limit, only where those tangents span the
 //     exact tangent plane: interior smooth vertices of valence >= 3 (eigenvector masks),
