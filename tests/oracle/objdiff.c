@@ -1,15 +1,25 @@
 /* objdiff: compares two OBJ meshes whose vertex and face order may differ (test oracle).
  *
- *   objdiff [--tol-rel T] a.obj b.obj
+ *   objdiff [--tol-rel T] [--normals T] a.obj b.obj
  *
  * Needs equal vertex and face counts. Every vertex of a is matched to the nearest vertex of
  * b (k-d tree); the match must be a bijection. The error is max |a_i - b_match(i)| divided
  * by the bounding-box diagonal of a (1 if that is 0). Faces of a, renumbered through the
  * match, must equal the faces of b as a multiset of cyclic sequences (any face order, any
  * rotation, same orientation).
+ * Coincident vertices: b-vertices within 1e-12 of the diagonal of each other (e.g. the face
+ * points of two faces on the same vertices, as in OpenSubdiv's catmark_val2_back2back) form
+ * one group, which position cannot tell apart. The bijection is then checked per group (as
+ * many a-vertices matched into it as it has members), faces are compared as cycles of group
+ * ids, and a normal is compared with the nearest normal of its group. Without such groups
+ * this is the plain check above.
  * Prints one line to stdout ("ok: ..." or "FAIL: ..."). Exit 0 if error <= T (default 1e-9)
  * and faces match, 1 otherwise, 2 on usage/parse errors or count mismatch.
- * Only `v` and `f` lines are read (1-based or negative indices, `a/b/c` tolerated).
+ * Only `v` and `f` lines are read (1-based or negative indices, `a/b/c` tolerated), and
+ * with --normals T also `vn` lines: each file needs one `vn` per `v` (the i-th belongs to the
+ * i-th vertex, as `ccnurbs limit` and `osd_refine --limit-normals` write them); for every
+ * matched pair whose normals are both non-zero the unit normals must differ by <= T (length
+ * of the difference); a zero normal (`vn 0 0 0`: undefined there) is skipped and counted.
  */
 #include <errno.h>
 #include <math.h>
@@ -22,6 +32,8 @@ typedef struct {
     const char *path;
     int nv, nf;
     double *pos;  /* 3*nv */
+    double *nrm;  /* 3*nn */
+    int nn;
     int *fsize;   /* nf */
     int *foff;    /* nf */
     int *fverts;  /* sum fsize, 0-based */
@@ -79,7 +91,18 @@ static void parse_obj(const char *path, Mesh *m) {
         if (eol) *eol = '\0';
         lineno++;
         while (is_space(*p)) p++;
-        if (p[0] == 'v' && is_space(p[1])) {
+        if (p[0] == 'v' && p[1] == 'n' && is_space(p[2])) {
+            if (m->nn % 1024 == 0) m->nrm = xrealloc(m->nrm, sizeof(double) * 3 * ((size_t)m->nn + 1024));
+            char *s = p + 2;
+            for (int k = 0; k < 3; k++) {
+                char *end;
+                double x = strtod(s, &end);
+                if (end == s || !isfinite(x)) die("%s:%ld: bad normal line", path, lineno);
+                m->nrm[3 * m->nn + k] = x;
+                s = end;
+            }
+            m->nn++;
+        } else if (p[0] == 'v' && is_space(p[1])) {
             if (m->nv == capv) {
                 capv = capv ? 2 * capv : 1024;
                 m->pos = xrealloc(m->pos, sizeof(double) * 3 * (size_t)capv);
@@ -208,6 +231,30 @@ static void kd_nearest(const KdTree *t, int lo, int hi, const double *q, int *be
     }
 }
 
+/* Every point of the tree within squared distance r2 of q: out[(*n)++] (caller sizes out). */
+static void kd_radius(const KdTree *t, int lo, int hi, const double *q, double r2, int *out, int *n) {
+    while (hi > lo) {
+        int mid = lo + (hi - lo) / 2;
+        const double *p = t->pos + 3 * t->idx[mid];
+        double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+        if (dx * dx + dy * dy + dz * dz <= r2) out[(*n)++] = t->idx[mid];
+        if (hi - lo == 1) return;
+        int ax = t->axis[mid];
+        double diff = q[ax] - p[ax];
+        if (diff <= 0 || diff * diff <= r2) kd_radius(t, lo, mid, q, r2, out, n);
+        if (diff >= 0 || diff * diff <= r2) { lo = mid + 1; continue; }
+        return;
+    }
+}
+
+static int uf_find(int *parent, int x) {
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
 /* ---- faces as canonical cyclic sequences ---- */
 typedef struct {
     int n;
@@ -222,21 +269,32 @@ static int face_cmp(const void *x, const void *y) {
     return 0;
 }
 
-/* Writes each face (vertex ids through map, if given) rotated so its smallest id is first. */
-static Face *canon_faces(const Mesh *m, const int *map, int **store) {
+/* Writes each face (vertex ids through map, then through group, if given) at its
+ * lexicographically smallest rotation (the smallest id first when ids are distinct). */
+static Face *canon_faces(const Mesh *m, const int *map, const int *group, int **store) {
     Face *f = xrealloc(NULL, sizeof(Face) * (size_t)m->nf);
     int *s = xrealloc(NULL, sizeof(int) * (size_t)m->nfv);
     for (int i = 0; i < m->nf; i++) {
         int n = m->fsize[i], off = m->foff[i], r = 0;
         const int *src = m->fverts + off;
-        for (int k = 1; k < n; k++) {
-            int vk = map ? map[src[k]] : src[k], vr = map ? map[src[r]] : src[r];
-            if (vk < vr) r = k;
-        }
+        int *ids = s + off;
         for (int k = 0; k < n; k++) {
-            int v = src[(r + k) % n];
-            s[off + k] = map ? map[v] : v;
+            int v = map ? map[src[k]] : src[k];
+            ids[k] = group ? group[v] : v;
         }
+        for (int c = 1; c < n; c++) {
+            for (int k = 0; k < n; k++) {
+                int x = ids[(c + k) % n], y = ids[(r + k) % n];
+                if (x != y) {
+                    if (x < y) r = c;
+                    break;
+                }
+            }
+        }
+        int tmp[64], *rot = n <= 64 ? tmp : xrealloc(NULL, sizeof(int) * (size_t)n);
+        for (int k = 0; k < n; k++) rot[k] = ids[(r + k) % n];
+        memcpy(ids, rot, sizeof(int) * (size_t)n);
+        if (rot != tmp) free(rot);
         f[i].n = n;
         f[i].v = s + off;
     }
@@ -244,25 +302,42 @@ static Face *canon_faces(const Mesh *m, const int *map, int **store) {
     return f;
 }
 
+/* Unit vector of n (3 doubles) into u; returns 0 for a zero vector. */
+static int unit(const double *n, double *u) {
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) return 0;
+    for (int k = 0; k < 3; k++) u[k] = n[k] / len;
+    return 1;
+}
+
 int main(int argc, char **argv) {
-    double tol = 1e-9;
+    double tol = 1e-9, ntol = -1.0;
     const char *pa = NULL, *pb = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--tol-rel") && i + 1 < argc) {
             char *end;
             tol = strtod(argv[++i], &end);
             if (*end || !(tol >= 0)) die("bad --tol-rel '%s'", argv[i]);
+        } else if (!strcmp(argv[i], "--normals") && i + 1 < argc) {
+            char *end;
+            ntol = strtod(argv[++i], &end);
+            if (*end || !(ntol >= 0)) die("bad --normals '%s'", argv[i]);
         } else if (argv[i][0] == '-' && argv[i][1]) {
-            die("usage: objdiff [--tol-rel T] a.obj b.obj (unknown option %s)", argv[i]);
+            die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj (unknown option %s)", argv[i]);
         } else if (!pa) pa = argv[i];
         else if (!pb) pb = argv[i];
-        else die("usage: objdiff [--tol-rel T] a.obj b.obj");
+        else die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj");
     }
-    if (!pa || !pb) die("usage: objdiff [--tol-rel T] a.obj b.obj");
+    if (!pa || !pb) die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj");
 
     Mesh a, b;
     parse_obj(pa, &a);
     parse_obj(pb, &b);
+    if (ntol >= 0 && (a.nn != a.nv || b.nn != b.nv)) {
+        printf("FAIL: --normals needs one vn per v: %s has %d v %d vn, %s has %d v %d vn\n", pa, a.nv,
+               a.nn, pb, b.nv, b.nn);
+        return 2;
+    }
     if (a.nv != b.nv || a.nf != b.nf) {
         fprintf(stderr, "objdiff: count mismatch: %s has %d verts %d faces, %s has %d verts %d faces\n",
                 pa, a.nv, a.nf, pb, b.nv, b.nf);
@@ -294,6 +369,41 @@ int main(int argc, char **argv) {
     for (int i = 0; i < b.nv; i++) t.idx[i] = i;
     kd_build(&t, 0, b.nv);
 
+    /* groups of coincident b-vertices (union-find; the root is the smallest index) */
+    int *group = xrealloc(NULL, sizeof(int) * (size_t)b.nv);
+    int *gsize = calloc((size_t)b.nv, sizeof(int));
+    int *gnext = xrealloc(NULL, sizeof(int) * (size_t)b.nv); /* next member of the group, -1 */
+    int *near = xrealloc(NULL, sizeof(int) * (size_t)b.nv);
+    if (!gsize) die("out of memory");
+    for (int j = 0; j < b.nv; j++) group[j] = j;
+    const double cr = 1e-12 * diag;
+    for (int j = 0; j < b.nv; j++) {
+        int nn = 0;
+        kd_radius(&t, 0, b.nv, b.pos + 3 * j, cr * cr, near, &nn);
+        for (int k = 0; k < nn; k++) {
+            int x = uf_find(group, j), y = uf_find(group, near[k]);
+            if (x < y) group[y] = x;
+            else if (y < x) group[x] = y;
+        }
+    }
+    int ngroups = 0; /* groups with more than one member */
+    for (int j = b.nv - 1; j >= 0; j--) {
+        group[j] = uf_find(group, j);
+        gnext[j] = -1;
+    }
+    {
+        int *last = xrealloc(NULL, sizeof(int) * (size_t)b.nv);
+        for (int j = 0; j < b.nv; j++) last[j] = -1;
+        for (int j = 0; j < b.nv; j++) {
+            int g = group[j];
+            if (gsize[g]++ == 1) ngroups++;
+            if (last[g] >= 0) gnext[last[g]] = j;
+            last[g] = j;
+        }
+        free(last);
+    }
+    free(near);
+
     int *map = xrealloc(NULL, sizeof(int) * (size_t)a.nv);
     int *used = calloc((size_t)b.nv, sizeof(int));
     if (!used) die("out of memory");
@@ -304,7 +414,7 @@ int main(int argc, char **argv) {
         double bestd2 = INFINITY;
         kd_nearest(&t, 0, b.nv, a.pos + 3 * i, &best, &bestd2);
         map[i] = best;
-        if (used[best]++) {
+        if (++used[group[best]] > gsize[group[best]]) {
             dup++;
             if (first_dup < 0) first_dup = i;
         }
@@ -318,7 +428,7 @@ int main(int argc, char **argv) {
 
     /* faces */
     int *sa, *sb;
-    Face *fa = canon_faces(&a, map, &sa), *fb = canon_faces(&b, NULL, &sb);
+    Face *fa = canon_faces(&a, map, group, &sa), *fb = canon_faces(&b, NULL, group, &sb);
     qsort(fa, (size_t)a.nf, sizeof(Face), face_cmp);
     qsort(fb, (size_t)b.nf, sizeof(Face), face_cmp);
     int missing = 0, ia = 0, ib = 0;
@@ -332,17 +442,48 @@ int main(int argc, char **argv) {
     if (ia < a.nf && !first_missing) first_missing = &fa[ia];
     missing += a.nf - ia;
 
-    int ok = rel <= tol && dup == 0 && missing == 0;
+    /* normals of matched vertices */
+    int ncmp = 0, nskip = 0, nworst_i = -1;
+    double nworst = 0.0;
+    char ntext[160] = "";
+    if (ntol >= 0) {
+        for (int i = 0; i < a.nv; i++) {
+            double ua[3], ub[3], d = INFINITY;
+            int zero = !unit(a.nrm + 3 * i, ua);
+            for (int j = group[map[i]]; j >= 0 && !zero; j = gnext[j]) {
+                if (!unit(b.nrm + 3 * j, ub)) { zero = 1; break; }
+                double dj = sqrt((ua[0] - ub[0]) * (ua[0] - ub[0]) + (ua[1] - ub[1]) * (ua[1] - ub[1]) +
+                                 (ua[2] - ub[2]) * (ua[2] - ub[2]));
+                if (dj < d) d = dj;
+            }
+            if (zero) { nskip++; continue; }
+            ncmp++;
+            if (d > nworst || nworst_i < 0) { nworst = d; nworst_i = i; }
+        }
+        snprintf(ntext, sizeof ntext, ", normals %d compared (%d zero, skipped), max_diff %.3g", ncmp,
+                 nskip, nworst);
+    }
+    if (ngroups) {
+        size_t l = strlen(ntext);
+        snprintf(ntext + l, sizeof ntext - l, ", %d coincident vertex group(s)", ngroups);
+    }
+    int nok = ntol < 0 || nworst <= ntol;
+    int ok = rel <= tol && dup == 0 && missing == 0 && nok;
     if (ok) {
-        printf("ok: %d verts, %d faces, max_rel %.3g\n", a.nv, a.nf, rel);
+        printf("ok: %d verts, %d faces, max_rel %.3g%s\n", a.nv, a.nf, rel, ntext);
         return 0;
     }
     const double *p = a.pos + 3 * worst_i, *q = b.pos + 3 * map[worst_i];
-    printf("FAIL: %d verts, %d faces, max_rel %.3g", a.nv, a.nf, rel);
+    printf("FAIL: %d verts, %d faces, max_rel %.3g%s", a.nv, a.nf, rel, ntext);
     if (!(rel <= tol))
         printf(" > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
                tol, worst_i + 1, p[0], p[1], p[2], map[worst_i] + 1, q[0], q[1], q[2]);
-    if (dup) printf("; not a bijection: %d b-vertices matched more than once (a-vertex %d)", dup, first_dup + 1);
+    if (!nok) {
+        const double *na = a.nrm + 3 * nworst_i, *nb = b.nrm + 3 * map[nworst_i];
+        printf("; normal > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
+               ntol, nworst_i + 1, na[0], na[1], na[2], map[nworst_i] + 1, nb[0], nb[1], nb[2]);
+    }
+    if (dup) printf("; not a bijection: %d b-vertices (or group members) matched more than once (a-vertex %d)", dup, first_dup + 1);
     if (missing) {
         printf("; %d of %d faces of a not in b (e.g. b-vertices", missing, a.nf);
         for (int k = 0; k < first_missing->n; k++) printf(" %d", first_missing->v[k] + 1);

@@ -1,26 +1,91 @@
 // osd_refine: reference Catmull-Clark refinement with OpenSubdiv (test oracle).
 //
-//   osd_refine [--levels K] [--corners smooth|pinned] [--limit] in.obj out.obj
+//   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd]
+//              in.obj out.obj
 //
-// Reads `v x y z` and `f a b c ...` lines (1-based, negative = relative, `a/b/c` tolerated,
-// every other line ignored), refines uniformly K levels (default 1) with SCHEME_CATMARK,
-// Sdc boundary interpolation EDGE_ONLY (smooth) or EDGE_AND_CORNER (pinned), default
-// creasing, and writes the level-K mesh (`v` with %.17g, `f` 1-based). With --limit the `v`
-// lines hold the limit positions of the level-K vertices instead. Positions are refined in
-// double precision (PrimvarRefinerReal<double>, double mask weights).
+// Input. `v x y z` and `f a b c ...` lines (1-based, negative = relative, `a/b/c` tolerated),
+// plus sharpness and options in either of two forms:
+//   OpenSubdiv shape tags (regression/common/shape_utils.cpp Shape::tag::parseTag, applied as
+//   in regression/common/far_utils.h GetSdcOptions / assignComponentTags):
+//     t NAME nints/nfloats/nstrings int... float... string...
+//     t crease 2k/1/0 a0 b0 ... a(k-1) b(k-1) s       k edges (0-based vertex pairs), one
+//     t crease 2k/k/0 a0 b0 ... s0 ... s(k-1)          sharpness for all or one per edge
+//     t corner k/1/0 v0 ... s  |  t corner k/k/0 v0 ... s0 ...   vertex sharpness
+//     t interpolateboundary 1/0/0 m      m = 0 VTX_BOUNDARY_NONE, 1 EDGE_AND_CORNER,
+//                                        2 EDGE_ONLY (far_utils.h; RenderMan's numbering)
+//     t creasemethod 0/0/1 normal|chaikin   CREASE_UNIFORM | CREASE_CHAIKIN ("uniform" is
+//                                        accepted as a synonym of "normal")
+//     t facevaryinginterpolateboundary 1/0/0 m   m = 0..5: FVAR_LINEAR_NONE, CORNERS_ONLY,
+//                                        CORNERS_PLUS1, CORNERS_PLUS2, BOUNDARIES, ALL; stored
+//                                        in Sdc::Options (no effect on vertex data)
+//     t smoothtriangles 0/0/1 catmark|smooth   TRI_SUB_CATMARK | TRI_SUB_SMOOTH
+//   Other tags (hole, vertexedit, ...) are ignored with a warning on stderr. Sharpness is
+//   clamped to >= 0 as OpenSubdiv does (std::max(0.0f, s)); a malformed tag is an error.
+//   Differences from far_utils.h: with several sharpness values far_utils.h reads
+//   floatargs[j] for the pair starting at int j (0, 2, 4, ...), which runs past the array;
+//   here value k goes with pair k. No OpenSubdiv shape has more than one value per tag.
+//   (RenderMan's crease tag lists a chain of vertices; OpenSubdiv's shapes use pairs.)
+//   CCNURBS comments (1-based vertex indices, OpenSubdiv sharpness):
+//     # crease i j s      edge i-j has sharpness s
+//     # corner i s        vertex i has sharpness s
+//   A comment whose word after crease/corner is not an integer is prose (OpenSubdiv's shapes
+//   have "#  crease tags for perimeter:") and is ignored.
+//   A later value for the same edge or vertex replaces an earlier one (as in OpenSubdiv).
+//   A crease on a pair of vertices that is not an edge of a face is an error.
+// Options. Boundary interpolation is EDGE_ONLY (--corners smooth, the default) or
+// EDGE_AND_CORNER (--corners pinned) unless the file has an interpolateboundary tag, which
+// then wins over --corners. Creasing is CREASE_UNIFORM unless creasemethod says chaikin.
+// Output. The level-K mesh (`v` with %.17g, `f` 1-based), K = --levels (default 1), refined
+// uniformly with SCHEME_CATMARK in double precision (PrimvarRefinerReal<double>).
+//   --limit: the `v` lines hold the exact limit positions of the level-K vertices.
+//     PrimvarRefiner::Limit applies the limit mask of each vertex's rule at the level it is
+//     called on, which is exact only where that mask belongs to the vertex's refinement
+//     matrix for all later levels. It is not where an edge or vertex with sharpness
+//     0 < s < 10 is left at level K (the mask treats it as infinitely sharp), at a dart (the
+//     smooth mask, but the dart's sharp edge refines with the crease rule) and at an
+//     interior valence-2 vertex (the corner mask: the point itself). For such a vertex this
+//     tool takes the vertex's one-ring of faces (positions, edge and vertex sharpness),
+//     refines it one level with the same options, takes the child vertex's one-ring, and so
+//     on: until no semi-sharp value is left around it (the mask is then exact), and at a dart
+//     or valence-2 vertex until the point moves by <= 1e-16 of the level-K one-ring's size
+//     or 4 ulps of its coordinates (the environment variable OSD_REFINE_SETTLE changes
+//     1e-16; at most 120 levels). A
+//     vertex's next one-ring depends only on its one-ring and the sharpness of its edges,
+//     so nothing else is needed. Checked: equal (<= 2e-16 of the bounding box) to
+//     PrimvarRefiner::Limit after refining the whole mesh past every semi-sharp value.
+//     A vertex of a non-quad face (--levels 0) is refined the same way, so --limit works at
+//     level 0 on any mesh.
+//   --limit-normals: --limit plus `vn` lines (one per `v`, unit length): the normalised
+//     cross product Tan1 x Tan2 of PrimvarRefiner::Limit, only where those tangents span the
+//     exact tangent plane: interior smooth vertices of valence >= 3 (eigenvector masks),
+//     regular boundary vertices (2 faces: the B-spline cross tangent) and sharp corners of one
+//     face (the two boundary curves' end tangents). Everywhere else the line is `vn 0 0 0`
+//     (undefined): interior crease vertices and corners of several faces (two or more
+//     tangent planes; Tan2 is one side's), darts (smooth masks, not the dart's), interior
+//     valence-2 vertices (chords of the two edges), smooth corners (average of the two
+//     boundary chords), boundary vertices of 3 or more faces (Biermann et al.'s masks, not
+//     those of these rules: they differ from deep refinement by up to 1e-2), and boundary
+//     vertices under interpolateboundary 0.
+//   --limit-osd: plain PrimvarRefiner::Limit at level K (OpenSubdiv's own approximation
+//     described above), for comparison.
 // Level-K vertex order: OpenSubdiv "orderVerticesFromFacesFirst" (at each level face
 // points, then edge points, then vertex points). Errors: message on stderr, exit 2.
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace OpenSubdiv;
@@ -41,9 +106,19 @@ struct Mesh {
     std::vector<Vertex3> verts;
     std::vector<int> faceSizes;
     std::vector<int> faceVerts;
+    // sharpness, 0-based; later entries replace earlier ones
+    std::map<std::pair<int, int>, float> creases;  // key: (min, max) vertex
+    std::map<int, float> corners;
+    // options from tags (-1 = not given)
+    int interpolateBoundary = -1;
+    int fvarInterpolateBoundary = -1;
+    int creaseMethod = -1;  // 0 normal, 1 chaikin
+    int smoothTriangles = -1;
 };
 
 int g_osdErrors = 0;
+double g_settle = 1e-16;  // environment OSD_REFINE_SETTLE overrides (for experiments)
+int g_maxLevels = 120;
 
 void osdError(Far::ErrorType, const char *msg) {
     std::fprintf(stderr, "osd_refine: OpenSubdiv error: %s\n", msg);
@@ -60,7 +135,182 @@ void osdWarning(const char *msg) {
 }
 
 void usage() {
-    die("usage: osd_refine [--levels K] [--corners smooth|pinned] [--limit] in.obj out.obj");
+    die("usage: osd_refine [--levels K] [--corners smooth|pinned] "
+        "[--limit | --limit-normals | --limit-osd] in.obj out.obj");
+}
+
+bool parseLong(const std::string &tok, long &out) {
+    char *end = nullptr;
+    errno = 0;
+    long x = std::strtol(tok.c_str(), &end, 10);
+    if (end == tok.c_str() || *end != '\0' || errno) return false;
+    out = x;
+    return true;
+}
+
+bool parseDouble(const std::string &tok, double &out) {
+    char *end = nullptr;
+    errno = 0;
+    double x = std::strtod(tok.c_str(), &end);
+    if (end == tok.c_str() || *end != '\0') return false;
+    out = x;
+    return true;
+}
+
+// OpenSubdiv clamps sharpness with std::max(0.0f, s), which also turns NaN into 0.
+float clampSharpness(double s) {
+    float f = (float)s;
+    return std::max(0.0f, f);
+}
+
+// Parses a `t` line (tokens after "t"). Returns false with msg on a malformed tag.
+bool parseTag(std::istringstream &ss, Mesh &m, const std::string &where, std::string &msg) {
+    std::string name, counts;
+    if (!(ss >> name >> counts)) {
+        msg = where + "tag needs a name and nints/nfloats/nstrings";
+        return false;
+    }
+    long n[3] = {0, 0, 0};
+    {
+        std::vector<std::string> parts;
+        std::string part;
+        std::istringstream cs(counts);
+        while (std::getline(cs, part, '/')) parts.push_back(part);
+        if (parts.size() != 3) {
+            msg = where + "tag counts must be nints/nfloats/nstrings, got '" + counts + "'";
+            return false;
+        }
+        for (int k = 0; k < 3; k++)
+            if (!parseLong(parts[k], n[k]) || n[k] < 0 || n[k] > 100000000L) {
+                msg = where + "bad tag count '" + counts + "'";
+                return false;
+            }
+    }
+    std::vector<long> ints;
+    std::vector<double> floats;
+    std::vector<std::string> strings;
+    std::string tok;
+    for (long k = 0; k < n[0]; k++) {
+        long x;
+        if (!(ss >> tok) || !parseLong(tok, x)) {
+            msg = where + "tag '" + name + "' needs " + std::to_string(n[0]) + " integers";
+            return false;
+        }
+        ints.push_back(x);
+    }
+    for (long k = 0; k < n[1]; k++) {
+        double x;
+        if (!(ss >> tok) || !parseDouble(tok, x)) {
+            msg = where + "tag '" + name + "' needs " + std::to_string(n[1]) + " numbers";
+            return false;
+        }
+        floats.push_back(x);
+    }
+    for (long k = 0; k < n[2]; k++) {
+        if (!(ss >> tok)) {
+            msg = where + "tag '" + name + "' needs " + std::to_string(n[2]) + " strings";
+            return false;
+        }
+        strings.push_back(tok);
+    }
+    if (ss >> tok) {
+        msg = where + "tag '" + name + "' has extra value '" + tok + "'";
+        return false;
+    }
+    auto oneInt = [&](long lo, long hi, int &dst) {
+        if (ints.size() != 1 || ints[0] < lo || ints[0] > hi) {
+            msg = where + "tag '" + name + "' needs one integer in " + std::to_string(lo) +
+                  ".." + std::to_string(hi);
+            return false;
+        }
+        dst = (int)ints[0];
+        return true;
+    };
+    if (name == "crease") {
+        const size_t pairs = ints.size() / 2;
+        if (ints.size() < 2 || ints.size() % 2 || !(floats.size() == 1 || floats.size() == pairs)) {
+            msg = where + "crease tag needs vertex pairs and one sharpness or one per pair";
+            return false;
+        }
+        for (size_t k = 0; k < pairs; k++) {
+            long a = ints[2 * k], b = ints[2 * k + 1];
+            if (a < 0 || b < 0 || a > 2000000000L || b > 2000000000L || a == b) {
+                msg = where + "bad crease edge " + std::to_string(a) + " " + std::to_string(b);
+                return false;
+            }
+            m.creases[{(int)std::min(a, b), (int)std::max(a, b)}] =
+                clampSharpness(floats.size() == 1 ? floats[0] : floats[k]);
+        }
+    } else if (name == "corner") {
+        if (ints.empty() || !(floats.size() == 1 || floats.size() == ints.size())) {
+            msg = where + "corner tag needs vertices and one sharpness or one per vertex";
+            return false;
+        }
+        for (size_t k = 0; k < ints.size(); k++) {
+            if (ints[k] < 0 || ints[k] > 2000000000L) {
+                msg = where + "bad corner vertex " + std::to_string(ints[k]);
+                return false;
+            }
+            m.corners[(int)ints[k]] = clampSharpness(floats.size() == 1 ? floats[0] : floats[k]);
+        }
+    } else if (name == "interpolateboundary") {
+        return oneInt(0, 2, m.interpolateBoundary);
+    } else if (name == "facevaryinginterpolateboundary") {
+        return oneInt(0, 5, m.fvarInterpolateBoundary);
+    } else if (name == "creasemethod") {
+        if (strings.size() != 1 ||
+            !(strings[0] == "normal" || strings[0] == "uniform" || strings[0] == "chaikin")) {
+            msg = where + "creasemethod tag needs one string: normal (or uniform) or chaikin";
+            return false;
+        }
+        m.creaseMethod = strings[0] == "chaikin" ? 1 : 0;
+    } else if (name == "smoothtriangles") {
+        if (strings.size() != 1 || !(strings[0] == "catmark" || strings[0] == "smooth")) {
+            msg = where + "smoothtriangles tag needs one string: catmark or smooth";
+            return false;
+        }
+        m.smoothTriangles = strings[0] == "smooth" ? 1 : 0;
+    } else {
+        std::fprintf(stderr, "osd_refine: warning: %signoring unsupported tag '%s'\n",
+                     where.c_str(), name.c_str());
+    }
+    return true;
+}
+
+// "# crease i j s" / "# corner i s" (1-based). Other comments are ignored.
+bool parseComment(std::istringstream &ss, Mesh &m, const std::string &where, std::string &msg) {
+    std::string kw;
+    if (!(ss >> kw)) return true;
+    if (kw != "crease" && kw != "corner") return true;
+    const int nInts = kw == "crease" ? 2 : 1;
+    long idx[2] = {0, 0};
+    double s = 0;
+    std::string tok;
+    // "# crease tags for perimeter:" (OpenSubdiv's shapes) is prose, not a statement
+    if (!(ss >> tok) || !parseLong(tok, idx[0])) return true;
+    for (int k = 0; k < nInts; k++) {
+        if ((k > 0 && !(ss >> tok)) || !parseLong(tok, idx[k]) || idx[k] < 1 ||
+            idx[k] > 2000000000L) {
+            msg = where + "expected '# " + kw + (nInts == 2 ? " i j s" : " i s") +
+                  "' with 1-based vertex indices";
+            return false;
+        }
+    }
+    if (!(ss >> tok) || !parseDouble(tok, s)) {
+        msg = where + "expected a sharpness after '# " + kw + "'";
+        return false;
+    }
+    if (nInts == 2) {
+        if (idx[0] == idx[1]) {
+            msg = where + "crease edge needs two different vertices";
+            return false;
+        }
+        m.creases[{(int)std::min(idx[0], idx[1]) - 1, (int)std::max(idx[0], idx[1]) - 1}] =
+            clampSharpness(s);
+    } else {
+        m.corners[(int)idx[0] - 1] = clampSharpness(s);
+    }
+    return true;
 }
 
 // Parses an OBJ file; returns false with msg set on error.
@@ -75,11 +325,17 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
     while (std::getline(in, line)) {
         lineNo++;
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::ostringstream where;
+        where << path << ":" << lineNo << ": ";
+        size_t first = line.find_first_not_of(" \t");
+        if (first != std::string::npos && line[first] == '#') {
+            std::istringstream cs(line.substr(first + 1));
+            if (!parseComment(cs, m, where.str(), msg)) return false;
+            continue;
+        }
         std::istringstream ss(line);
         std::string tag;
         if (!(ss >> tag)) continue;
-        std::ostringstream where;
-        where << path << ":" << lineNo << ": ";
         if (tag == "v") {
             Vertex3 v;
             for (int k = 0; k < 3; k++) {
@@ -122,6 +378,8 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
                 return false;
             }
             m.faceSizes.push_back(n);
+        } else if (tag == "t") {
+            if (!parseTag(ss, m, where.str(), msg)) return false;
         }
     }
     if (in.bad()) {
@@ -129,6 +387,7 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
         return false;
     }
     const int nv = (int)m.verts.size();
+    std::set<std::pair<int, int>> edges;
     size_t off = 0;
     for (size_t f = 0; f < m.faceSizes.size(); f++) {
         const int n = m.faceSizes[f];
@@ -147,6 +406,8 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
                     return false;
                 }
             }
+            const int b = m.faceVerts[off + (i + 1) % n];
+            edges.insert({std::min(a, b), std::max(a, b)});
         }
         off += (size_t)n;
     }
@@ -154,14 +415,246 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
         msg = std::string(path) + ": no faces";
         return false;
     }
+    for (auto const &c : m.creases) {
+        if (!edges.count(c.first)) {
+            msg = std::string(path) + ": crease on vertices " + std::to_string(c.first.first) +
+                  " " + std::to_string(c.first.second) +
+                  " (0-based) which are not joined by an edge";
+            return false;
+        }
+    }
+    for (auto const &c : m.corners) {
+        if (c.first >= nv) {
+            msg = std::string(path) + ": corner on vertex " + std::to_string(c.first) +
+                  " (0-based) of " + std::to_string(nv);
+            return false;
+        }
+    }
     return true;
+}
+
+typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+
+// A mesh with its sharpness, ready for a TopologyDescriptor.
+struct Cage {
+    std::vector<Vertex3> pos;
+    std::vector<int> faceSizes, faceVerts;
+    std::vector<int> creasePairs;
+    std::vector<float> creaseWeights;
+    std::vector<int> cornerVerts;
+    std::vector<float> cornerWeights;
+};
+
+Far::TopologyRefiner *createRefiner(Cage const &c, Sdc::Options const &opts) {
+    Far::TopologyDescriptor desc;
+    desc.numVertices = (int)c.pos.size();
+    desc.numFaces = (int)c.faceSizes.size();
+    desc.numVertsPerFace = c.faceSizes.data();
+    desc.vertIndicesPerFace = c.faceVerts.data();
+    desc.numCreases = (int)c.creaseWeights.size();
+    desc.creaseVertexIndexPairs = c.creasePairs.empty() ? nullptr : c.creasePairs.data();
+    desc.creaseWeights = c.creaseWeights.empty() ? nullptr : c.creaseWeights.data();
+    desc.numCorners = (int)c.cornerWeights.size();
+    desc.cornerVertexIndices = c.cornerVerts.empty() ? nullptr : c.cornerVerts.data();
+    desc.cornerWeights = c.cornerWeights.empty() ? nullptr : c.cornerWeights.data();
+    return Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opts));
+}
+
+bool isSemiSharp(float s) { return s > 0.0f && s < Sdc::Crease::SHARPNESS_INFINITE; }
+
+bool isSmoothRule(Sdc::Crease::Rule r) {
+    return r == Sdc::Crease::RULE_SMOOTH || r == Sdc::Crease::RULE_DART;
+}
+
+// Interior vertex of two faces with the smooth or dart rule: Limit() uses the corner mask.
+bool isInteriorValence2(Far::TopologyLevel const &lev, int v) {
+    return !lev.IsVertexBoundary(v) && lev.GetVertexFaces(v).size() == 2 &&
+           isSmoothRule(lev.GetVertexRule(v));
+}
+
+bool hasSemiSharp(Far::TopologyLevel const &lev, int v) {
+    if (isSemiSharp(lev.GetVertexSharpness(v))) return true;
+    Far::ConstIndexArray ve = lev.GetVertexEdges(v);
+    for (int i = 0; i < ve.size(); i++)
+        if (isSemiSharp(lev.GetEdgeSharpness(ve[i]))) return true;
+    return false;
+}
+
+bool facesAllQuads(Far::TopologyLevel const &lev, int v) {
+    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
+    for (int i = 0; i < vf.size(); i++)
+        if (lev.GetFaceVertices(vf[i]).size() != 4) return false;
+    return true;
+}
+
+// Limit() uses the smooth mask at a dart, but the dart's sharp edge refines with the crease
+// rule, so the mask is not that of the vertex's refinement matrix; at an interior valence-2
+// vertex Limit() uses the corner mask. Both need refining until the point settles.
+bool needsSettling(Far::TopologyLevel const &lev, int v) {
+    return isInteriorValence2(lev, v) || lev.GetVertexRule(v) == Sdc::Crease::RULE_DART;
+}
+
+// Does Limit() at this level give the exact limit of vertex v? (see the header)
+bool limitMaskExact(Far::TopologyLevel const &lev, int v) {
+    return !hasSemiSharp(lev, v) && !needsSettling(lev, v) && facesAllQuads(lev, v);
+}
+
+// Whether Tan1 x Tan2 of Limit() is the surface normal at v (see the header); the rule is
+// final there (limitMaskExact, or valence 2 refined to convergence).
+bool normalDefined(Far::TopologyLevel const &lev, int v, Sdc::Options const &opts) {
+    const bool boundary = lev.IsVertexBoundary(v);
+    const int nf = lev.GetVertexFaces(v).size();
+    if (boundary && opts.GetVtxBoundaryInterpolation() == Sdc::Options::VTX_BOUNDARY_NONE)
+        return false;
+    switch (lev.GetVertexRule(v)) {
+    case Sdc::Crease::RULE_SMOOTH: return !boundary && nf >= 3;
+    case Sdc::Crease::RULE_CREASE: return boundary && nf == 2;
+    case Sdc::Crease::RULE_CORNER: return boundary && nf == 1;
+    default: return false;
+    }
+}
+
+double diagonal(std::vector<Vertex3> const &p) {
+    if (p.empty()) return 0.0;
+    double mn[3], mx[3];
+    for (int k = 0; k < 3; k++) mn[k] = mx[k] = p[0].p[k];
+    for (auto const &q : p)
+        for (int k = 0; k < 3; k++) {
+            mn[k] = std::min(mn[k], q.p[k]);
+            mx[k] = std::max(mx[k], q.p[k]);
+        }
+    return std::sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) +
+                     (mx[2] - mn[2]) * (mx[2] - mn[2]));
+}
+
+// The faces around vertex v of level lev (positions P) with every sharpness they carry, as
+// a Cage; returns v's index in it.
+int extractRing(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v, Cage &c) {
+    c = Cage();
+    std::map<int, int> local;
+    std::vector<int> global;
+    auto loc = [&](int g) {
+        auto it = local.find(g);
+        if (it != local.end()) return it->second;
+        const int l = (int)c.pos.size();
+        local[g] = l;
+        global.push_back(g);
+        c.pos.push_back(P[(size_t)g]);
+        return l;
+    };
+    const int center = loc(v);
+    std::set<int> seen;
+    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
+    for (int i = 0; i < vf.size(); i++) {
+        Far::ConstIndexArray fv = lev.GetFaceVertices(vf[i]);
+        c.faceSizes.push_back(fv.size());
+        for (int k = 0; k < fv.size(); k++) c.faceVerts.push_back(loc(fv[k]));
+        Far::ConstIndexArray fe = lev.GetFaceEdges(vf[i]);
+        for (int k = 0; k < fe.size(); k++) {
+            if (!seen.insert(fe[k]).second) continue;
+            const float s = lev.GetEdgeSharpness(fe[k]);
+            if (s > 0.0f) {
+                Far::ConstIndexArray ev = lev.GetEdgeVertices(fe[k]);
+                c.creasePairs.push_back(loc(ev[0]));
+                c.creasePairs.push_back(loc(ev[1]));
+                c.creaseWeights.push_back(s);
+            }
+        }
+    }
+    for (size_t l = 0; l < global.size(); l++) {
+        const float s = lev.GetVertexSharpness(global[l]);
+        if (s > 0.0f) {
+            c.cornerVerts.push_back((int)l);
+            c.cornerWeights.push_back(s);
+        }
+    }
+    return center;
+}
+
+struct LimitPoint {
+    Vertex3 pos, tan1, tan2;
+    bool normalOk;
+};
+
+// Exact limit of vertex v of level lev by refining its one-ring (see the header).
+LimitPoint localLimit(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v,
+                      Sdc::Options const &opts) {
+    Cage c;
+    int center = extractRing(lev, P, v, c);
+    const double scale = diagonal(c.pos);
+    bool settled = false;  // valence 2 or dart: the point no longer moves
+    for (int it = 0;; it++) {
+        Far::TopologyRefiner *ref = createRefiner(c, opts);
+        if (!ref || g_osdErrors) die("OpenSubdiv rejected a vertex one-ring");
+        Far::TopologyLevel const &l0 = ref->GetLevel(0);
+        if (!hasSemiSharp(l0, center) && facesAllQuads(l0, center) &&
+            (settled || !needsSettling(l0, center))) {
+            std::vector<Vertex3> pos(c.pos.size()), t1(c.pos.size()), t2(c.pos.size());
+            Far::PrimvarRefinerReal<double> pr(*ref);
+            pr.Limit(c.pos, pos, t1, t2);
+            LimitPoint r{pos[(size_t)center], t1[(size_t)center], t2[(size_t)center],
+                         normalDefined(l0, center, opts)};
+            delete ref;
+            return r;
+        }
+        if (it >= g_maxLevels) die("a vertex limit did not settle in " + std::to_string(g_maxLevels) + " levels");
+        Far::TopologyRefiner::UniformOptions uo(1);
+        uo.fullTopologyInLastLevel = true;
+        ref->RefineUniform(uo);
+        if (g_osdErrors) die("OpenSubdiv refinement of a vertex one-ring failed");
+        std::vector<Vertex3> next((size_t)ref->GetLevel(1).GetNumVertices());
+        Far::PrimvarRefinerReal<double> pr(*ref);
+        pr.Interpolate(1, c.pos, next);
+        const int child = ref->GetLevel(0).GetVertexChildVertex(center);
+        double d2 = 0.0, mag = 0.0;
+        for (int k = 0; k < 3; k++) {
+            const double d = next[(size_t)child].p[k] - c.pos[(size_t)center].p[k];
+            d2 += d * d;
+            mag = std::max(mag, std::fabs(next[(size_t)child].p[k]));
+        }
+        // the move cannot get below the rounding of the coordinates themselves
+        settled = std::sqrt(d2) <= std::max(g_settle * scale, 4 * DBL_EPSILON * mag);
+        Cage nc;
+        center = extractRing(ref->GetLevel(1), next, child, nc);
+        c.pos.swap(nc.pos);
+        c.faceSizes.swap(nc.faceSizes);
+        c.faceVerts.swap(nc.faceVerts);
+        c.creasePairs.swap(nc.creasePairs);
+        c.creaseWeights.swap(nc.creaseWeights);
+        c.cornerVerts.swap(nc.cornerVerts);
+        c.cornerWeights.swap(nc.cornerWeights);
+        delete ref;
+    }
+}
+
+Vertex3 unitNormal(Vertex3 const &a, Vertex3 const &b) {
+    Vertex3 n;
+    n.p[0] = a.p[1] * b.p[2] - a.p[2] * b.p[1];
+    n.p[1] = a.p[2] * b.p[0] - a.p[0] * b.p[2];
+    n.p[2] = a.p[0] * b.p[1] - a.p[1] * b.p[0];
+    const double len = std::sqrt(n.p[0] * n.p[0] + n.p[1] * n.p[1] + n.p[2] * n.p[2]);
+    if (!(len > 0.0) || !std::isfinite(len)) {
+        n.Clear();
+        return n;
+    }
+    for (int k = 0; k < 3; k++) n.p[k] /= len;
+    return n;
+}
+
+const char *boundaryName(Sdc::Options::VtxBoundaryInterpolation b) {
+    switch (b) {
+    case Sdc::Options::VTX_BOUNDARY_NONE: return "none";
+    case Sdc::Options::VTX_BOUNDARY_EDGE_ONLY: return "edge-only";
+    case Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER: return "edge-and-corner";
+    }
+    return "?";
 }
 
 }  // namespace
 
 int main(int argc, char **argv) {
     int levels = 1;
-    bool pinned = false, limit = false;
+    bool pinned = false, limit = false, normals = false, limitOsd = false;
     const char *inPath = nullptr, *outPath = nullptr;
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
@@ -177,6 +670,10 @@ int main(int argc, char **argv) {
             else die("--corners must be smooth or pinned");
         } else if (a == "--limit") {
             limit = true;
+        } else if (a == "--limit-normals") {
+            limit = normals = true;
+        } else if (a == "--limit-osd") {
+            limit = limitOsd = true;
         } else if (a.size() > 1 && a[0] == '-') {
             usage();
         } else if (!inPath) {
@@ -188,7 +685,9 @@ int main(int argc, char **argv) {
         }
     }
     if (!inPath || !outPath) usage();
+    if (limitOsd && normals) die("--limit-osd and --limit-normals exclude each other");
 
+    if (const char *e = std::getenv("OSD_REFINE_SETTLE")) g_settle = std::atof(e);
     Far::SetErrorCallback(osdError);
     Far::SetWarningCallback(osdWarning);
 
@@ -199,21 +698,45 @@ int main(int argc, char **argv) {
     Sdc::Options sdcOpts;
     sdcOpts.SetVtxBoundaryInterpolation(pinned ? Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER
                                                : Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    if (m.interpolateBoundary >= 0) {
+        static const Sdc::Options::VtxBoundaryInterpolation ib[3] = {
+            Sdc::Options::VTX_BOUNDARY_NONE, Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER,
+            Sdc::Options::VTX_BOUNDARY_EDGE_ONLY};
+        sdcOpts.SetVtxBoundaryInterpolation(ib[m.interpolateBoundary]);
+    }
+    if (m.fvarInterpolateBoundary >= 0) {
+        static const Sdc::Options::FVarLinearInterpolation fv[6] = {
+            Sdc::Options::FVAR_LINEAR_NONE,          Sdc::Options::FVAR_LINEAR_CORNERS_ONLY,
+            Sdc::Options::FVAR_LINEAR_CORNERS_PLUS1, Sdc::Options::FVAR_LINEAR_CORNERS_PLUS2,
+            Sdc::Options::FVAR_LINEAR_BOUNDARIES,    Sdc::Options::FVAR_LINEAR_ALL};
+        sdcOpts.SetFVarLinearInterpolation(fv[m.fvarInterpolateBoundary]);
+    }
+    sdcOpts.SetCreasingMethod(m.creaseMethod == 1 ? Sdc::Options::CREASE_CHAIKIN
+                                                  : Sdc::Options::CREASE_UNIFORM);
+    sdcOpts.SetTriangleSubdivision(m.smoothTriangles == 1 ? Sdc::Options::TRI_SUB_SMOOTH
+                                                          : Sdc::Options::TRI_SUB_CATMARK);
 
-    Far::TopologyDescriptor desc;
-    desc.numVertices = (int)m.verts.size();
-    desc.numFaces = (int)m.faceSizes.size();
-    desc.numVertsPerFace = m.faceSizes.data();
-    desc.vertIndicesPerFace = m.faceVerts.data();
-
-    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-    Far::TopologyRefiner *refiner =
-        Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, sdcOpts));
+    Cage base;
+    base.pos = m.verts;
+    base.faceSizes = m.faceSizes;
+    base.faceVerts = m.faceVerts;
+    for (auto const &c : m.creases) {
+        if (!(c.second > 0.0f)) continue;
+        base.creasePairs.push_back(c.first.first);
+        base.creasePairs.push_back(c.first.second);
+        base.creaseWeights.push_back(c.second);
+    }
+    for (auto const &c : m.corners) {
+        if (!(c.second > 0.0f)) continue;
+        base.cornerVerts.push_back(c.first);
+        base.cornerWeights.push_back(c.second);
+    }
+    Far::TopologyRefiner *refiner = createRefiner(base, sdcOpts);
     if (!refiner || g_osdErrors) die("OpenSubdiv rejected the topology");
 
-    if (limit && levels == 0) {
+    if (limitOsd && levels == 0) {
         for (int s : m.faceSizes)
-            if (s != 4) die("--limit with --levels 0 needs an all-quad mesh");
+            if (s != 4) die("--limit-osd with --levels 0 needs an all-quad mesh");
     }
     if (levels > 0) {
         Far::TopologyRefiner::UniformOptions uo(levels);
@@ -227,31 +750,66 @@ int main(int argc, char **argv) {
     std::vector<Vertex3> cur = m.verts, next;
     for (int l = 1; l <= levels; l++) {
         next.assign((size_t)refiner->GetLevel(l).GetNumVertices(), Vertex3());
-        Vertex3 const *src = cur.data();
-        Vertex3 *dst = next.data();
-        primvar.Interpolate(l, src, dst);
+        primvar.Interpolate(l, cur, next);
         cur.swap(next);
     }
+    Far::TopologyLevel const &lev = refiner->GetLevel(levels);
+    std::vector<Vertex3> nrm;
+    int nLocal = 0, nNoNormal = 0;
     if (limit) {
-        next.assign(cur.size(), Vertex3());
-        Vertex3 const *src = cur.data();
-        Vertex3 *dst = next.data();
-        primvar.Limit(src, dst);
-        cur.swap(next);
+        std::vector<Vertex3> pos(cur.size()), t1(cur.size()), t2(cur.size());
+        primvar.Limit(cur, pos, t1, t2);
+        if (g_osdErrors) die("OpenSubdiv Limit failed");
+        if (normals) nrm.assign(cur.size(), Vertex3());
+        for (int v = 0; v < (int)cur.size(); v++) {
+            bool ok;
+            if (limitOsd || limitMaskExact(lev, v)) {
+                ok = normalDefined(lev, v, sdcOpts);
+            } else {
+                LimitPoint lp = localLimit(lev, cur, v, sdcOpts);
+                pos[(size_t)v] = lp.pos;
+                t1[(size_t)v] = lp.tan1;
+                t2[(size_t)v] = lp.tan2;
+                ok = lp.normalOk;
+                nLocal++;
+            }
+            if (normals) {
+                if (ok) nrm[(size_t)v] = unitNormal(t1[(size_t)v], t2[(size_t)v]);
+                else nrm[(size_t)v].Clear();
+                const Vertex3 &n = nrm[(size_t)v];
+                if (n.p[0] == 0.0 && n.p[1] == 0.0 && n.p[2] == 0.0) nNoNormal++;
+            }
+        }
+        cur.swap(pos);
     }
     if (g_osdErrors) die("OpenSubdiv interpolation failed");
 
-    Far::TopologyLevel const &lev = refiner->GetLevel(levels);
     FILE *out = std::fopen(outPath, "w");
     if (!out) die(std::string("cannot write ") + outPath + ": " + std::strerror(errno));
-    std::fprintf(out, "# osd_refine: catmark, %d level(s), corners %s%s\n", levels,
-                 pinned ? "pinned" : "smooth", limit ? ", limit positions" : "");
+    std::fprintf(out,
+                 "# osd_refine: catmark, %d level(s), boundary %s%s, creasing %s, %d crease(s), "
+                 "%d corner(s)%s",
+                 levels, boundaryName(sdcOpts.GetVtxBoundaryInterpolation()),
+                 m.interpolateBoundary >= 0 ? " (file tag)" : "",
+                 m.creaseMethod == 1 ? "chaikin" : "uniform", (int)base.creaseWeights.size(),
+                 (int)base.cornerWeights.size(), m.smoothTriangles == 1 ? ", smooth triangles" : "");
+    if (m.fvarInterpolateBoundary >= 0)
+        std::fprintf(out, ", fvar boundary %d", m.fvarInterpolateBoundary);
+    if (limitOsd) std::fprintf(out, ", PrimvarRefiner::Limit positions");
+    else if (limit) std::fprintf(out, ", limit positions (%d by one-ring refinement)", nLocal);
+    if (normals) std::fprintf(out, ", normals (%d undefined: 0 0 0)", nNoNormal);
+    std::fputc('\n', out);
     for (size_t i = 0; i < cur.size(); i++)
         std::fprintf(out, "v %.17g %.17g %.17g\n", cur[i].p[0], cur[i].p[1], cur[i].p[2]);
+    for (size_t i = 0; i < nrm.size(); i++)
+        std::fprintf(out, "vn %.17g %.17g %.17g\n", nrm[i].p[0], nrm[i].p[1], nrm[i].p[2]);
     for (int f = 0; f < lev.GetNumFaces(); f++) {
         Far::ConstIndexArray fv = lev.GetFaceVertices(f);
         std::fputc('f', out);
-        for (int i = 0; i < fv.size(); i++) std::fprintf(out, " %d", fv[i] + 1);
+        for (int i = 0; i < fv.size(); i++) {
+            if (normals) std::fprintf(out, " %d//%d", fv[i] + 1, fv[i] + 1);
+            else std::fprintf(out, " %d", fv[i] + 1);
+        }
         std::fputc('\n', out);
     }
     if (std::fclose(out) != 0) die(std::string("write error on ") + outPath);
