@@ -10,7 +10,7 @@ CAD_SRC  := $(filter-out $(LIB_SRC),$(sort $(wildcard csrc/io/*.c)))
 LIB_SRC  += $(CAD_SRC)
 HDRS     += $(if $(CAD_SRC),$(wildcard csrc/io/*.h))
 OCCT_INC  = -I/usr/include/opencascade
-OCCT_LIBS = -lTKSTEP -lTKIGES -lTKXSBase -lTKShHealing -lTKTopAlgo -lTKGeomAlgo -lTKBRep \
+OCCT_LIBS = -lTKSTEP -lTKSTEPBase -lTKIGES -lTKXSBase -lTKShHealing -lTKTopAlgo -lTKGeomAlgo -lTKBRep \
             -lTKGeomBase -lTKG3d -lTKG2d -lTKMath -lTKernel
 
 $(B)/occt_read: tests/oracle/occt_read.cpp

@@ -1,7 +1,7 @@
 // Independent oracle for the CAD writers (test-only): reads a STEP or IGES file with
 // OpenCASCADE and reports what a CAD system would see, as "key: value" lines on stdout.
 //
-//   occt_read [--grid N --points FILE] [--samples K] model.step|model.igs
+//   occt_read [--no-heal] [--grid N --points FILE] [--samples K] model.step|model.igs
 //   occt_read --build SURF.txt --grid N --points FILE
 //
 // Report: reader status, counts of solids/shells/faces/wires/edges/vertices, whether
@@ -16,6 +16,10 @@
 // surface's parameter bounds: lines "face i j u v x y z nx ny nz" (normal of the oriented
 // face), in face order (TopExp_Explorer over the file's shape).
 //
+// --no-heal: no shape healing after the translation (the reader's ShapeFix sequence is
+// replaced by an undefined one), so a wrongly oriented edge use or a gap the writer left
+// shows as an invalid shape instead of being repaired silently.
+//
 // --build reads a B-spline description (below) and builds the Geom_BSplineSurface itself
 // (OpenCASCADE's periodic form when a direction is periodic), then writes the same grid:
 // the independent surface a writer's output is compared with.
@@ -25,7 +29,18 @@
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepLProp_SLProps.hxx>
+#include <BRepGProp.hxx>
 #include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <IGESSolid_EdgeList.hxx>
+#include <IGESSolid_Loop.hxx>
+#include <IGESSolid_VertexList.hxx>
+#include <StepData_StepModel.hxx>
+#include <StepShape_Edge.hxx>
+#include <StepShape_EdgeLoop.hxx>
+#include <StepShape_OrientedEdge.hxx>
+#include <StepShape_Vertex.hxx>
 #include <GeomAdaptor_Surface.hxx>
 #include <GeomLProp_SLProps.hxx>
 #include <Geom2d_Curve.hxx>
@@ -34,6 +49,12 @@
 #include <Geom_Surface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
+#include <Interface_Static.hxx>
+#include <Transfer_TransientProcess.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <STEPControl_Reader.hxx>
@@ -54,6 +75,8 @@
 #include <gp_Pnt2d.hxx>
 
 #include <algorithm>
+#include <map>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -63,7 +86,7 @@
 #include <vector>
 
 static int usage() {
-    std::fprintf(stderr, "usage: occt_read [--grid N --points FILE] [--samples K] FILE.step|FILE.igs\n"
+    std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE] [--samples K] FILE.step|FILE.igs\n"
                          "       occt_read --build SURF.txt --grid N --points FILE\n");
     return 2;
 }
@@ -74,6 +97,97 @@ static bool ends_with(const std::string &s, const char *suf) {
     std::string e = s.substr(s.size() - t.size());
     std::transform(e.begin(), e.end(), e.begin(), ::tolower);
     return e == t;
+}
+
+// Warnings and fails of a check list: counted on stdout, the messages on stderr.
+static void count_checks(const char *what, const Interface_CheckIterator &chl) {
+    int nw = 0, nf = 0;
+    for (chl.Start(); chl.More(); chl.Next()) {
+        const Handle(Interface_Check) &c = chl.Value();
+        for (int i = 1; i <= c->NbWarnings(); i++) std::fprintf(stderr, "%s warning: %s\n", what, c->CWarning(i));
+        for (int i = 1; i <= c->NbFails(); i++) std::fprintf(stderr, "%s fail: %s\n", what, c->CFail(i));
+        nw += c->NbWarnings();
+        nf += c->NbFails();
+    }
+    std::printf("%s_warnings: %d\n%s_fails: %d\n", what, nw, what, nf);
+}
+
+static void reader_checks(XSControl_Reader &r) {
+    count_checks("load", r.WS()->ModelCheckList());
+    count_checks("transfer", r.WS()->TransferReader()->TransientProcess()->CheckList(Standard_False));
+}
+
+// The loops as written in the file, read through OpenCASCADE's entity model (before any
+// translation or healing): every loop closed head to tail (the end vertex of each edge use is
+// the start of the next) and every edge used at most once in each direction (a consistently
+// oriented shell uses a shared edge once forward and once reversed).
+struct use_count { int fwd = 0, rev = 0; };
+typedef std::map<std::pair<const void *, int>, use_count> use_map; // edge -> uses
+static void report_file_loops(int loops, int broken, const use_map &uses) {
+    int opposite = 0, single = 0, bad = 0;
+    for (auto &u : uses) {
+        if (u.second.fwd == 1 && u.second.rev == 1) opposite++;
+        else if (u.second.fwd + u.second.rev == 1) single++;
+        else bad++;
+    }
+    std::printf("file_loops: %d\nfile_loops_broken: %d\nfile_edges_used_both_ways: %d\n"
+                "file_edges_used_once: %d\nfile_edges_misused: %d\n", loops, broken, opposite, single, bad);
+}
+
+static void step_file_loops(const Handle(StepData_StepModel) &model) {
+    int loops = 0, broken = 0;
+    use_map uses;
+    for (int i = 1; i <= model->NbEntities(); i++) {
+        Handle(StepShape_EdgeLoop) loop = Handle(StepShape_EdgeLoop)::DownCast(model->Value(i));
+        if (loop.IsNull()) continue;
+        loops++;
+        int n = loop->NbEdgeList();
+        bool ok = n > 0;
+        for (int k = 1; k <= n && ok; k++) {
+            Handle(StepShape_OrientedEdge) a = loop->EdgeListValue(k), b = loop->EdgeListValue(k % n + 1);
+            Handle(StepShape_Edge) ea = a->EdgeElement(), eb = b->EdgeElement();
+            if (ea.IsNull() || eb.IsNull()) { ok = false; break; }
+            const void *end = (a->Orientation() ? ea->EdgeEnd() : ea->EdgeStart()).get();
+            const void *start = (b->Orientation() ? eb->EdgeStart() : eb->EdgeEnd()).get();
+            ok = end != nullptr && end == start;
+            use_count &u = uses[std::make_pair((const void *)ea.get(), 0)];
+            (a->Orientation() ? u.fwd : u.rev)++;
+        }
+        broken += !ok;
+    }
+    report_file_loops(loops, broken, uses);
+}
+
+static void iges_file_loops(const Handle(IGESData_IGESModel) &model) {
+    int loops = 0, broken = 0;
+    use_map uses;
+    for (int i = 1; i <= model->NbEntities(); i++) {
+        Handle(IGESSolid_Loop) loop = Handle(IGESSolid_Loop)::DownCast(model->Value(i));
+        if (loop.IsNull()) continue;
+        loops++;
+        int n = loop->NbEdges();
+        bool ok = n > 0;
+        auto ends = [&](int k, std::pair<const void *, int> &s, std::pair<const void *, int> &e) {
+            Handle(IGESSolid_EdgeList) el = Handle(IGESSolid_EdgeList)::DownCast(loop->Edge(k));
+            if (loop->EdgeType(k) != 0 || el.IsNull()) return false;
+            int x = loop->ListIndex(k);
+            if (x < 1 || x > el->NbEdges()) return false;
+            std::pair<const void *, int> a(el->StartVertexList(x).get(), el->StartVertexIndex(x));
+            std::pair<const void *, int> b(el->EndVertexList(x).get(), el->EndVertexIndex(x));
+            s = loop->Orientation(k) ? a : b;
+            e = loop->Orientation(k) ? b : a;
+            return true;
+        };
+        for (int k = 1; k <= n && ok; k++) {
+            std::pair<const void *, int> sa, ea, sb, eb;
+            ok = ends(k, sa, ea) && ends(k % n + 1, sb, eb) && ea == sb;
+            if (!ok) break;
+            use_count &u = uses[std::make_pair((const void *)loop->Edge(k).get(), loop->ListIndex(k))];
+            (loop->Orientation(k) ? u.fwd : u.rev)++;
+        }
+        broken += !ok;
+    }
+    report_file_loops(loops, broken, uses);
 }
 
 // Oriented unit normal of face F at (u, v); false where the normal is undefined.
@@ -201,6 +315,11 @@ static void report(const TopoDS_Shape &shape, int K) {
     for (TopExp_Explorer ex(shape, TopAbs_SHELL); ex.More(); ex.Next())
         closed_shells += BRep_Tool::IsClosed(ex.Current()) ? 1 : 0;
     std::printf("closed_shells: %d\n", closed_shells);
+    if (closed_shells) { // a closed shell bounds positive volume when its faces point out
+        GProp_GProps g;
+        BRepGProp::VolumeProperties(shape, g);
+        std::printf("volume: %.17g\n", g.Mass());
+    }
     ShapeAnalysis_FreeBounds fb(shape, Standard_False, Standard_False); // no sewing: as read
     TopTools_IndexedMapOfShape fe;
     TopExp::MapShapes(fb.GetClosedWires(), TopAbs_EDGE, fe);
@@ -278,13 +397,14 @@ static Handle(Geom_BSplineSurface) build_surface(const char *path) {
 }
 
 int main(int argc, char **argv) {
-    int N = 0, K = 8;
+    int N = 0, K = 8, heal = 1;
     const char *points = nullptr, *build = nullptr, *file = nullptr;
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--grid") && i + 1 < argc) N = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--points") && i + 1 < argc) points = argv[++i];
         else if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) K = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--build") && i + 1 < argc) build = argv[++i];
+        else if (!std::strcmp(argv[i], "--no-heal")) heal = 0;
         else if (argv[i][0] == '-') return usage();
         else file = argv[i];
     }
@@ -316,17 +436,24 @@ int main(int argc, char **argv) {
     TopoDS_Shape shape;
     IFSelect_ReturnStatus st;
     int roots = 0;
-    if (iges) {
-        IGESControl_Reader r;
-        st = r.ReadFile(file);
-        if (st == IFSelect_RetDone) { roots = r.TransferRoots(); shape = r.OneShape(); }
-    } else {
-        STEPControl_Reader r;
-        st = r.ReadFile(file);
-        if (st == IFSelect_RetDone) { roots = r.TransferRoots(); shape = r.OneShape(); }
+    std::printf("file: %s\nformat: %s\n", file, iges ? "iges" : "step");
+    IGESControl_Reader ri;
+    STEPControl_Reader rs;
+    XSControl_Reader &r = iges ? (XSControl_Reader &)ri : (XSControl_Reader &)rs;
+    if (!heal) { // the translation as written: no ShapeFix sequence after it
+        Interface_Static::SetCVal("read.step.sequence", "CcnNoHealing");
+        Interface_Static::SetCVal("read.iges.sequence", "CcnNoHealing");
     }
-    std::printf("file: %s\nformat: %s\nreader_status: %s\ntransferred_roots: %d\n", file,
-                iges ? "iges" : "step", st == IFSelect_RetDone ? "done" : "failed", roots);
+    std::printf("healing: %d\n", heal);
+    st = r.ReadFile(file);
+    if (st == IFSelect_RetDone) {
+        if (iges) iges_file_loops(ri.IGESModel());
+        else step_file_loops(rs.StepModel());
+        roots = r.TransferRoots();
+        shape = r.OneShape();
+        reader_checks(r);
+    }
+    std::printf("reader_status: %s\ntransferred_roots: %d\n", st == IFSelect_RetDone ? "done" : "failed", roots);
     if (st != IFSelect_RetDone || shape.IsNull()) {
         std::printf("shape: null\n");
         return 1;
