@@ -215,26 +215,25 @@ static ccn_status check_direction(const ccn__cad_surface *f, int32_t fi, int dir
     return CCN_OK;
 }
 
-static void corner_point(const ccn__cad_surface *f, int c, double out[3]) {
+/* Point of side s at parameter t of the side's direction (u for sides 0, 2, v for 1, 3). */
+static void side_point_at(const ccn__cad_surface *f, int s, double t, double out[3]) {
     double u0, u1, v0, v1;
     ccn__cad_domain(f, 0, &u0, &u1);
     ccn__cad_domain(f, 1, &v0, &v1);
-    ccn__cad_eval(f, c == 1 || c == 2 ? u1 : u0, c >= 2 ? v1 : v0, out);
+    switch (s) {
+    case 0: ccn__cad_eval(f, t, v0, out); break;
+    case 1: ccn__cad_eval(f, u1, t, out); break;
+    case 2: ccn__cad_eval(f, t, v1, out); break;
+    default: ccn__cad_eval(f, u0, t, out); break;
+    }
 }
 
-/* Point at fraction w of side s in the side's own running direction. */
-static void side_point(const ccn__cad_surface *f, int s, double w, double out[3]) {
-    double u0, u1, v0, v1;
-    ccn__cad_domain(f, 0, &u0, &u1);
-    ccn__cad_domain(f, 1, &v0, &v1);
-    double a = u0 + w * (u1 - u0), b = v0 + w * (v1 - v0);
-    double ra = u1 - w * (u1 - u0), rb = v1 - w * (v1 - v0);
-    switch (s) {
-    case 0: ccn__cad_eval(f, a, v0, out); break;
-    case 1: ccn__cad_eval(f, u1, b, out); break;
-    case 2: ccn__cad_eval(f, ra, v1, out); break;
-    default: ccn__cad_eval(f, u0, rb, out); break;
-    }
+/* Point at fraction w of segment j in its loop running direction. */
+static void seg_point(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j, double w,
+                      double out[3]) {
+    int s = t->seg_side[j];
+    double lo = t->seg_lo[j], hi = t->seg_hi[j];
+    side_point_at(&m->faces[t->seg_face[j]], s, s < 2 ? lo + w * (hi - lo) : hi - w * (hi - lo), out);
 }
 
 static double dist3(const double a[3], const double b[3]) {
@@ -253,8 +252,9 @@ static void uf_union(int32_t *parent, int32_t a, int32_t b) {
 }
 
 void ccn__cad_topo_free(ccn__cad_topo *t) {
-    free(t->corner_vert); free(t->vert_pos); free(t->side_edge); free(t->side_sense);
-    free(t->edge_side); free(t->edge_vert);
+    free(t->face_seg); free(t->seg_face); free(t->seg_side); free(t->seg_lo); free(t->seg_hi);
+    free(t->seg_vert); free(t->vert_pos); free(t->seg_edge); free(t->seg_sense);
+    free(t->edge_seg); free(t->edge_vert);
     memset(t, 0, sizeof *t);
 }
 
@@ -306,31 +306,88 @@ static ccn_status check_faces(const ccn__cad_model *m, ccn__cad_topo *t, ccn_err
     return CCN_OK;
 }
 
-/* Sides shared both ways, and the same curve (corners and three inner points agree). */
+/* Segments: where each side is split (validated) and its parameter range. */
+static ccn_status build_segments(const ccn__cad_model *m, ccn__cad_topo *t, ccn_error *err) {
+    int32_t nf = m->num_faces;
+    const int32_t *bs = m->side_breaks_start;
+    if ((bs == NULL) != (m->side_breaks == NULL))
+        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                             "side_breaks_start and side_breaks must both be given or both NULL");
+    int64_t nb = bs ? bs[4 * nf] : 0;
+    if (bs && bs[0] != 0)
+        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "side_breaks_start[0] must be 0");
+    for (int32_t a = 0; bs && a < 4 * nf; a++)
+        if (bs[a + 1] < bs[a] || bs[a + 1] > INT32_MAX / 4 - 4 * (int64_t)nf)
+            return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, a / 4,
+                                 "face %d side %d: side_breaks_start decreases or is too large",
+                                 (int)(a / 4), (int)(a % 4));
+    t->num_segs = (int32_t)(4 * (int64_t)nf + nb);
+    size_t ns = (size_t)t->num_segs;
+    t->face_seg = malloc(sizeof(int32_t) * ((size_t)nf + 1));
+    t->seg_face = malloc(sizeof(int32_t) * ns);
+    t->seg_side = malloc(ns);
+    t->seg_lo = malloc(sizeof(double) * ns);
+    t->seg_hi = malloc(sizeof(double) * ns);
+    if (!t->face_seg || !t->seg_face || !t->seg_side || !t->seg_lo || !t->seg_hi)
+        return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    int32_t j = 0;
+    for (int32_t f = 0; f < nf; f++) {
+        t->face_seg[f] = j;
+        for (int s = 0; s < 4; s++) {
+            double lo, hi;
+            ccn__cad_domain(&m->faces[f], s % 2, &lo, &hi);
+            int32_t a = 4 * f + s, k0 = bs ? bs[a] : 0, k1 = bs ? bs[a + 1] : 0;
+            /* running order: increasing parameter on sides 0, 1, decreasing on 2, 3 */
+            double prev = s < 2 ? lo : hi;
+            for (int32_t k = k0; k <= k1; k++, j++) {
+                double next = k < k1 ? m->side_breaks[k] : (s < 2 ? hi : lo);
+                int inside = s < 2 ? next > prev && next <= hi : next < prev && next >= lo;
+                if (!isfinite(next) || !inside || (k < k1 && (next == lo || next == hi)))
+                    return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, f,
+                                         "face %d side %d: break %g is not strictly inside the side "
+                                         "and after the previous one", (int)f, s, next);
+                t->seg_face[j] = f;
+                t->seg_side[j] = (uint8_t)s;
+                t->seg_lo[j] = s < 2 ? prev : next;
+                t->seg_hi[j] = s < 2 ? next : prev;
+                prev = next;
+            }
+        }
+    }
+    t->face_seg[nf] = j;
+    return CCN_OK;
+}
+
+/* Segments shared both ways, and the same curve (ends and three inner points agree). */
 static ccn_status check_adjacency(const ccn__cad_model *m, const ccn__cad_topo *t, ccn_error *err) {
-    int32_t ns = 4 * m->num_faces;
-    for (int32_t a = 0; a < ns; a++) {
-        int32_t b = m->adjacency[a];
+    for (int32_t a = 0; a < t->num_segs; a++) {
+        int32_t b = m->adjacency[a], fa = t->seg_face[a], sa = t->seg_side[a];
         if (b < 0) continue;
-        if (b >= ns || b == a || m->adjacency[b] != a)
-            return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, a / 4,
-                                 "face %d side %d: adjacency %d is out of range, itself or not "
-                                 "mutual", (int)(a / 4), (int)(a % 4), (int)b);
+        if (b >= t->num_segs || b == a || m->adjacency[b] != a)
+            return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
+                                 "face %d side %d: adjacency %d of segment %d is out of range, "
+                                 "itself or not mutual", (int)fa, sa, (int)b, (int)a);
         if (b < a) continue;
         static const double w[5] = {0, 0.25, 0.5, 0.75, 1};
         for (int k = 0; k < 5; k++) {
             double pa[3], pb[3];
-            side_point(&m->faces[a / 4], a % 4, w[k], pa);
-            side_point(&m->faces[b / 4], b % 4, 1 - w[k], pb);
+            seg_point(m, t, a, w[k], pa);
+            seg_point(m, t, b, 1 - w[k], pb);
             double d = dist3(pa, pb);
             if (!(d <= t->tolerance))
-                return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, a / 4,
+                return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
                                      "face %d side %d and face %d side %d are not the same "
                                      "curve run in opposite directions (%.3g apart at %g)",
-                                     (int)(a / 4), (int)(a % 4), (int)(b / 4), (int)(b % 4), d, w[k]);
+                                     (int)fa, sa, (int)t->seg_face[b], (int)t->seg_side[b], d, w[k]);
         }
     }
     return CCN_OK;
+}
+
+/* The segment after j in its face's loop. */
+static int32_t seg_next(const ccn__cad_topo *t, int32_t j) {
+    int32_t f = t->seg_face[j];
+    return j + 1 < t->face_seg[f + 1] ? j + 1 : t->face_seg[f];
 }
 
 ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_error *err) {
@@ -349,61 +406,129 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
                                      "the %s must be printable ASCII (at most 200 characters) "
                                      "without quotes or backslashes", k ? "timestamp" : "name");
     ccn_status st = check_faces(m, t, err);
-    if (st) return st;
-    if ((st = check_adjacency(m, t, err))) return st;
-    int32_t nf = m->num_faces, ns = 4 * nf;
-    t->corner_vert = malloc(sizeof(int32_t) * (size_t)ns);
-    t->side_edge = malloc(sizeof(int32_t) * (size_t)ns);
-    t->side_sense = malloc((size_t)ns);
-    t->edge_side = malloc(sizeof(int32_t) * (size_t)ns);
-    t->edge_vert = malloc(sizeof(int32_t) * 2 * (size_t)ns);
-    t->vert_pos = malloc(sizeof(double) * 3 * (size_t)ns);
-    int32_t *parent = malloc(sizeof(int32_t) * (size_t)ns);
-    if (!t->corner_vert || !t->side_edge || !t->side_sense || !t->edge_side || !t->edge_vert ||
+    if (!st) st = build_segments(m, t, err);
+    if (!st) st = check_adjacency(m, t, err);
+    if (st) { ccn__cad_topo_free(t); return st; }
+    size_t ns = (size_t)t->num_segs;
+    t->seg_vert = malloc(sizeof(int32_t) * ns);
+    t->seg_edge = malloc(sizeof(int32_t) * ns);
+    t->seg_sense = malloc(ns);
+    t->edge_seg = malloc(sizeof(int32_t) * ns);
+    t->edge_vert = malloc(sizeof(int32_t) * 2 * ns);
+    t->vert_pos = malloc(sizeof(double) * 3 * ns);
+    int32_t *parent = malloc(sizeof(int32_t) * ns);
+    if (!t->seg_vert || !t->seg_edge || !t->seg_sense || !t->edge_seg || !t->edge_vert ||
         !t->vert_pos || !parent) {
         free(parent);
         ccn__cad_topo_free(t);
         return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     }
-    /* vertices: corners joined through shared sides (corner s of f ~ corner t+1 of g) */
-    for (int32_t i = 0; i < ns; i++) parent[i] = i;
+    /* vertices: segment starts joined through shared segments (start of a ~ end of b) */
+    for (size_t i = 0; i < ns; i++) parent[i] = (int32_t)i;
     t->closed = 1;
-    for (int32_t a = 0; a < ns; a++) {
+    for (int32_t a = 0; a < t->num_segs; a++) {
         int32_t b = m->adjacency[a];
         if (b < 0) { t->closed = 0; continue; }
-        int32_t fa = a / 4, sa = a % 4, fb = b / 4, sb = b % 4;
-        uf_union(parent, 4 * fa + sa, 4 * fb + (sb + 1) % 4);
-        uf_union(parent, 4 * fa + (sa + 1) % 4, 4 * fb + sb);
+        uf_union(parent, a, seg_next(t, b));
+        uf_union(parent, seg_next(t, a), b);
     }
-    int32_t *vid = t->side_edge; /* scratch: root -> vertex id */
-    for (int32_t i = 0; i < ns; i++) vid[i] = -1;
-    for (int32_t i = 0; i < ns; i++) {
+    int32_t *vid = t->seg_edge; /* scratch: root -> vertex id */
+    for (size_t i = 0; i < ns; i++) vid[i] = -1;
+    for (int32_t i = 0; i < t->num_segs; i++) {
         int32_t r = uf_find(parent, i);
         if (vid[r] < 0) {
             vid[r] = t->num_verts;
-            corner_point(&m->faces[r / 4], r % 4, t->vert_pos + 3 * (size_t)t->num_verts);
+            seg_point(m, t, r, 0, t->vert_pos + 3 * (size_t)t->num_verts);
             t->num_verts++;
         }
-        t->corner_vert[i] = vid[r];
+        t->seg_vert[i] = vid[r];
     }
     free(parent);
     /* edges: first appearance defines the curve (increasing parameter of that side) */
-    for (int32_t i = 0; i < ns; i++) t->side_edge[i] = -1;
-    for (int32_t a = 0; a < ns; a++) {
-        if (t->side_edge[a] >= 0) continue;
-        int32_t e = t->num_edges++, f = a / 4, s = a % 4;
-        int fwd = s < 2; /* sides 0, 1 run in increasing parameter, 2, 3 decreasing */
-        t->edge_side[e] = a;
-        t->side_edge[a] = e;
-        t->side_sense[a] = (uint8_t)fwd;
-        int32_t c0 = t->corner_vert[4 * f + s], c1 = t->corner_vert[4 * f + (s + 1) % 4];
+    for (size_t i = 0; i < ns; i++) t->seg_edge[i] = -1;
+    for (int32_t a = 0; a < t->num_segs; a++) {
+        if (t->seg_edge[a] >= 0) continue;
+        int32_t e = t->num_edges++;
+        int fwd = t->seg_side[a] < 2; /* sides 0, 1 run in increasing parameter, 2, 3 decreasing */
+        t->edge_seg[e] = a;
+        t->seg_edge[a] = e;
+        t->seg_sense[a] = (uint8_t)fwd;
+        int32_t c0 = t->seg_vert[a], c1 = t->seg_vert[seg_next(t, a)];
         t->edge_vert[2 * e] = fwd ? c0 : c1;
         t->edge_vert[2 * e + 1] = fwd ? c1 : c0;
         int32_t b = m->adjacency[a];
         if (b >= 0) {
-            t->side_edge[b] = e;
-            t->side_sense[b] = (uint8_t)!fwd;
+            t->seg_edge[b] = e;
+            t->seg_sense[b] = (uint8_t)!fwd;
         }
     }
     return CCN_OK;
+}
+
+/* ---- segment curves ------------------------------------------------------------------ */
+
+int32_t ccn__cad_curve_capacity(const ccn__cad_surface *f) {
+    int32_t a = f->num_poles[0] + 2 * f->degree[0], b = f->num_poles[1] + 2 * f->degree[1];
+    return a > b ? a : b;
+}
+
+/* Inserts x into the curve until its multiplicity is degree (Boehm). */
+static void insert_to_degree(ccn__cad_curve *c, double x) {
+    int32_t p = c->degree;
+    for (;;) {
+        int32_t n = c->num_poles, k = p, mult = 0;
+        while (k + 1 < n && c->knots[k + 1] <= x) k++; /* knots[k] <= x < knots[k+1] */
+        for (int32_t i = k; i >= 0 && c->knots[i] == x; i--) mult++;
+        if (mult >= p) return;
+        for (int32_t i = n; i > k - mult; i--) memcpy(c->poles + 3 * (size_t)i, c->poles + 3 * ((size_t)i - 1), sizeof(double) * 3);
+        /* new pole i (k-p+1 <= i <= k-mult) = a P_i + (1-a) P_{i-1}; poles[i] still holds P_i */
+        double prev[3];
+        memcpy(prev, c->poles + 3 * (size_t)(k - p), sizeof prev);
+        for (int32_t i = k - p + 1; i <= k - mult; i++) {
+            double a = (x - c->knots[i]) / (c->knots[i + p] - c->knots[i]), cur[3];
+            double *q = c->poles + 3 * (size_t)i;
+            memcpy(cur, q, sizeof cur);
+            for (int d = 0; d < 3; d++) q[d] = a * cur[d] + (1 - a) * prev[d];
+            memcpy(prev, cur, sizeof prev);
+        }
+        for (int32_t i = n + p; i > k; i--) c->knots[i + 1] = c->knots[i];
+        c->knots[k + 1] = x;
+        c->num_poles = n + 1;
+    }
+}
+
+void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
+                            ccn__cad_curve *c) {
+    const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
+    int s = t->seg_side[j], d = s % 2 == 0 ? 0 : 1;
+    double lo, hi;
+    ccn__cad_domain(f, d, &lo, &hi);
+    int32_t p = f->degree[d], n = f->num_poles[d], i = 0;
+    c->degree = p;
+    c->num_poles = n;
+    for (int32_t k = 0; k < f->num_knots[d]; k++)
+        for (int32_t r = 0; r < f->mults[d][k]; r++) c->knots[i++] = f->knots[d][k];
+    ccn__cad_side_curve(f, s, c->poles);
+    c->periodic = f->periodic[d];
+    if (t->seg_lo[j] == lo && t->seg_hi[j] == hi) return;
+    c->periodic = 0;
+    double a = t->seg_lo[j], b = t->seg_hi[j];
+    /* cut at b: keep poles 0 .. (first index of b) - 1 and knots up to b (p+1 times) */
+    if (!(b == hi && c->knots[n + p] == hi && c->knots[n] == hi)) {
+        insert_to_degree(c, b);
+        int32_t i0 = 0;
+        while (c->knots[i0] < b) i0++;
+        c->num_poles = i0;
+        c->knots[i0 + p] = b;
+    }
+    if (!(a == lo && c->knots[0] == lo && c->knots[p] == lo)) {
+        insert_to_degree(c, a);
+        int32_t i0 = 0;
+        while (c->knots[i0] < a) i0++; /* knots[i0 .. i0+p-1] = a; pole i0-1 is on the curve */
+        int32_t drop = i0 - 1, nk = c->num_poles + p + 1;
+        memmove(c->poles, c->poles + 3 * (size_t)drop, sizeof(double) * 3 * (size_t)(c->num_poles - drop));
+        memmove(c->knots + 1, c->knots + i0, sizeof(double) * (size_t)(nk - i0));
+        c->knots[0] = a;
+        c->num_poles -= drop;
+    }
 }

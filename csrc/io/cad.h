@@ -10,10 +10,15 @@
  * Corners: 0 = (u0,v0), 1 = (u1,v0), 2 = (u1,v1), 3 = (u0,v1). Side s runs from corner s to
  * corner s+1 (mod 4): counter-clockwise around the domain, so the face normal Su x Sv and
  * the boundary agree (the outward normal of a closed shell is Su x Sv on every face).
- * adjacency[4f+s] = 4g+t: side s of face f is side t of face g (g may be f: a seam), run in
- * the opposite direction (a consistently oriented shell): corner s of f is corner t+1 of g
- * and corner s+1 of f is corner t of g. -1: a boundary side. The writers check that the two
- * sides are the same curve (same parametrisation up to direction) within the tolerance.
+ * Sides may be split into several edges (T-junctions: a packed face next to smaller faces,
+ * the rings of a bi-5 cap): side_breaks lists the parameters strictly inside side s of face
+ * f where it is split, in the side's running direction. Its segments are numbered face by
+ * face, side by side, in running order: segment k of side s of face f has the index
+ * seg(f, s, k) = 4f + s + side_breaks_start[4f+s] + k (without breaks: 4f + s).
+ * adjacency[seg] = the segment of another (or the same: a seam) face side that is the same
+ * edge run in the opposite direction (a consistently oriented shell), -1 on the boundary. The
+ * writers check that the two segments are the same curve (same parametrisation up to
+ * direction and an affine change) within the tolerance.
  *
  * Numbers are written with 17 significant digits (round-trip exact); the output is a
  * deterministic function of the model (the timestamp is fixed unless given).
@@ -45,7 +50,10 @@ typedef struct {
 typedef struct {
     int32_t num_faces;
     const ccn__cad_surface *faces;
-    const int32_t *adjacency; /* 4 * num_faces, see above */
+    /* split sides, see above; both NULL: no side is split */
+    const int32_t *side_breaks_start; /* 4 * num_faces + 1, [0] = 0, non-decreasing */
+    const double *side_breaks;        /* side_breaks_start[4 * num_faces] parameters */
+    const int32_t *adjacency;         /* one per segment (4 * num_faces without breaks) */
     const char *name;         /* product / file name (printable ASCII), NULL: "ccnurbs" */
     const char *timestamp;    /* "YYYY-MM-DDThh:mm:ss", NULL: "2000-01-01T00:00:00" */
     double tolerance;         /* model units (mm); <= 0: max(1e-7, 1e-10 * bounding-box size) */
@@ -66,19 +74,26 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
 
 /* ---- shared by the writers (cad.c) -------------------------------------------------- */
 
-/* Vertices and edges of a validated model. Edge e is side edge_side[e] = 4f+s (its first
- * appearance) of face f; its curve is that side's iso curve in increasing parameter, from
- * vertex edge_vert[2e] to edge_vert[2e+1]. side_edge[4f+s] is the edge of each side and
- * side_sense[4f+s] = 1 if the side runs along the edge's curve, 0 against it. */
+/* Segments, vertices and edges of a validated model. Segment j lies on side seg_side[j] of
+ * face seg_face[j] over the parameters [seg_lo[j], seg_hi[j]] of that side's direction; a
+ * face's segments are face_seg[f] .. face_seg[f+1]-1 in loop order, and seg_vert[j] is the
+ * vertex where segment j starts (in loop order). Edge e is segment edge_seg[e] (its first
+ * appearance); its curve is that segment's iso curve in increasing parameter, from vertex
+ * edge_vert[2e] to edge_vert[2e+1]. seg_edge[j] is the edge of each segment and
+ * seg_sense[j] = 1 if the segment (in loop order) runs along the edge's curve, 0 against it. */
 typedef struct {
-    int32_t num_verts, num_edges;
-    int closed;               /* every side shared */
+    int32_t num_segs, num_verts, num_edges;
+    int closed;               /* every segment shared */
     double tolerance, size;   /* effective tolerance; bounding-box diagonal of the poles */
-    int32_t *corner_vert;     /* 4 * num_faces */
+    int32_t *face_seg;        /* num_faces + 1 */
+    int32_t *seg_face;        /* num_segs */
+    uint8_t *seg_side;        /* num_segs */
+    double *seg_lo, *seg_hi;  /* num_segs */
+    int32_t *seg_vert;        /* num_segs */
     double *vert_pos;         /* 3 * num_verts */
-    int32_t *side_edge;       /* 4 * num_faces */
-    uint8_t *side_sense;      /* 4 * num_faces */
-    int32_t *edge_side;       /* num_edges */
+    int32_t *seg_edge;        /* num_segs */
+    uint8_t *seg_sense;       /* num_segs */
+    int32_t *edge_seg;        /* num_edges */
     int32_t *edge_vert;       /* 2 * num_edges */
 } ccn__cad_topo;
 
@@ -90,6 +105,20 @@ void ccn__cad_topo_free(ccn__cad_topo *t);
  * that direction (the caller reads them from the surface: direction (s % 2 == 0 ? u : v))
  * and num_poles[dir] poles into out (3 each). */
 void ccn__cad_side_curve(const ccn__cad_surface *f, int s, double *out);
+
+/* A B-spline curve in flat-knot form (knots: num_poles + degree + 1 values). */
+typedef struct {
+    int32_t degree, num_poles;
+    double *knots, *poles;   /* caller-owned, capacity given by ccn__cad_curve_capacity */
+    int periodic;            /* the whole side of a periodic direction */
+} ccn__cad_curve;
+/* Poles needed for any segment curve of face f (knots: + degree + 1). */
+int32_t ccn__cad_curve_capacity(const ccn__cad_surface *f);
+/* The curve of segment j (increasing parameter): the side's iso curve itself when the
+ * segment is the whole side, else that curve cut to [seg_lo, seg_hi] by knot insertion
+ * (clamped ends). */
+void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
+                            ccn__cad_curve *out);
 /* Domain [lo, hi] of direction dir (0 = u, 1 = v). */
 void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi);
 /* Surface point at (u, v) by de Boor (u, v inside the domain). */

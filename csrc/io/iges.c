@@ -9,7 +9,8 @@
  * a 186 manifold solid. OpenCASCADE reads that into one shell whose faces share their edges.
  *
  * Layout: directory entry k (1-based) is on lines 2k-1, 2k; entity order: the vertex list,
- * the edge curves, the edge list, per face (128, 508, 510), the shell, the solid. Every
+ * the edge curves (cut to their segment when a side is split), the edge list, per face
+ * (128, 508 with one edge use per side segment, 510), the shell, the solid. Every
  * entity except the top one is physically dependent (status 00010000), so the top entity
  * is the only root a reader transfers. The parameter section is built in memory first (the
  * directory needs each entity's first parameter line and line count).
@@ -102,23 +103,19 @@ static void pd_flat_knots(iges_pd *p, const ccn__cad_surface *f, int d) {
         for (int32_t r = 0; r < f->mults[d][k]; r++) pd_real(p, f->knots[d][k]);
 }
 
-static void curve_126(iges_pd *p, const ccn__cad_surface *f, int s, int closed, double *pts) {
-    int d = s % 2 == 0 ? 0 : 1;
-    int32_t n = f->num_poles[d];
-    ccn__cad_side_curve(f, s, pts);
+static void curve_126(iges_pd *p, const ccn__cad_curve *c, int closed) {
+    int32_t n = c->num_poles;
     pd_int(p, n - 1);
-    pd_int(p, f->degree[d]);
-    pd_int(p, 0);                          /* PROP1: not known to be planar */
-    pd_int(p, closed);                     /* PROP2 */
-    pd_int(p, 1);                          /* PROP3: polynomial */
-    pd_int(p, closed && f->periodic[d]);   /* PROP4 */
-    pd_flat_knots(p, f, d);
+    pd_int(p, c->degree);
+    pd_int(p, 0);                     /* PROP1: not known to be planar */
+    pd_int(p, closed);                /* PROP2 */
+    pd_int(p, 1);                     /* PROP3: polynomial */
+    pd_int(p, closed && c->periodic); /* PROP4 */
+    for (int32_t i = 0; i < n + c->degree + 1; i++) pd_real(p, c->knots[i]);
     for (int32_t i = 0; i < n; i++) pd_real(p, 1.0);
-    for (int32_t i = 0; i < 3 * n; i++) pd_real(p, pts[i]);
-    double lo, hi;
-    ccn__cad_domain(f, d, &lo, &hi);
-    pd_real(p, lo);
-    pd_real(p, hi);
+    for (int32_t i = 0; i < 3 * n; i++) pd_real(p, c->poles[i]);
+    pd_real(p, c->knots[c->degree]);
+    pd_real(p, c->knots[n]);
     pd_real(p, 0); pd_real(p, 0); pd_real(p, 0); /* normal: unused (not planar) */
 }
 
@@ -177,7 +174,7 @@ static void section_lines(ccn__cad_out *o, const char *text, char L, int32_t *co
 }
 
 static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges_pd *p,
-                           iges_de *de, double *pts) {
+                           iges_de *de, ccn__cad_curve *c) {
     int32_t E = t->num_edges, F = m->num_faces;
     int32_t k_vl = 0, k_el = 1 + E, k_shell = 2 + E + 3 * F;
 #define DEP(k) (2 * (long)(k) + 1)
@@ -186,9 +183,9 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
     for (int32_t v = 0; v < 3 * t->num_verts; v++) pd_real(p, t->vert_pos[v]);
     pd_finish(p, de, k_vl);
     for (int32_t e = 0; e < E; e++) {
-        int32_t side = t->edge_side[e];
         pd_begin(p, de, 1 + e, 126, 0);
-        curve_126(p, &m->faces[side / 4], side % 4, t->edge_vert[2 * e] == t->edge_vert[2 * e + 1], pts);
+        ccn__cad_segment_curve(m, t, t->edge_seg[e], c);
+        curve_126(p, c, t->edge_vert[2 * e] == t->edge_vert[2 * e + 1]);
         pd_finish(p, de, 1 + e);
     }
     pd_begin(p, de, k_el, 504, 1);
@@ -207,12 +204,12 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         surface_128(p, &m->faces[f]);
         pd_finish(p, de, ks);
         pd_begin(p, de, ks + 1, 508, 1);
-        pd_int(p, 4);
-        for (int s = 0; s < 4; s++) {
+        pd_int(p, t->face_seg[f + 1] - t->face_seg[f]);
+        for (int32_t j = t->face_seg[f]; j < t->face_seg[f + 1]; j++) {
             pd_int(p, 0); /* an edge */
             pd_int(p, DEP(k_el));
-            pd_int(p, t->side_edge[4 * f + s] + 1);
-            pd_int(p, t->side_sense[4 * f + s]);
+            pd_int(p, t->seg_edge[j] + 1);
+            pd_int(p, t->seg_sense[j]);
             pd_int(p, 0); /* no parameter-space curves */
         }
         pd_finish(p, de, ks + 1);
@@ -253,16 +250,18 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     double maxc = 0;
     for (int32_t f = 0; f < m->num_faces; f++) {
         const ccn__cad_surface *s = &m->faces[f];
-        for (int d = 0; d < 2; d++) maxp = s->num_poles[d] > maxp ? s->num_poles[d] : maxp;
+        int32_t cap = ccn__cad_curve_capacity(s);
+        maxp = cap > maxp ? cap : maxp;
         for (size_t i = 0; i < 3 * (size_t)s->num_poles[0] * (size_t)s->num_poles[1]; i++)
             maxc = s->poles[i] > maxc ? s->poles[i] : -s->poles[i] > maxc ? -s->poles[i] : maxc;
     }
     int32_t nde = 4 + t.num_edges + 3 * m->num_faces;
     iges_de *de = calloc((size_t)nde, sizeof *de);
-    double *pts = malloc(sizeof(double) * 3 * (size_t)maxp);
+    double *pts = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
+    ccn__cad_curve c = {0, 0, pts + 3 * (size_t)maxp, pts, 0}; /* poles, then knots */
     iges_pd *p = calloc(1, sizeof *p);
     ccn__cad_out *o = malloc(sizeof *o);
-    if (!de || !pts || !p || !o || build_pd(m, &t, p, de, pts) != CCN_OK) {
+    if (!de || !pts || !p || !o || build_pd(m, &t, p, de, &c) != CCN_OK) {
         st = ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }

@@ -3,8 +3,9 @@
  * Entities, leaves first so that every reference points backwards:
  *   CARTESIAN_POINT, VERTEX_POINT (one per shared vertex),
  *   B_SPLINE_CURVE_WITH_KNOTS + EDGE_CURVE (one per shared edge: the iso curve of the side
- *   that defines it, in increasing parameter),
- *   per face: B_SPLINE_SURFACE_WITH_KNOTS, four ORIENTED_EDGEs, EDGE_LOOP, FACE_OUTER_BOUND,
+ *   segment that defines it, in increasing parameter, cut to the segment when the side is
+ *   split),
+ *   per face: B_SPLINE_SURFACE_WITH_KNOTS, an ORIENTED_EDGE per side segment, EDGE_LOOP, FACE_OUTER_BOUND,
  *   ADVANCED_FACE (same_sense .T.: the face normal is Su x Sv),
  *   CLOSED_SHELL + MANIFOLD_SOLID_BREP + ADVANCED_BREP_SHAPE_REPRESENTATION when every side
  *   is shared, else OPEN_SHELL + SHELL_BASED_SURFACE_MODEL +
@@ -38,14 +39,23 @@ static int32_t point(step_w *w, const double p[3]) {
     return id;
 }
 
-static void knot_lists(step_w *w, const ccn__cad_surface *f, int dir) {
+/* Distinct knots and multiplicities of a flat knot vector. */
+static void flat_knot_lists(step_w *w, const double *t, int32_t nt) {
     char r[32];
     ccn__cad_puts(&w->o, "(");
-    for (int32_t k = 0; k < f->num_knots[dir]; k++)
-        ccn__cad_printf(&w->o, "%s%d", k ? "," : "", (int)f->mults[dir][k]);
+    for (int32_t i = 0, first = 1; i < nt; first = 0) {
+        int32_t k = i;
+        while (k < nt && t[k] == t[i]) k++;
+        ccn__cad_printf(&w->o, "%s%d", first ? "" : ",", (int)(k - i));
+        i = k;
+    }
     ccn__cad_puts(&w->o, "),(");
-    for (int32_t k = 0; k < f->num_knots[dir]; k++)
-        ccn__cad_printf(&w->o, "%s%s", k ? "," : "", ccn__cad_real(f->knots[dir][k], r));
+    for (int32_t i = 0, first = 1; i < nt; first = 0) {
+        ccn__cad_printf(&w->o, "%s%s", first ? "" : ",", ccn__cad_real(t[i], r));
+        int32_t k = i;
+        while (k < nt && t[k] == t[i]) k++;
+        i = k;
+    }
     ccn__cad_puts(&w->o, ")");
 }
 
@@ -58,20 +68,16 @@ static void id_list(step_w *w, int32_t first, int32_t n) {
 }
 
 static int32_t edge_curve(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
-                          const int32_t *vert_id, int32_t e, double *scratch) {
-    int32_t side = t->edge_side[e], s = side % 4;
-    const ccn__cad_surface *f = &m->faces[side / 4];
-    int dir = s % 2 == 0 ? 0 : 1;
-    int32_t n = f->num_poles[dir];
-    ccn__cad_side_curve(f, s, scratch);
+                          const int32_t *vert_id, int32_t e, ccn__cad_curve *c) {
+    ccn__cad_segment_curve(m, t, t->edge_seg[e], c);
     int32_t first = w->id + 1;
-    for (int32_t i = 0; i < n; i++) point(w, scratch + 3 * (size_t)i);
+    for (int32_t i = 0; i < c->num_poles; i++) point(w, c->poles + 3 * (size_t)i);
     int closed = t->edge_vert[2 * e] == t->edge_vert[2 * e + 1];
     int32_t curve = ent(w);
-    ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',%d,", (int)f->degree[dir]);
-    id_list(w, first, n);
+    ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',%d,", (int)c->degree);
+    id_list(w, first, c->num_poles);
     ccn__cad_printf(&w->o, ",.UNSPECIFIED.,%s,.F.,", closed ? ".T." : ".F.");
-    knot_lists(w, f, dir);
+    flat_knot_lists(w, c->knots, c->num_poles + c->degree + 1);
     ccn__cad_puts(&w->o, ",.UNSPECIFIED.);\n");
     int32_t id = ent(w);
     ccn__cad_printf(&w->o, "EDGE_CURVE('',#%d,#%d,#%d,.T.);\n", (int)vert_id[t->edge_vert[2 * e]],
@@ -109,15 +115,16 @@ static int32_t face(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
     for (int32_t k = 0; k < f->num_knots[1]; k++)
         ccn__cad_printf(&w->o, "%s%s", k ? "," : "", ccn__cad_real(f->knots[1][k], r));
     ccn__cad_puts(&w->o, "),.UNSPECIFIED.);\n");
-    int32_t oe = w->id + 1;
-    for (int s = 0; s < 4; s++) {
+    int32_t oe = w->id + 1, j0 = t->face_seg[fi], nj = t->face_seg[fi + 1] - j0;
+    for (int32_t j = j0; j < j0 + nj; j++) {
         ent(w);
-        ccn__cad_printf(&w->o, "ORIENTED_EDGE('',*,*,#%d,%s);\n", (int)edge_id[t->side_edge[4 * fi + s]],
-                        t->side_sense[4 * fi + s] ? ".T." : ".F.");
+        ccn__cad_printf(&w->o, "ORIENTED_EDGE('',*,*,#%d,%s);\n", (int)edge_id[t->seg_edge[j]],
+                        t->seg_sense[j] ? ".T." : ".F.");
     }
     int32_t loop = ent(w);
-    ccn__cad_printf(&w->o, "EDGE_LOOP('',(#%d,#%d,#%d,#%d));\n", (int)oe, (int)oe + 1, (int)oe + 2,
-                    (int)oe + 3);
+    ccn__cad_puts(&w->o, "EDGE_LOOP('',");
+    id_list(w, oe, nj);
+    ccn__cad_puts(&w->o, ");\n");
     int32_t bound = ent(w);
     ccn__cad_printf(&w->o, "FACE_OUTER_BOUND('',#%d,.T.);\n", (int)loop);
     int32_t id = ent(w);
@@ -194,12 +201,14 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     ccn_status st = ccn__cad_topo_build(m, &t, err);
     if (st) return st;
     int32_t maxp = 0;
-    for (int32_t f = 0; f < m->num_faces; f++)
-        for (int d = 0; d < 2; d++) maxp = m->faces[f].num_poles[d] > maxp ? m->faces[f].num_poles[d] : maxp;
+    for (int32_t f = 0; f < m->num_faces; f++) {
+        int32_t c = ccn__cad_curve_capacity(&m->faces[f]);
+        maxp = c > maxp ? c : maxp;
+    }
     int32_t *vert_id = malloc(sizeof(int32_t) * (size_t)t.num_verts);
     int32_t *edge_id = malloc(sizeof(int32_t) * (size_t)t.num_edges);
     int32_t *face_id = malloc(sizeof(int32_t) * (size_t)m->num_faces);
-    double *scratch = malloc(sizeof(double) * 3 * (size_t)maxp);
+    double *scratch = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
     step_w *w = malloc(sizeof *w);
     if (!vert_id || !edge_id || !face_id || !scratch || !w) {
         st = ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
@@ -214,7 +223,8 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         vert_id[v] = ent(w);
         ccn__cad_printf(&w->o, "VERTEX_POINT('',#%d);\n", (int)p);
     }
-    for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, scratch);
+    ccn__cad_curve c = {0, 0, scratch + 3 * (size_t)maxp, scratch, 0}; /* poles, then knots */
+    for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, &c);
     for (int32_t f = 0; f < m->num_faces; f++) face_id[f] = face(w, m, &t, edge_id, f);
     int32_t shell = ent(w);
     ccn__cad_printf(&w->o, "%s('',(", t.closed ? "CLOSED_SHELL" : "OPEN_SHELL");

@@ -87,31 +87,58 @@ static void bezier_setup(tsurf *f, int deg, double lo, double hi) {
     f->s.poles = f->poles;
 }
 
-/* Adjacency by geometry: side a of f and side b of g are shared when they are the same
- * curve run in opposite directions (checked at 5 fractions). */
-static void side_pt(const ccn__cad_surface *s, int side, double w, double out[3]) {
+/* Segments of the model (as cad.h numbers them) and adjacency by geometry: two segments
+ * are shared when they are the same curve run in opposite directions (5 fractions). */
+typedef struct { int face, side; double lo, hi; } tseg;
+
+static int segments(const tsurf *f, int n, const int32_t *bs, const double *br, tseg *out) {
+    int j = 0;
+    for (int k = 0; k < n; k++)
+        for (int s = 0; s < 4; s++) {
+            double lo, hi;
+            ref_domain(&f[k].s, s % 2, &lo, &hi);
+            int a = 4 * k + s, b0 = bs ? bs[a] : 0, b1 = bs ? bs[a + 1] : 0;
+            double prev = s < 2 ? lo : hi;
+            for (int b = b0; b <= b1; b++, j++) {
+                double next = b < b1 ? br[b] : (s < 2 ? hi : lo);
+                out[j].face = k;
+                out[j].side = s;
+                out[j].lo = s < 2 ? prev : next;
+                out[j].hi = s < 2 ? next : prev;
+                prev = next;
+            }
+        }
+    return j;
+}
+
+static void seg_pt(const tsurf *f, const tseg *g, double w, double out[3]) {
     double u0, u1, v0, v1;
+    const ccn__cad_surface *s = &f[g->face].s;
     ref_domain(s, 0, &u0, &u1);
     ref_domain(s, 1, &v0, &v1);
-    double u = side == 0 ? u0 + w * (u1 - u0) : side == 1 ? u1 : side == 2 ? u1 - w * (u1 - u0) : u0;
-    double v = side == 0 ? v0 : side == 1 ? v0 + w * (v1 - v0) : side == 2 ? v1 : v1 - w * (v1 - v0);
+    double t = g->side < 2 ? g->lo + w * (g->hi - g->lo) : g->hi - w * (g->hi - g->lo);
+    double u = g->side == 0 || g->side == 2 ? t : g->side == 1 ? u1 : u0;
+    double v = g->side == 1 || g->side == 3 ? t : g->side == 0 ? v0 : v1;
     ref_eval(s, u, v, out);
 }
 
-static void find_adjacency(const tsurf *f, int n, int32_t *adj) {
-    for (int a = 0; a < 4 * n; a++) adj[a] = -1;
-    for (int a = 0; a < 4 * n; a++)
-        for (int b = 0; b < 4 * n && adj[a] < 0; b++) {
+static int find_adjacency(const tsurf *f, int n, const int32_t *bs, const double *br, int32_t *adj) {
+    tseg g[128];
+    int ns = segments(f, n, bs, br, g);
+    for (int a = 0; a < ns; a++) adj[a] = -1;
+    for (int a = 0; a < ns; a++)
+        for (int b = 0; b < ns && adj[a] < 0; b++) {
             if (b == a || adj[b] >= 0) continue;
             int same = 1;
             for (int k = 0; k <= 4 && same; k++) {
                 double p[3], q[3];
-                side_pt(&f[a / 4].s, a % 4, k / 4.0, p);
-                side_pt(&f[b / 4].s, b % 4, 1 - k / 4.0, q);
+                seg_pt(f, &g[a], k / 4.0, p);
+                seg_pt(f, &g[b], 1 - k / 4.0, q);
                 same = fabs(p[0] - q[0]) + fabs(p[1] - q[1]) + fabs(p[2] - q[2]) < 1e-12;
             }
             if (same) { adj[a] = b; adj[b] = a; }
         }
+    return ns;
 }
 
 /* Unit cube, each face a bicubic Bézier patch with its inner poles pushed out by 0.15:
@@ -160,6 +187,40 @@ static int make_grid(tsurf *f) {
                     }
         }
     return n;
+}
+
+/* T-junctions: the left column of the grid's B-spline as one packed face (unclamped uniform
+ * knots, 4 x 6 poles, three spans along v) next to the right column's three Bézier patches;
+ * the pack's side 1 is split at its knots v = 4, 5. */
+static int32_t tee_bs[4 * 4 + 1];
+static double tee_br[2] = {4, 5};
+static int make_tee(tsurf *f) {
+    tsurf g[6];
+    make_grid(g);
+    f[1] = g[3]; f[2] = g[4]; f[3] = g[5];
+    for (int k = 1; k < 4; k++) f[k].s.knots[0] = f[k].knots[0], f[k].s.knots[1] = f[k].knots[1],
+                                f[k].s.mults[0] = f[k].mults[0], f[k].s.mults[1] = f[k].mults[1],
+                                f[k].s.poles = f[k].poles;
+    memset(&f[0], 0, sizeof f[0]);
+    const int np[2] = {4, 6};
+    for (int d = 0; d < 2; d++) {
+        f[0].s.degree[d] = 3;
+        f[0].s.num_poles[d] = np[d];
+        f[0].s.num_knots[d] = np[d] + 4;
+        for (int i = 0; i < np[d] + 4; i++) { f[0].knots[d][i] = i; f[0].mults[d][i] = 1; }
+        f[0].s.knots[d] = f[0].knots[d];
+        f[0].s.mults[d] = f[0].mults[d];
+    }
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 6; j++) {
+            double *P = f[0].poles + 3 * (6 * i + j);
+            P[0] = i;
+            P[1] = j * 0.9;
+            P[2] = 0.4 * sin(1.3 * i) * cos(0.8 * j) + 0.1 * i * j / 6.0;
+        }
+    f[0].s.poles = f[0].poles;
+    for (int a = 0; a <= 16; a++) tee_bs[a] = a <= 1 ? 0 : 2; /* face 0 side 1: two breaks */
+    return 4;
 }
 
 /* Torus: a periodic bicubic B-spline in both directions, NU x NV distinct poles, knot
@@ -257,15 +318,16 @@ static void write_ref(const char *name, const tsurf *f, int n) {
 }
 
 /* Writes the model with both writers: status, determinism, files for the oracle. */
-static void export_model(const char *name, tsurf *f, int n, int expect_closed) {
+static void export_model(const char *name, tsurf *f, int n, const int32_t *bs, const double *br,
+                         int expect_closed) {
     ccn__cad_surface faces[8];
-    int32_t adj[32];
+    int32_t adj[128];
     for (int k = 0; k < n; k++) faces[k] = f[k].s;
-    find_adjacency(f, n, adj);
-    int shared = 0;
-    for (int a = 0; a < 4 * n; a++) shared += adj[a] >= 0;
-    CHECK((shared == 4 * n) == expect_closed, "%s: %d of %d sides shared", name, shared, 4 * n);
-    ccn__cad_model m = {n, faces, adj, name, NULL, 0};
+    int ns = find_adjacency(f, n, bs, br, adj), shared = 0;
+    for (int a = 0; a < ns; a++) shared += adj[a] >= 0;
+    CHECK((shared == ns) == expect_closed, "%s: %d of %d segments shared", name, shared, ns);
+    ccn__cad_model m = {.num_faces = n, .faces = faces, .side_breaks_start = bs, .side_breaks = br,
+                        .adjacency = adj, .name = name};
     static const char *ext[2] = {"step", "igs"};
     writer_fn w[2] = {ccn__step_write, ccn__iges_write};
     for (int k = 0; k < 2; k++) {
@@ -287,10 +349,11 @@ static void export_model(const char *name, tsurf *f, int n, int expect_closed) {
 
 static tsurf models[8];
 
-static void test_cube(void) { export_model("cube", models, make_cube(models), 1); }
-static void test_grid(void) { export_model("grid", models, make_grid(models), 0); }
+static void test_cube(void) { export_model("cube", models, make_cube(models), NULL, NULL, 1); }
+static void test_grid(void) { export_model("grid", models, make_grid(models), NULL, NULL, 0); }
+static void test_tee(void) { export_model("tee", models, make_tee(models), tee_bs, tee_br, 0); }
 static void test_torus(void) {
-    export_model("torus", models, make_torus(models), 1);
+    export_model("torus", models, make_torus(models), NULL, NULL, 1);
     if (!outdir) return;
     char path[512];
     snprintf(path, sizeof path, "%s/torus_build.txt", outdir);
@@ -333,6 +396,78 @@ static void test_eval(void) {
     CHECK(worst <= 1e-13, "de Boor vs recursion %g", worst);
 }
 
+/* Each segment curve (knot insertion cut) evaluated by the recursion equals the surface side
+ * at the same parameter: a split unclamped (periodic) side and the tee's split pack side. */
+static double curve_eval_ref(const ccn__cad_curve *c, double t, int k) {
+    double x = 0, end = c->knots[c->num_poles];
+    for (int i = 0; i < c->num_poles; i++) x += cdb(c->knots, i, c->degree, t, end) * c->poles[3 * i + k];
+    return x;
+}
+
+static void check_segments(const ccn__cad_model *m, const tsurf *f) {
+    ccn__cad_topo t;
+    ccn_error e;
+    CHECK(ccn__cad_topo_build(m, &t, &e) == CCN_OK, "topo: %s", e.message);
+    double knots[200], poles[600], worst = 0;
+    int cut = 0;
+    for (int32_t j = 0; j < t.num_segs; j++) {
+        ccn__cad_curve c = {0, 0, knots, poles, 0};
+        CHECK(ccn__cad_curve_capacity(&m->faces[t.seg_face[j]]) <= 190, "capacity");
+        ccn__cad_segment_curve(m, &t, j, &c);
+        CHECK(c.knots[c.degree] == t.seg_lo[j] && c.knots[c.num_poles] == t.seg_hi[j],
+              "segment %d: curve domain [%g, %g] vs [%g, %g]", (int)j, c.knots[c.degree],
+              c.knots[c.num_poles], t.seg_lo[j], t.seg_hi[j]);
+        cut += c.num_poles != m->faces[t.seg_face[j]].num_poles[t.seg_side[j] % 2];
+        for (int q = 0; q <= 8; q++) {
+            double w = t.seg_lo[j] + (t.seg_hi[j] - t.seg_lo[j]) * q / 8, x[3], u0, u1, v0, v1;
+            const ccn__cad_surface *s = &f[t.seg_face[j]].s;
+            ref_domain(s, 0, &u0, &u1);
+            ref_domain(s, 1, &v0, &v1);
+            int sd = t.seg_side[j];
+            ref_eval(s, sd % 2 ? (sd == 1 ? u1 : u0) : w, sd % 2 ? w : (sd == 0 ? v0 : v1), x);
+            for (int k = 0; k < 3; k++) worst = fmax(worst, fabs(curve_eval_ref(&c, w, k) - x[k]));
+        }
+    }
+    CHECK(worst <= 1e-13, "segment curves differ from the surface by %g", worst);
+    CHECK(cut > 0, "no segment was cut");
+    ccn__cad_topo_free(&t);
+}
+
+static void test_segments(void) {
+    int n = make_tee(models);
+    ccn__cad_surface faces[4];
+    int32_t adj[128];
+    for (int k = 0; k < n; k++) faces[k] = models[k].s;
+    find_adjacency(models, n, tee_bs, tee_br, adj);
+    ccn__cad_model m = {.num_faces = n, .faces = faces, .side_breaks_start = tee_bs,
+                        .side_breaks = tee_br, .adjacency = adj};
+    check_segments(&m, models);
+    /* the torus with its u seam split at two knots and its v seam at one non-knot */
+    make_torus(models);
+    /* side 0 split at u = 2.7, 6 (knots), side 1 at v = 3.5 (no knot); sides 2, 3 are the
+     * same seam edges, split at the same points in their own running order */
+    int32_t bs2[5] = {0, 2, 3, 5, 6};
+    double br2[6] = {2.7, 6.0, 3.5, 6.0, 2.7, 3.5};
+    ccn__cad_surface tf = models[0].s;
+    int32_t tadj[16];
+    int ns = find_adjacency(models, 1, bs2, br2, tadj), shared = 0;
+    for (int a = 0; a < ns; a++) shared += tadj[a] >= 0;
+    CHECK(shared == ns, "split torus: %d of %d segments shared", shared, ns);
+    ccn__cad_model tm = {.num_faces = 1, .faces = &tf, .side_breaks_start = bs2, .side_breaks = br2,
+                         .adjacency = tadj};
+    check_segments(&tm, models);
+    writer_fn w[2] = {ccn__step_write, ccn__iges_write};
+    static const char *ext[2] = {"step", "igs"};
+    for (int k = 0; k < 2; k++) {
+        sink a = {NULL, 0, 0, -1};
+        ccn_error e;
+        CHECK(w[k](&tm, sink_fn, &a, &e) == CCN_OK, "split torus: %s", e.message);
+        if (outdir) write_file("torus_split", ext[k], a.buf, a.len);
+        free(a.buf);
+    }
+    if (outdir) write_ref("torus_split", models, 1);
+}
+
 static void expect_error(const char *what, ccn__cad_model *m, ccn_status want, int32_t face) {
     writer_fn w[2] = {ccn__step_write, ccn__iges_write};
     for (int k = 0; k < 2; k++) {
@@ -354,8 +489,8 @@ static void test_bad_models(void) {
     ccn__cad_surface faces[6];
     int32_t adj[24];
     for (int k = 0; k < n; k++) faces[k] = models[k].s;
-    find_adjacency(models, n, adj);
-    ccn__cad_model m = {n, faces, adj, "bad", NULL, 0};
+    find_adjacency(models, n, NULL, NULL, adj);
+    ccn__cad_model m = {.num_faces = n, .faces = faces, .adjacency = adj, .name = "bad"};
     int32_t keep = adj[5];
     adj[5] = 4 * 3 + 2; /* not mutual */
     expect_error("non-mutual side", &m, CCN_ERR_TOPOLOGY, 1);
@@ -364,7 +499,7 @@ static void test_bad_models(void) {
     int32_t c = adj[1];
     adj[0] = c; adj[c] = 0; adj[1] = b; adj[b] = 1;
     expect_error("mismatched sides", &m, CCN_ERR_TOPOLOGY, 0);
-    find_adjacency(models, n, adj);
+    find_adjacency(models, n, NULL, NULL, adj);
     models[2].poles[7] = NAN;
     expect_error("NaN pole", &m, CCN_ERR_ARGUMENT, 2);
     models[2].poles[7] = 0;
@@ -388,8 +523,23 @@ static void test_bad_models(void) {
     models[0].poles[0] += 0.5;
     ccn__cad_surface tf = models[0].s;
     int32_t tadj[4] = {2, 3, 0, 1};
-    ccn__cad_model tm = {1, &tf, tadj, NULL, NULL, 0};
+    ccn__cad_model tm = {.num_faces = 1, .faces = &tf, .adjacency = tadj};
     expect_error("periodic rows differ", &tm, CCN_ERR_ARGUMENT, 0);
+    /* a break outside its side, and breaks out of order */
+    int nt = make_tee(models);
+    ccn__cad_surface tee[4];
+    for (int k = 0; k < nt; k++) tee[k] = models[k].s;
+    int32_t tadj2[128];
+    find_adjacency(models, nt, tee_bs, tee_br, tadj2);
+    ccn__cad_model mt = {.num_faces = nt, .faces = tee, .side_breaks_start = tee_bs,
+                         .side_breaks = tee_br, .adjacency = tadj2};
+    tee_br[1] = 6; /* = the side's end */
+    expect_error("break at the side's end", &mt, CCN_ERR_ARGUMENT, 0);
+    tee_br[0] = 5; tee_br[1] = 4;
+    expect_error("breaks out of order", &mt, CCN_ERR_ARGUMENT, 0);
+    tee_br[0] = 4; tee_br[1] = 5;
+    mt.side_breaks = NULL;
+    expect_error("breaks without their starts", &mt, CCN_ERR_ARGUMENT, -1);
 }
 
 int main(int argc, char **argv) {
@@ -397,6 +547,8 @@ int main(int argc, char **argv) {
     RUN(test_eval);
     RUN(test_cube);
     RUN(test_grid);
+    RUN(test_tee);
+    RUN(test_segments);
     RUN(test_torus);
     RUN(test_bad_models);
     return TEST_SUMMARY();

@@ -317,7 +317,7 @@ static void report(const TopoDS_Shape &shape, int K) {
     std::printf("closed_shells: %d\n", closed_shells);
     if (closed_shells) { // a closed shell bounds positive volume when its faces point out
         GProp_GProps g;
-        BRepGProp::VolumeProperties(shape, g);
+        BRepGProp::VolumeProperties(shape, g, 1e-10); // adaptive, relative error 1e-10
         std::printf("volume: %.17g\n", g.Mass());
     }
     ShapeAnalysis_FreeBounds fb(shape, Standard_False, Standard_False); // no sewing: as read

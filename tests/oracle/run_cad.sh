@@ -1,7 +1,8 @@
 #!/bin/sh
 # The CAD writers vs OpenCASCADE (build/occt_read): test_cad_writer writes a closed pillow
 # cube (6 Bezier faces), an open 2x3 patch grid and a periodic non-uniform torus face as
-# STEP and IGES plus reference grids from its own Cox-de Boor evaluator. For every file:
+# STEP and IGES (and a T-junction model: a packed B-spline face whose side is split into three
+# edges next to three Bezier faces; the torus with split seams) plus reference grids from its own Cox-de Boor evaluator. For every file:
 # the loops as written (OpenCASCADE's entity model, before translation): closed head to
 # tail, every shared edge used once each way; read without failure, BRepCheck valid with
 # and without the reader's shape healing, one shell, the expected faces/edges/vertices, no
@@ -37,7 +38,8 @@ griddiff() {
 }
 
 # name faces edges vertices closed boundary_edges shared_edges seams smooth periodic_faces
-for spec in "cube 6 12 8 1 0 12 0 0 0" "grid 6 17 12 0 10 7 0 1 0" "torus 1 2 1 1 0 0 2 1 1"; do
+for spec in "cube 6 12 8 1 0 12 0 0 0" "grid 6 17 12 0 10 7 0 1 0" "tee 4 13 10 0 8 5 0 1 0" \
+            "torus 1 2 1 1 0 0 2 1 1" "torus_split 1 5 4 1 0 0 5 1 1"; do
   set -- $spec
   name=$1 nf=$2 ne=$3 nv=$4 closed=$5 nb=$6 n2=$7 nseam=$8 smooth=$9 nper=${10}
   for ext in step igs; do
