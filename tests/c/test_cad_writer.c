@@ -189,8 +189,31 @@ static int make_grid(tsurf *f) {
     return n;
 }
 
+/* Degree elevation of a Bézier face in both directions (exact: same surface, degree + 1). */
+static void bezier_elevate(tsurf *f) {
+    int p = f->s.degree[0], n = p + 1;
+    double Q[3 * 36], T[3 * 36];
+    for (int i = 0; i <= n; i++) /* along u: T[i][j] from P[i-1][j], P[i][j] */
+        for (int j = 0; j < n; j++)
+            for (int k = 0; k < 3; k++) {
+                double a = (double)i / n;
+                double lo = i > 0 ? f->poles[3 * ((i - 1) * n + j) + k] : 0, hi = i < n ? f->poles[3 * (i * n + j) + k] : 0;
+                T[3 * (i * n + j) + k] = a * lo + (1 - a) * hi;
+            }
+    for (int i = 0; i <= n; i++) /* along v */
+        for (int j = 0; j <= n; j++)
+            for (int k = 0; k < 3; k++) {
+                double a = (double)j / n;
+                double lo = j > 0 ? T[3 * (i * n + j - 1) + k] : 0, hi = j < n ? T[3 * (i * n + j) + k] : 0;
+                Q[3 * (i * (n + 1) + j) + k] = a * lo + (1 - a) * hi;
+            }
+    bezier_setup(f, p + 1, f->knots[0][0], f->knots[0][1]);
+    memcpy(f->poles, Q, sizeof(double) * 3 * (size_t)((n + 1) * (n + 1)));
+}
+
 /* T-junctions: the left column of the grid's B-spline as one packed face (unclamped uniform
- * knots, 4 x 6 poles, three spans along v) next to the right column's three Bézier patches;
+ * knots, 4 x 6 poles, three spans along v) next to the right column's three Bézier patches,
+ * the middle one elevated to bi-5 (a degree-3 pack meeting a degree-5 face, as at a cap);
  * the pack's side 1 is split at its knots v = 4, 5. */
 static int32_t tee_bs[4 * 4 + 1];
 static double tee_br[2] = {4, 5};
@@ -201,6 +224,8 @@ static int make_tee(tsurf *f) {
     for (int k = 1; k < 4; k++) f[k].s.knots[0] = f[k].knots[0], f[k].s.knots[1] = f[k].knots[1],
                                 f[k].s.mults[0] = f[k].mults[0], f[k].s.mults[1] = f[k].mults[1],
                                 f[k].s.poles = f[k].poles;
+    bezier_elevate(&f[2]);
+    bezier_elevate(&f[2]);
     memset(&f[0], 0, sizeof f[0]);
     const int np[2] = {4, 6};
     for (int d = 0; d < 2; d++) {
