@@ -17,5 +17,10 @@ $(B)/occt_read: tests/oracle/occt_read.cpp
 	@mkdir -p $(@D)
 	$(CXX) -std=c++14 -O1 -Wall -Wextra -Werror $(OCCT_INC) $< -o $@ $(OCCT_LIBS)
 
-TEST_DEPS += $(B)/occt_read
+# Prototype of the unpacked export (tests/oracle/EXPORT_DESIGN.md): plan patches -> CAD faces.
+$(B)/cad_from_patches: tests/oracle/cad_from_patches.c $(B)/libccnurbs.a $(HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) -Icsrc $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
+
+TEST_DEPS += $(B)/occt_read $(B)/cad_from_patches
 .DEFAULT_GOAL := $(OCCT_SAVED_GOAL)
