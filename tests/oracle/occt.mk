@@ -18,7 +18,7 @@ $(B)/occt_read: tests/oracle/occt_read.cpp
 	$(CXX) -std=c++14 -O1 -Wall -Wextra -Werror $(OCCT_INC) $< -o $@ $(OCCT_LIBS)
 
 # Prototype of the unpacked export (tests/oracle/EXPORT_DESIGN.md): plan patches -> CAD faces.
-$(B)/cad_from_patches: tests/oracle/cad_from_patches.c $(B)/libccnurbs.a $(HDRS)
+$(B)/cad_from_patches: tests/oracle/cad_from_patches.c tests/oracle/cad_pack.h $(B)/libccnurbs.a $(HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Icsrc $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
 
