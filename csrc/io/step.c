@@ -1,0 +1,244 @@
+/* STEP AP214 writer of the neutral B-rep (cad.h).
+ *
+ * Entities, leaves first so that every reference points backwards:
+ *   CARTESIAN_POINT, VERTEX_POINT (one per shared vertex),
+ *   B_SPLINE_CURVE_WITH_KNOTS + EDGE_CURVE (one per shared edge: the iso curve of the side
+ *   segment that defines it, in increasing parameter, cut to the segment when the side is
+ *   split),
+ *   per face: B_SPLINE_SURFACE_WITH_KNOTS, an ORIENTED_EDGE per side segment, EDGE_LOOP, FACE_OUTER_BOUND,
+ *   ADVANCED_FACE (same_sense .T.: the face normal is Su x Sv),
+ *   CLOSED_SHELL + MANIFOLD_SOLID_BREP + ADVANCED_BREP_SHAPE_REPRESENTATION when every side
+ *   is shared, else OPEN_SHELL + SHELL_BASED_SURFACE_MODEL +
+ *   MANIFOLD_SURFACE_SHAPE_REPRESENTATION,
+ *   the representation context (millimetre, radian, steradian, the tolerance as
+ *   UNCERTAINTY_MEASURE_WITH_UNIT) and the AP214 product structure (PRODUCT ->
+ *   PRODUCT_DEFINITION -> PRODUCT_DEFINITION_SHAPE -> SHAPE_DEFINITION_REPRESENTATION).
+ * Edges carry no pcurves: the faces are untrimmed and every edge is an iso line of each face
+ * it bounds, which readers recover exactly.
+ */
+#include "cad.h"
+
+#include <stdlib.h>
+
+typedef struct {
+    ccn__cad_out o;
+    int32_t id; /* last entity id written */
+} step_w;
+
+static int32_t ent(step_w *w) {
+    w->id++;
+    ccn__cad_printf(&w->o, "#%d=", (int)w->id);
+    return w->id;
+}
+
+static int32_t point(step_w *w, const double p[3]) {
+    char a[32], b[32], c[32];
+    int32_t id = ent(w);
+    ccn__cad_printf(&w->o, "CARTESIAN_POINT('',(%s,%s,%s));\n", ccn__cad_real(p[0], a),
+                    ccn__cad_real(p[1], b), ccn__cad_real(p[2], c));
+    return id;
+}
+
+/* Distinct knots and multiplicities of a flat knot vector. */
+static void flat_knot_lists(step_w *w, const double *t, int32_t nt) {
+    char r[32];
+    ccn__cad_puts(&w->o, "(");
+    for (int32_t i = 0, first = 1; i < nt; first = 0) {
+        int32_t k = i;
+        while (k < nt && t[k] == t[i]) k++;
+        ccn__cad_printf(&w->o, "%s%d", first ? "" : ",", (int)(k - i));
+        i = k;
+    }
+    ccn__cad_puts(&w->o, "),(");
+    for (int32_t i = 0, first = 1; i < nt; first = 0) {
+        ccn__cad_printf(&w->o, "%s%s", first ? "" : ",", ccn__cad_real(t[i], r));
+        int32_t k = i;
+        while (k < nt && t[k] == t[i]) k++;
+        i = k;
+    }
+    ccn__cad_puts(&w->o, ")");
+}
+
+/* The id list of n consecutive entities starting at first, wrapped every 8 ids. */
+static void id_list(step_w *w, int32_t first, int32_t n) {
+    ccn__cad_puts(&w->o, "(");
+    for (int32_t i = 0; i < n; i++)
+        ccn__cad_printf(&w->o, "%s#%d", i ? (i % 8 ? "," : ",\n") : "", (int)(first + i));
+    ccn__cad_puts(&w->o, ")");
+}
+
+static int32_t edge_curve(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
+                          const int32_t *vert_id, int32_t e, ccn__cad_curve *c) {
+    ccn__cad_segment_curve(m, t, t->edge_seg[e], c);
+    int32_t first = w->id + 1;
+    for (int32_t i = 0; i < c->num_poles; i++) point(w, c->poles + 3 * (size_t)i);
+    int closed = t->edge_vert[2 * e] == t->edge_vert[2 * e + 1];
+    int32_t curve = ent(w);
+    ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',%d,", (int)c->degree);
+    id_list(w, first, c->num_poles);
+    ccn__cad_printf(&w->o, ",.UNSPECIFIED.,%s,.F.,", closed ? ".T." : ".F.");
+    flat_knot_lists(w, c->knots, c->num_poles + c->degree + 1);
+    ccn__cad_puts(&w->o, ",.UNSPECIFIED.);\n");
+    int32_t id = ent(w);
+    ccn__cad_printf(&w->o, "EDGE_CURVE('',#%d,#%d,#%d,.T.);\n", (int)vert_id[t->edge_vert[2 * e]],
+                    (int)vert_id[t->edge_vert[2 * e + 1]], (int)curve);
+    return id;
+}
+
+static int32_t face(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
+                    const int32_t *edge_id, int32_t fi) {
+    const ccn__cad_surface *f = &m->faces[fi];
+    int32_t nu = f->num_poles[0], nv = f->num_poles[1];
+    int32_t first = w->id + 1;
+    for (int32_t i = 0; i < nu; i++)
+        for (int32_t j = 0; j < nv; j++) point(w, f->poles + 3 * ((size_t)i * nv + j));
+    int32_t surf = ent(w);
+    ccn__cad_printf(&w->o, "B_SPLINE_SURFACE_WITH_KNOTS('',%d,%d,(", (int)f->degree[0],
+                    (int)f->degree[1]);
+    for (int32_t i = 0; i < nu; i++) {
+        ccn__cad_puts(&w->o, i ? ",\n" : "");
+        id_list(w, first + i * nv, nv);
+    }
+    ccn__cad_printf(&w->o, "),.UNSPECIFIED.,%s,%s,.F.,", f->periodic[0] ? ".T." : ".F.",
+                    f->periodic[1] ? ".T." : ".F.");
+    ccn__cad_puts(&w->o, "(");
+    for (int32_t k = 0; k < f->num_knots[0]; k++)
+        ccn__cad_printf(&w->o, "%s%d", k ? "," : "", (int)f->mults[0][k]);
+    ccn__cad_puts(&w->o, "),(");
+    for (int32_t k = 0; k < f->num_knots[1]; k++)
+        ccn__cad_printf(&w->o, "%s%d", k ? "," : "", (int)f->mults[1][k]);
+    ccn__cad_puts(&w->o, "),(");
+    char r[32];
+    for (int32_t k = 0; k < f->num_knots[0]; k++)
+        ccn__cad_printf(&w->o, "%s%s", k ? "," : "", ccn__cad_real(f->knots[0][k], r));
+    ccn__cad_puts(&w->o, "),(");
+    for (int32_t k = 0; k < f->num_knots[1]; k++)
+        ccn__cad_printf(&w->o, "%s%s", k ? "," : "", ccn__cad_real(f->knots[1][k], r));
+    ccn__cad_puts(&w->o, "),.UNSPECIFIED.);\n");
+    int32_t oe = w->id + 1, j0 = t->face_seg[fi], nj = t->face_seg[fi + 1] - j0;
+    for (int32_t j = j0; j < j0 + nj; j++) {
+        ent(w);
+        ccn__cad_printf(&w->o, "ORIENTED_EDGE('',*,*,#%d,%s);\n", (int)edge_id[t->seg_edge[j]],
+                        t->seg_sense[j] ? ".T." : ".F.");
+    }
+    int32_t loop = ent(w);
+    ccn__cad_puts(&w->o, "EDGE_LOOP('',");
+    id_list(w, oe, nj);
+    ccn__cad_puts(&w->o, ");\n");
+    int32_t bound = ent(w);
+    ccn__cad_printf(&w->o, "FACE_OUTER_BOUND('',#%d,.T.);\n", (int)loop);
+    int32_t id = ent(w);
+    ccn__cad_printf(&w->o, "ADVANCED_FACE('',(#%d),#%d,.T.);\n", (int)bound, (int)surf);
+    return id;
+}
+
+static void header(step_w *w, const char *name, const char *stamp) {
+    ccn__cad_puts(&w->o, "ISO-10303-21;\nHEADER;\n");
+    ccn__cad_puts(&w->o, "FILE_DESCRIPTION(('CCNURBS exact limit surface'),'2;1');\n");
+    ccn__cad_printf(&w->o, "FILE_NAME('%s','%s',(''),(''),'ccnurbs %d.%d','ccnurbs','');\n", name,
+                    stamp, CCN_VERSION_MAJOR, CCN_VERSION_MINOR);
+    ccn__cad_puts(&w->o, "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\n");
+    ccn__cad_puts(&w->o, "ENDSEC;\nDATA;\n");
+}
+
+/* Context, units, representation and the product structure around the shape item. */
+static void trailer(step_w *w, const char *name, int closed, int32_t item, double tol) {
+    char r[32];
+    ccn__cad_out *o = &w->o;
+    int32_t mm = ent(w);
+    ccn__cad_puts(o, "(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.));\n");
+    int32_t rad = ent(w);
+    ccn__cad_puts(o, "(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));\n");
+    int32_t sr = ent(w);
+    ccn__cad_puts(o, "(NAMED_UNIT(*)SI_UNIT($,.STERADIAN.)SOLID_ANGLE_UNIT());\n");
+    int32_t unc = ent(w);
+    ccn__cad_printf(o, "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(%s),#%d,'distance_accuracy_value',"
+                       "'confusion accuracy');\n", ccn__cad_real(tol, r), (int)mm);
+    int32_t ctx = ent(w);
+    ccn__cad_printf(o, "(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#%d))"
+                       "GLOBAL_UNIT_ASSIGNED_CONTEXT((#%d,#%d,#%d))REPRESENTATION_CONTEXT('',''));\n",
+                    (int)unc, (int)mm, (int)rad, (int)sr);
+    double org[3] = {0, 0, 0};
+    int32_t p0 = point(w, org);
+    int32_t dz = ent(w);
+    ccn__cad_puts(o, "DIRECTION('',(0.,0.,1.));\n");
+    int32_t dx = ent(w);
+    ccn__cad_puts(o, "DIRECTION('',(1.,0.,0.));\n");
+    int32_t ax = ent(w);
+    ccn__cad_printf(o, "AXIS2_PLACEMENT_3D('',#%d,#%d,#%d);\n", (int)p0, (int)dz, (int)dx);
+    int32_t rep = ent(w);
+    ccn__cad_printf(o, "%s('%s',(#%d,#%d),#%d);\n",
+                    closed ? "ADVANCED_BREP_SHAPE_REPRESENTATION" : "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
+                    name, (int)ax, (int)item, (int)ctx);
+    int32_t app = ent(w);
+    ccn__cad_puts(o, "APPLICATION_CONTEXT('automotive design');\n");
+    ent(w);
+    ccn__cad_printf(o, "APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',"
+                       "2000,#%d);\n", (int)app);
+    int32_t pctx = ent(w);
+    ccn__cad_printf(o, "PRODUCT_CONTEXT('',#%d,'mechanical');\n", (int)app);
+    int32_t prod = ent(w);
+    ccn__cad_printf(o, "PRODUCT('%s','%s','',(#%d));\n", name, name, (int)pctx);
+    ent(w);
+    ccn__cad_printf(o, "PRODUCT_RELATED_PRODUCT_CATEGORY('part',$,(#%d));\n", (int)prod);
+    int32_t pdf = ent(w);
+    ccn__cad_printf(o, "PRODUCT_DEFINITION_FORMATION('','',#%d);\n", (int)prod);
+    int32_t pdc = ent(w);
+    ccn__cad_printf(o, "PRODUCT_DEFINITION_CONTEXT('part definition',#%d,'design');\n", (int)app);
+    int32_t pd = ent(w);
+    ccn__cad_printf(o, "PRODUCT_DEFINITION('design','',#%d,#%d);\n", (int)pdf, (int)pdc);
+    int32_t pds = ent(w);
+    ccn__cad_printf(o, "PRODUCT_DEFINITION_SHAPE('','',#%d);\n", (int)pd);
+    ent(w);
+    ccn__cad_printf(o, "SHAPE_DEFINITION_REPRESENTATION(#%d,#%d);\n", (int)pds, (int)rep);
+    ccn__cad_puts(o, "ENDSEC;\nEND-ISO-10303-21;\n");
+}
+
+ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
+                           ccn_error *err) {
+    if (!fn) return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "write callback is NULL");
+    ccn__cad_topo t;
+    ccn_status st = ccn__cad_topo_build(m, &t, err);
+    if (st) return st;
+    int32_t maxp = 0;
+    for (int32_t f = 0; f < m->num_faces; f++) {
+        int32_t c = ccn__cad_curve_capacity(&m->faces[f]);
+        maxp = c > maxp ? c : maxp;
+    }
+    int32_t *vert_id = malloc(sizeof(int32_t) * (size_t)t.num_verts);
+    int32_t *edge_id = malloc(sizeof(int32_t) * (size_t)t.num_edges);
+    int32_t *face_id = malloc(sizeof(int32_t) * (size_t)m->num_faces);
+    double *scratch = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
+    step_w *w = malloc(sizeof *w);
+    if (!vert_id || !edge_id || !face_id || !scratch || !w) {
+        st = ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        goto done;
+    }
+    ccn__cad_out_init(&w->o, fn, user);
+    w->id = 0;
+    const char *name = m->name ? m->name : "ccnurbs";
+    header(w, name, m->timestamp ? m->timestamp : "2000-01-01T00:00:00");
+    for (int32_t v = 0; v < t.num_verts; v++) {
+        int32_t p = point(w, t.vert_pos + 3 * (size_t)v);
+        vert_id[v] = ent(w);
+        ccn__cad_printf(&w->o, "VERTEX_POINT('',#%d);\n", (int)p);
+    }
+    ccn__cad_curve c = {0, 0, scratch + 3 * (size_t)maxp, scratch, 0}; /* poles, then knots */
+    for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, &c);
+    for (int32_t f = 0; f < m->num_faces; f++) face_id[f] = face(w, m, &t, edge_id, f);
+    int32_t shell = ent(w);
+    ccn__cad_printf(&w->o, "%s('',(", t.closed ? "CLOSED_SHELL" : "OPEN_SHELL");
+    for (int32_t f = 0; f < m->num_faces; f++)
+        ccn__cad_printf(&w->o, "%s#%d", f ? (f % 8 ? "," : ",\n") : "", (int)face_id[f]);
+    ccn__cad_puts(&w->o, "));\n");
+    int32_t item = ent(w);
+    if (t.closed) ccn__cad_printf(&w->o, "MANIFOLD_SOLID_BREP('%s',#%d);\n", name, (int)shell);
+    else ccn__cad_printf(&w->o, "SHELL_BASED_SURFACE_MODEL('%s',(#%d));\n", name, (int)shell);
+    trailer(w, name, t.closed, item, t.tolerance);
+    if (ccn__cad_flush(&w->o))
+        st = ccn__cad_fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
+done:
+    free(vert_id); free(edge_id); free(face_id); free(scratch); free(w);
+    ccn__cad_topo_free(&t);
+    return st;
+}
