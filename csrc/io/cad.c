@@ -1,26 +1,14 @@
 /* The neutral B-rep of the CAD writers (cad.h): validation, vertices and shared edges, iso
  * curves of face sides, and the buffered number-exact output both writers use. */
-#include "cad.h"
+#include "io/cad.h"
+
+#include "base/error.h"
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-ccn_status ccn__cad_fail(ccn_error *err, ccn_status st, int32_t kind, int32_t element,
-                         const char *fmt, ...) {
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->message, sizeof err->message, fmt, ap);
-        va_end(ap);
-        err->status = st;
-        err->element_kind = kind;
-        err->element = element;
-    }
-    return st;
-}
 
 /* ---- output ------------------------------------------------------------------------ */
 
@@ -168,11 +156,11 @@ static ccn_status check_direction(const ccn__cad_surface *f, int32_t fi, int dir
     const char *d = dir ? "v" : "u";
     int32_t p = f->degree[dir], n = f->num_poles[dir], nk = f->num_knots[dir];
     if (p < 1 || p > CCN_CAD_MAX_DEGREE)
-        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                              "face %d: %s degree %d is not in [1, %d]", (int)fi, d, (int)p,
                              CCN_CAD_MAX_DEGREE);
     if (n < p + 1 || nk < 2 || !f->knots[dir] || !f->mults[dir])
-        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                              "face %d: %s needs >= %d poles and >= 2 knots (got %d, %d)",
                              (int)fi, d, (int)p + 1, (int)n, (int)nk);
     int64_t sum = 0;
@@ -180,36 +168,36 @@ static ccn_status check_direction(const ccn__cad_surface *f, int32_t fi, int dir
         double t = f->knots[dir][k];
         int32_t mu = f->mults[dir][k];
         if (!isfinite(t) || (k && !(t > f->knots[dir][k - 1])))
-            return ccn__cad_fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
+            return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
                                  "face %d: %s knot %d (%g) is not finite and increasing",
                                  (int)fi, d, (int)k, t);
         int32_t maxm = k == 0 || k == nk - 1 ? p + 1 : p;
         if (mu < 1 || mu > maxm)
-            return ccn__cad_fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
+            return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
                                  "face %d: %s knot %d has multiplicity %d (allowed 1..%d)",
                                  (int)fi, d, (int)k, (int)mu, (int)maxm);
         sum += mu;
     }
     if (sum != (int64_t)n + p + 1)
-        return ccn__cad_fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
+        return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
                              "face %d: %s multiplicities sum to %lld, expected %d poles + %d + 1",
                              (int)fi, d, (long long)sum, (int)n, (int)p);
     double lo, hi;
     ccn__cad_domain(f, dir, &lo, &hi);
     if (!(hi > lo))
-        return ccn__cad_fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
+        return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
                              "face %d: empty %s domain [%g, %g]", (int)fi, d, lo, hi);
     if (f->periodic[dir]) { /* intervals repeat with the period; last p rows = first p */
         for (int32_t i = 0; i + 1 < 2 * p; i++) {
             double a = flat_knot(f, dir, i + 1) - flat_knot(f, dir, i);
             double b = flat_knot(f, dir, i + n - p + 1) - flat_knot(f, dir, i + n - p);
             if (fabs(a - b) > 1e-12 * (hi - lo))
-                return ccn__cad_fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
+                return ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_FACE, fi,
                                      "face %d: %s is marked periodic but its knot intervals "
                                      "do not repeat", (int)fi, d);
         }
         if (n < 2 * p)
-            return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                                  "face %d: periodic %s needs >= %d poles", (int)fi, d, (int)(2 * p));
     }
     return CCN_OK;
@@ -267,14 +255,14 @@ static ccn_status check_faces(const ccn__cad_model *m, ccn__cad_topo *t, ccn_err
             if (st) return st;
         }
         if (!f->poles)
-            return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi, "face %d: poles is NULL", (int)fi);
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi, "face %d: poles is NULL", (int)fi);
         if ((int64_t)f->num_poles[0] * f->num_poles[1] > INT32_MAX / 3)
-            return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_FACE, fi, "face %d: too many poles", (int)fi);
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_FACE, fi, "face %d: too many poles", (int)fi);
         size_t np = (size_t)f->num_poles[0] * (size_t)f->num_poles[1];
         for (size_t i = 0; i < 3 * np; i++) {
             double x = f->poles[i];
             if (!isfinite(x) || fabs(x) > 1e300)
-                return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
+                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                                      "face %d: pole %zu has a non-finite or huge coordinate",
                                      (int)fi, i / 3);
             lo[i % 3] = x < lo[i % 3] ? x : lo[i % 3];
@@ -295,7 +283,7 @@ static ccn_status check_faces(const ccn__cad_model *m, ccn__cad_topo *t, ccn_err
                     size_t a = dir == 0 ? (size_t)i * nv + j : (size_t)j * nv + i;
                     size_t b = dir == 0 ? (size_t)(i + n - p) * nv + j : (size_t)j * nv + i + n - p;
                     if (dist3(f->poles + 3 * a, f->poles + 3 * b) > t->tolerance)
-                        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
+                        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                                              "face %d: %s is marked periodic but pole row %d "
                                              "differs from row %d", (int)fi, dir ? "v" : "u",
                                              (int)(i + n - p), (int)i);
@@ -311,14 +299,14 @@ static ccn_status build_segments(const ccn__cad_model *m, ccn__cad_topo *t, ccn_
     int32_t nf = m->num_faces;
     const int32_t *bs = m->side_breaks_start;
     if ((bs == NULL) != (m->side_breaks == NULL))
-        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                              "side_breaks_start and side_breaks must both be given or both NULL");
     int64_t nb = bs ? bs[4 * nf] : 0;
     if (bs && bs[0] != 0)
-        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "side_breaks_start[0] must be 0");
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "side_breaks_start[0] must be 0");
     for (int32_t a = 0; bs && a < 4 * nf; a++)
         if (bs[a + 1] < bs[a] || bs[a + 1] > INT32_MAX / 4 - 4 * (int64_t)nf)
-            return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, a / 4,
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, a / 4,
                                  "face %d side %d: side_breaks_start decreases or is too large",
                                  (int)(a / 4), (int)(a % 4));
     t->num_segs = (int32_t)(4 * (int64_t)nf + nb);
@@ -329,7 +317,7 @@ static ccn_status build_segments(const ccn__cad_model *m, ccn__cad_topo *t, ccn_
     t->seg_lo = malloc(sizeof(double) * ns);
     t->seg_hi = malloc(sizeof(double) * ns);
     if (!t->face_seg || !t->seg_face || !t->seg_side || !t->seg_lo || !t->seg_hi)
-        return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     int32_t j = 0;
     for (int32_t f = 0; f < nf; f++) {
         t->face_seg[f] = j;
@@ -343,7 +331,7 @@ static ccn_status build_segments(const ccn__cad_model *m, ccn__cad_topo *t, ccn_
                 double next = k < k1 ? m->side_breaks[k] : (s < 2 ? hi : lo);
                 int inside = s < 2 ? next > prev && next <= hi : next < prev && next >= lo;
                 if (!isfinite(next) || !inside || (k < k1 && (next == lo || next == hi)))
-                    return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, f,
+                    return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, f,
                                          "face %d side %d: break %g is not strictly inside the side "
                                          "and after the previous one", (int)f, s, next);
                 t->seg_face[j] = f;
@@ -364,7 +352,7 @@ static ccn_status check_adjacency(const ccn__cad_model *m, const ccn__cad_topo *
         int32_t b = m->adjacency[a], fa = t->seg_face[a], sa = t->seg_side[a];
         if (b < 0) continue;
         if (b >= t->num_segs || b == a || m->adjacency[b] != a)
-            return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
+            return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
                                  "face %d side %d: adjacency %d of segment %d is out of range, "
                                  "itself or not mutual", (int)fa, sa, (int)b, (int)a);
         if (b < a) continue;
@@ -375,7 +363,7 @@ static ccn_status check_adjacency(const ccn__cad_model *m, const ccn__cad_topo *
             seg_point(m, t, b, 1 - w[k], pb);
             double d = dist3(pa, pb);
             if (!(d <= t->tolerance))
-                return ccn__cad_fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
+                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
                                      "face %d side %d and face %d side %d are not the same "
                                      "curve run in opposite directions (%.3g apart at %g)",
                                      (int)fa, sa, (int)t->seg_face[b], (int)t->seg_side[b], d, w[k]);
@@ -394,15 +382,15 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
     memset(t, 0, sizeof *t);
     if (err) { err->status = CCN_OK; err->element_kind = CCN_ELEM_NONE; err->element = -1; err->message[0] = 0; }
     if (!m || m->num_faces < 1 || !m->faces || !m->adjacency)
-        return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                              "the model is NULL or has no faces or no adjacency");
     if (m->num_faces > INT32_MAX / 8)
-        return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "too many faces (%d)", (int)m->num_faces);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "too many faces (%d)", (int)m->num_faces);
     const char *strs[2] = {m->name, m->timestamp};
     for (int k = 0; k < 2; k++)
         for (const char *c = strs[k]; c && *c; c++)
             if (*c < 32 || *c > 126 || *c == '\'' || *c == '\\' || c - strs[k] > 200)
-                return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                                      "the %s must be printable ASCII (at most 200 characters) "
                                      "without quotes or backslashes", k ? "timestamp" : "name");
     ccn_status st = check_faces(m, t, err);
@@ -421,7 +409,7 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
         !t->vert_pos || !parent) {
         free(parent);
         ccn__cad_topo_free(t);
-        return ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     }
     /* vertices: segment starts joined through shared segments (start of a ~ end of b) */
     for (size_t i = 0; i < ns; i++) parent[i] = (int32_t)i;

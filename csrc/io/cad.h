@@ -146,12 +146,4 @@ int ccn__cad_flush(ccn__cad_out *o);
  * ("1.", "-2.5E-07"): valid as a STEP and an IGES real. buf: at least 32 chars. */
 const char *ccn__cad_real(double x, char *buf);
 
-/* Error helper of this module (fills err as the library's other entries do). */
-ccn_status ccn__cad_fail(ccn_error *err, ccn_status st, int32_t kind, int32_t element,
-                         const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 5, 6)))
-#endif
-    ;
-
 #endif

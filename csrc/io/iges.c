@@ -15,7 +15,9 @@
  * is the only root a reader transfers. The parameter section is built in memory first (the
  * directory needs each entity's first parameter line and line count).
  */
-#include "cad.h"
+#include "io/cad.h"
+
+#include "base/error.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -242,7 +244,7 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
 
 ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
                            ccn_error *err) {
-    if (!fn) return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "write callback is NULL");
+    if (!fn) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "write callback is NULL");
     ccn__cad_topo t;
     ccn_status st = ccn__cad_topo_build(m, &t, err);
     if (st) return st;
@@ -262,7 +264,7 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     iges_pd *p = calloc(1, sizeof *p);
     ccn__cad_out *o = malloc(sizeof *o);
     if (!de || !pts || !p || !o || build_pd(m, &t, p, de, &c) != CCN_OK) {
-        st = ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }
     if (!t.closed) nde--; /* no solid */
@@ -292,7 +294,7 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     ccn__cad_write(o, p->buf, p->len);
     ccn__cad_printf(o, "S%7dG%7dD%7dP%7d%40sT%7d\n", (int)ns, (int)ng, (int)(2 * nde), (int)p->nlines, "", 1);
     if (ccn__cad_flush(o))
-        st = ccn__cad_fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the IGES file failed");
+        st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the IGES file failed");
 done:
     if (p) free(p->buf);
     free(p); free(de); free(pts); free(o);

@@ -16,7 +16,9 @@
  * Edges carry no pcurves: the faces are untrimmed and every edge is an iso line of each face
  * it bounds, which readers recover exactly.
  */
-#include "cad.h"
+#include "io/cad.h"
+
+#include "base/error.h"
 
 #include <stdlib.h>
 
@@ -196,7 +198,7 @@ static void trailer(step_w *w, const char *name, int closed, int32_t item, doubl
 
 ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
                            ccn_error *err) {
-    if (!fn) return ccn__cad_fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "write callback is NULL");
+    if (!fn) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "write callback is NULL");
     ccn__cad_topo t;
     ccn_status st = ccn__cad_topo_build(m, &t, err);
     if (st) return st;
@@ -211,7 +213,7 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     double *scratch = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
     step_w *w = malloc(sizeof *w);
     if (!vert_id || !edge_id || !face_id || !scratch || !w) {
-        st = ccn__cad_fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }
     ccn__cad_out_init(&w->o, fn, user);
@@ -236,7 +238,7 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     else ccn__cad_printf(&w->o, "SHELL_BASED_SURFACE_MODEL('%s',(#%d));\n", name, (int)shell);
     trailer(w, name, t.closed, item, t.tolerance);
     if (ccn__cad_flush(&w->o))
-        st = ccn__cad_fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
+        st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
 done:
     free(vert_id); free(edge_id); free(face_id); free(scratch); free(w);
     ccn__cad_topo_free(&t);

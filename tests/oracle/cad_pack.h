@@ -6,9 +6,9 @@
 #ifndef CAD_PACK_H
 #define CAD_PACK_H
 
-#include "internal.h"
-#include "limit.h"
-#include "patches.h"
+#include "surface/limit.h"
+#include "surface/patches.h"
+#include "topology/halfedge.h"
 
 #include <stdlib.h>
 #include <string.h>
