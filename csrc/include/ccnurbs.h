@@ -175,6 +175,85 @@ ccn_status ccn_obj_cage(const ccn_obj *obj, ccn_cage *cage);
 
 const char *ccn_status_name(ccn_status s);
 
+/* ---- CAD export: the exact surface as STEP or IGES ---------------------------------- */
+
+typedef enum { CCN_EXPORT_STEP = 0, CCN_EXPORT_IGES = 1 } ccn_export_format;
+/* ccn_export_options.flags: no packing (every regular cage quad and every patch its own face) */
+#define CCN_EXPORT_UNPACKED 1u
+
+typedef enum {
+    CCN_EXPORT_FACE_PACK = 0, /* bicubic B-spline of a rectangle of regular faces, knots = the
+                                 ring intervals (periodic where the rectangle closes) */
+    CCN_EXPORT_FACE_BICUBIC,  /* one bicubic patch of the plan (faces around extraordinary points) */
+    CCN_EXPORT_FACE_BI5,      /* a degree-5 ring or cap patch of a guided bi-5 cap */
+    CCN_EXPORT_FACE_REFINED,  /* exact bicubic pieces of a hole refined below the plan's level */
+    CCN_EXPORT_FACE_FILL      /* the approximate faces that close a hole (counted fallbacks) */
+} ccn_export_face_kind;
+
+/* Where part of an exported face lies: its parameters [uv[0],uv[1]] x [uv[2],uv[3]] map
+ * affinely onto cage face cage_face (sub = -1: a quad, local (s,t) in [0,1]^2 with corner 0 at
+ * (0,0) and its first half-edge along s) or onto the level-1 quad at corner `sub` of a cage
+ * face with n != 4 sides (corner 0 = the cage vertex, 1 = midpoint of the edge of that corner's
+ * half-edge, 2 = the face point, 3 = midpoint of the previous edge). st[0], st[1], st[2] are the
+ * local coordinates at (u0,v0), (u1,v0) and (u0,v1). */
+typedef struct {
+    int32_t cage_face, sub;
+    double uv[4];
+    double st[3][2];
+} ccn_export_cell;
+
+typedef struct {
+    int32_t index;   /* face number in the file's shell order, from 0 */
+    int32_t kind;    /* ccn_export_face_kind */
+    int32_t patch;   /* index in ccn_plan_patches' output, -1 if the face is none of them */
+    int32_t num_cells;
+    const ccn_export_cell *cells; /* valid during the call */
+} ccn_export_face;
+typedef void (*ccn_export_face_fn)(void *user, const ccn_export_face *face);
+/* Output sink: returns 0 on success, non-zero to stop (the export returns CCN_ERR_IO). */
+typedef int (*ccn_write_fn)(void *user, const char *data, size_t len);
+/* Progress in [0, 1]. */
+typedef void (*ccn_progress_fn)(void *user, double fraction);
+
+typedef struct {
+    int32_t format;          /* ccn_export_format */
+    uint32_t flags;          /* CCN_EXPORT_UNPACKED */
+    const char *name;        /* product name: printable ASCII without quotes, NULL = "ccnurbs" */
+    const char *timestamp;   /* "YYYY-MM-DDThh:mm:ss", NULL = fixed (byte-identical output) */
+    double tolerance;        /* model units (mm); <= 0: max(1e-7, 1e-10 x size) */
+    int32_t fill_levels;     /* levels refined below the patch level around holes, 1..12;
+                                0 = default (6) */
+    ccn_export_face_fn face_fn; /* optional: called once per face, in file order */
+    void *face_user;
+    ccn_progress_fn progress;   /* optional */
+    void *progress_user;
+} ccn_export_options;
+
+typedef struct {
+    int32_t num_faces;
+    int32_t num_packs, num_bicubic, num_bi5, num_refined, num_fill_faces; /* by kind */
+    int32_t num_packed_cage_faces; /* cage quads inside level-0 packs */
+    int32_t num_fills;       /* holes closed by fill faces: irregular vertices without cap */
+    int32_t fill_level;      /* mesh level of the fill faces (-1: none) */
+    int32_t num_edges, num_vertices, num_shells, num_boundary_edges;
+    int32_t closed;          /* every edge shared by two face sides: a closed shell (solid) */
+    double max_g1_deviation;      /* rad: largest normal angle across shared edges, fills excluded */
+    double max_fill_g1_deviation; /* rad: the same across edges of fill faces (0 without fills) */
+    double size;             /* bounding-box diagonal of the poles */
+    int64_t bytes;           /* written */
+} ccn_export_info;
+
+/* Evaluates the plan at positions (3 * num_cage_verts, NULL = the cage's own, as
+ * ccn_plan_evaluate) and writes its finite surface as STEP AP214 or IGES 5.3 through fn: one
+ * B-spline face per maximal rectangle of regular cage quads (ring intervals as knots), the
+ * plan's bicubic patches and bi-5 rings and caps around extraordinary points, and where the
+ * plan has no patch (cap fallbacks, smooth boundary corners, boundary EVs) the exact pieces
+ * of a deeper local refinement closed by fill faces, whose G1 deviation is measured. Faces
+ * share their edges (one shell; closed cages: a solid). opts NULL = defaults; info may be
+ * NULL. Nothing is written if the status is not CCN_OK before output starts. */
+ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_export_options *opts,
+                           ccn_write_fn fn, void *user, ccn_export_info *info, ccn_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -120,6 +120,55 @@ void ccn__cad_eval(const ccn__cad_surface *f, double u, double v, double out[3])
         }
 }
 
+/* basis() with first derivatives dN (Piegl & Tiller A2.3, first order). */
+static int32_t basis_d(const ccn__cad_surface *f, int dir, double t, double *N, double *dN) {
+    int32_t p = f->degree[dir], n = f->num_poles[dir], span = p;
+    while (span + 1 < n && flat_knot(f, dir, span + 1) <= t) span++;
+    double left[CCN_CAD_MAX_DEGREE + 1], right[CCN_CAD_MAX_DEGREE + 1];
+    double ndu[CCN_CAD_MAX_DEGREE + 1][CCN_CAD_MAX_DEGREE + 1]; /* ndu[j][r]: basis, ndu[r][j]: knot differences */
+    ndu[0][0] = 1;
+    for (int32_t j = 1; j <= p; j++) {
+        left[j] = t - flat_knot(f, dir, span + 1 - j);
+        right[j] = flat_knot(f, dir, span + j) - t;
+        double saved = 0;
+        for (int32_t r = 0; r < j; r++) {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            double tmp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * tmp;
+            saved = left[j - r] * tmp;
+        }
+        ndu[j][j] = saved;
+    }
+    for (int32_t r = 0; r <= p; r++) {
+        N[r] = ndu[r][p];
+        double d = 0;
+        if (p >= 1) {
+            if (r >= 1) d += ndu[r - 1][p - 1] / ndu[p][r - 1];
+            if (r <= p - 1) d -= ndu[r][p - 1] / ndu[p][r];
+            d *= p;
+        }
+        dN[r] = d;
+    }
+    return span;
+}
+
+void ccn__cad_eval_d(const ccn__cad_surface *f, double u, double v, double pos[3], double du[3],
+                     double dv[3]) {
+    double Nu[CCN_CAD_MAX_DEGREE + 1], Nv[CCN_CAD_MAX_DEGREE + 1];
+    double Du[CCN_CAD_MAX_DEGREE + 1], Dv[CCN_CAD_MAX_DEGREE + 1];
+    int32_t su = basis_d(f, 0, u, Nu, Du), sv = basis_d(f, 1, v, Nv, Dv), nv = f->num_poles[1];
+    for (int k = 0; k < 3; k++) pos[k] = du[k] = dv[k] = 0;
+    for (int32_t a = 0; a <= f->degree[0]; a++)
+        for (int32_t b = 0; b <= f->degree[1]; b++) {
+            const double *P = f->poles + 3 * ((size_t)(su - f->degree[0] + a) * nv + sv - f->degree[1] + b);
+            for (int k = 0; k < 3; k++) {
+                pos[k] += Nu[a] * Nv[b] * P[k];
+                du[k] += Du[a] * Nv[b] * P[k];
+                dv[k] += Nu[a] * Dv[b] * P[k];
+            }
+        }
+}
+
 void ccn__cad_side_curve(const ccn__cad_surface *f, int s, double *out) {
     int dir = s % 2 == 0 ? 0 : 1, other = 1 - dir; /* the curve runs along dir */
     int at_hi = s == 1 || s == 2;                   /* side 1: u = u1, side 2: v = v1 */

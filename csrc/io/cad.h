@@ -123,6 +123,10 @@ void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int
 void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi);
 /* Surface point at (u, v) by de Boor (u, v inside the domain). */
 void ccn__cad_eval(const ccn__cad_surface *f, double u, double v, double out[3]);
+/* Point and first derivatives at (u, v) (u, v inside the domain; at an inner knot the span
+ * above it, at the domain's upper end the last span). */
+void ccn__cad_eval_d(const ccn__cad_surface *f, double u, double v, double pos[3], double du[3],
+                     double dv[3]);
 
 /* Buffered output through a ccn__cad_write_fn; the first failure sticks. */
 typedef struct {

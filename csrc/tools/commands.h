@@ -7,5 +7,6 @@ int ccn_cmd_refine(int argc, char **argv);     /* cmd_refine.c */
 int ccn_cmd_matrix(int argc, char **argv);     /* cmd_matrix.c */
 int ccn_cmd_limit(int argc, char **argv);      /* cmd_limit.c */
 int ccn_cmd_patches(int argc, char **argv);    /* cmd_patches.c */
+int ccn_cmd_export(int argc, char **argv);     /* cmd_export.c */
 int ccn_cmd_experiment(int argc, char **argv); /* cmd_experiment.c */
 #endif

@@ -22,6 +22,7 @@ static const command commands[] = {
     {"matrix", ccn_cmd_matrix},
     {"limit", ccn_cmd_limit},
     {"patches", ccn_cmd_patches},
+    {"export", ccn_cmd_export},
     {"experiment", ccn_cmd_experiment},
 };
 
@@ -31,6 +32,8 @@ static int usage(void) {
             "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] in.obj out.obj\n"
             "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] in.obj out.obj\n"
             "  ccnurbs patches [--scheme ...] [--corners ...] in.obj out.bv\n"
+            "  ccnurbs export --format step|iges [--unpacked] [--fill-levels N] [--name NAME] [--face-map F]\n"
+            "                 [--scheme ...] [--cap bi5|refine] [--corners ...] in.obj out.step\n"
             "  ccnurbs matrix --valence N [--knots d0,d1,...] [--scheme eigen|nurss|cc]\n"
             "  ccnurbs experiment maxima|charmap --cases N --seed S [...] (experiment --help)\n");
     return 2;

@@ -1,0 +1,12 @@
+/* Topology of the CAD export's faces from their places on the cage (internal;
+ * io/export_topo.c). */
+#ifndef CCN_IO_EXPORT_TOPO_H
+#define CCN_IO_EXPORT_TOPO_H
+
+#include "io/export_model.h"
+
+/* Side breaks and adjacency of the faces (cad.h's model) from their places on the cage. */
+ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t **breaks_start,
+                            double **breaks, int32_t **adjacency, ccn_error *err);
+
+#endif
