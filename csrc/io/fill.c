@@ -21,10 +21,13 @@
  *     continuations, as 2-span curves (the two faces along each far side join C2 with equal
  *     intervals): the fill joins them exactly C1 (position and derivative);
  *   - spokes (c[i][0], c[0][j]), shared bit-identically by the two sectors: c00 = the exact
- *     limit point of w, c20 = 2 c30 - c40, c10 = 2 c20 - c30 projected into w's limit tangent
- *     plane; a boundary spoke is the exact boundary curve (cubic B-spline of the boundary
- *     polygon);
- *   - the inner poles: linear continuations of the outer layers (c2j = 2 c3j - c4j, ...).
+ *     limit point of w, c20 = 2 c30 - c40, c10 in w's limit tangent plane (five candidates:
+ *     2 c20 - c30 or P + b (c20 - P), b = 0.3 .. 0.9, projected; the one whose fills deviate
+ *     least across the spokes is kept); a boundary spoke is the exact boundary curve (cubic
+ *     B-spline of the boundary polygon);
+ *   - the inner poles: linear continuations of the outer layers (c2j = 2 c3j - c4j, ...), then
+ *     along every inner spoke the cross-derivative poles of both sectors are moved into planes
+ *     whose normals run from w's limit normal to the exact normal at the spoke's far end.
  * So the fill is C1 across its far sides and G1 at w; across the spokes it is G1 only
  * approximately, a deviation the export measures and reports (it shrinks with the levels).
  */
@@ -254,6 +257,110 @@ static void side_poles(const double P[4][4][3], const double Q[4][4][3], int alo
     two_span((const double(*)[3])a, out);
 }
 
+static void unit3(double *a) {
+    double l = sqrt(dot3(a, a));
+    if (l > 0) for (int d = 0; d < 3; d++) a[d] /= l;
+}
+static void cross(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* x moved least so that (x - p).n = 0 (n unit). */
+static void onto_plane(double *x, const double *p, const double *n) {
+    double t = (x[0] - p[0]) * n[0] + (x[1] - p[1]) * n[1] + (x[2] - p[2]) * n[2];
+    for (int d = 0; d < 3; d++) x[d] -= t * n[d];
+}
+/* x moved least so that (x - p).n1 = 0 and (x - q).n2 = 0 (n1, n2 unit; nearly parallel: their
+ * mean alone). */
+static void onto_two(double *x, const double *p, const double *n1, const double *q, const double *n2) {
+    double a = dot3(n1, n2), r1 = 0, r2 = 0, det = 1 - a * a;
+    for (int d = 0; d < 3; d++) { r1 += (x[d] - p[d]) * n1[d]; r2 += (x[d] - q[d]) * n2[d]; }
+    if (det < 1e-6) {
+        double n[3] = {n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2]}, m[3];
+        unit3(n);
+        for (int d = 0; d < 3; d++) m[d] = 0.5 * (p[d] + q[d]);
+        onto_plane(x, m, n);
+        return;
+    }
+    double al = (r1 - a * r2) / det, be = (r2 - a * r1) / det;
+    for (int d = 0; d < 3; d++) x[d] -= al * n1[d] + be * n2[d];
+}
+
+/* Approximate G1 across the fills' spokes: along spoke k the normal is interpolated between
+ * w's limit normal N and the exact normal at the spoke's far end (Greville abscissae 1/6, 1/2
+ * of poles 1, 2), and both sectors' cross-derivative poles there are moved into that plane:
+ * c_k[2][1], c_{k-1}[1][2] by one constraint, the twists c_k[1][1] by the constraints of both
+ * of their spokes. Boundary spokes keep their exact boundary curve and constrain nothing. */
+static void spoke_planes(const ccn_mesh *m, int32_t w, double (*nb)[6][4][4][3], double (*cs)[5][5][3],
+                         int32_t nfan, int32_t nsp, int bnd, double N[3]) {
+    (void)m; (void)w;
+    double ring[3] = {0, 0, 0};
+    for (int32_t k = 0; k < nfan; k++) { /* orient N like the sectors */
+        double a[3], b[3], c[3];
+        for (int d = 0; d < 3; d++) { a[d] = cs[k][4][0][d] - cs[k][0][0][d]; b[d] = cs[k][0][4][d] - cs[k][0][0][d]; }
+        cross(a, b, c);
+        for (int d = 0; d < 3; d++) ring[d] += c[d];
+    }
+    if (dot3(ring, N) < 0) for (int d = 0; d < 3; d++) N[d] = -N[d];
+    double (*np)[2][3] = malloc(sizeof *np * (size_t)(nsp + 1)); /* per spoke: normals at poles 1, 2 */
+    if (!np) return; /* the fill stays as built (a larger deviation, still reported) */
+    for (int32_t k = 0; k < nsp; k++) {
+        double du[3], dv[3], n4[3];
+        if (k < nfan) { /* sector k's N1 at its corner (2h,0): exact */
+            const double (*c)[4][3] = (const double(*)[4][3])nb[k][0];
+            for (int d = 0; d < 3; d++) { du[d] = c[1][0][d] - c[0][0][d]; dv[d] = c[0][1][d] - c[0][0][d]; }
+        } else {
+            const double (*c)[4][3] = (const double(*)[4][3])nb[k - 1][2];
+            for (int d = 0; d < 3; d++) { du[d] = c[1][0][d] - c[0][0][d]; dv[d] = c[0][1][d] - c[0][0][d]; }
+        }
+        cross(du, dv, n4);
+        unit3(n4);
+        static const double g[2] = {1.0 / 6.0, 0.5};
+        for (int i = 0; i < 2; i++) {
+            for (int d = 0; d < 3; d++) np[k][i][d] = (1 - g[i]) * N[d] + g[i] * n4[d];
+            unit3(np[k][i]);
+        }
+    }
+    for (int32_t k = 0; k < nfan; k++) {
+        int32_t k1 = (k + 1) % nsp;
+        int inner0 = !bnd || k > 0, inner1 = !bnd || k1 < nsp - 1; /* spokes k, k+1 inner? */
+        double (*c)[5][3] = cs[k];
+        if (inner0) onto_plane(c[2][1], c[2][0], np[k][1]);
+        if (inner1) onto_plane(c[1][2], c[0][2], np[k1][1]);
+        if (inner0 && inner1) onto_two(c[1][1], c[1][0], np[k][0], c[0][1], np[k1][0]);
+        else if (inner0) onto_plane(c[1][1], c[1][0], np[k][0]);
+        else if (inner1) onto_plane(c[1][1], c[0][1], np[k1][0]);
+    }
+    free(np);
+}
+
+/* Largest normal angle across the inner spokes of the fills cs (8 points per spoke). */
+static double spoke_deviation(double (*cs)[5][5][3], int32_t nfan, int32_t nsp, int bnd) {
+    static const double kn[3] = {0, 1, 2};
+    static const int32_t mu[3] = {4, 1, 4};
+    double worst = 0;
+    for (int32_t k = 0; k < nsp; k++) {
+        if (bnd && (k == 0 || k == nsp - 1)) continue;
+        int32_t a = k % nfan, b = (k + nfan - 1) % nfan; /* spoke k: u-axis of a, v-axis of b */
+        ccn__cad_surface A = {{3, 3}, {5, 5}, {3, 3}, {kn, kn}, {mu, mu}, &cs[a][0][0][0], {0, 0}};
+        ccn__cad_surface B = A;
+        B.poles = &cs[b][0][0][0];
+        for (int i = 0; i < 8; i++) {
+            double t = 2.0 * (i + 0.5) / 8, p[3], du[3], dv[3], na[3], nb[3], c[3];
+            ccn__cad_eval_d(&A, t, 0, p, du, dv);
+            cross(du, dv, na);
+            ccn__cad_eval_d(&B, 0, t, p, du, dv);
+            cross(du, dv, nb);
+            cross(na, nb, c);
+            double ang = atan2(sqrt(dot3(c, c)), dot3(na, nb));
+            if (!(ang <= worst)) worst = ang;
+        }
+    }
+    return worst;
+}
+
 /* Fill faces around irregular vertex w of m (the last level): per fan face (sector) one
  * bicubic B-spline face with 2 x 2 spans over the sector's 2x2 faces, which it replaces. */
 static ccn_status fill_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *m,
@@ -267,6 +374,7 @@ static ccn_status fill_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const cc
     double (*sp)[5][3] = malloc(sizeof *sp * (size_t)(nsp + 1)); /* spoke curves from w */
     double (*nb)[6][4][4][3] = malloc(sizeof *nb * (size_t)(nfan ? nfan : 1)); /* N1 N2 M1 M2 A B */
     block *bk = malloc(sizeof *bk * (size_t)(nfan ? nfan : 1));
+    double (*cs)[5][5][3] = NULL; /* the fills' poles, per sector */
     if (!sp || !nb || !bk) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
     for (int32_t k = 0; k < nfan; k++) {
         sector_block(m, m->vfan[m->vfan_start[w] + k], &bk[k]);
@@ -279,77 +387,96 @@ static ccn_status fill_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const cc
             goto done;
         }
     }
-    for (int32_t k = 0; k < nsp; k++) { /* spoke k: sector k's u-axis, sector k-1's v-axis */
-        double (*c)[3] = sp[k], L[5][3], S[5][3];
-        if (k < nfan) { /* from sector k's cells N1 (and N2) across u = 2 */
-            side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 0, S);
-            side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 1, L);
-        } else { /* a boundary vertex's last spoke: sector k-1's cells M1, M2 across v = 2 */
-            side_poles((const double(*)[4][3])nb[k - 1][2], (const double(*)[4][3])nb[k - 1][3], 1, 0, S);
-            side_poles((const double(*)[4][3])nb[k - 1][2], (const double(*)[4][3])nb[k - 1][3], 1, 1, L);
-        }
-        memcpy(c[4], S[0], sizeof c[4]);
-        memcpy(c[3], L[0], sizeof c[3]);
-        memcpy(c[0], P, sizeof P);
-        if (bnd && (k == 0 || k == nsp - 1)) { /* the boundary curve: exact */
-            /* second span = the boundary row of cell A (sector 0) / column of cell B (last) */
-            const double (*E)[4][3] = (const double(*)[4][3])(k == 0 ? nb[0][4] : nb[nfan - 1][5]);
-            double e2[4][3];
-            for (int q = 0; q < 4; q++) memcpy(e2[q], k == 0 ? E[q][0] : E[0][q], sizeof e2[q]);
-            int32_t e = ccn__fan_edge(m, w, k), eo = ccn__fan_edge(m, w, k == 0 ? nsp - 1 : 0);
-            int32_t end = fan_end(m, w, k);
-            double D0 = m->eknot[e], Dm = m->eknot[eo], b1[3], b2[3];
-            double al = Dm / (Dm + 2 * D0), ga = (Dm + D0) / (Dm + 2 * D0); /* D_1 = D_0 */
-            for (int d = 0; d < 3; d++) {
-                b1[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d];
-                b2[d] = (1 - ga) * m->pos[3 * (size_t)w + d] + ga * m->pos[3 * (size_t)end + d];
-                c[1][d] = b1[d];
-                c[2][d] = 0.5 * ((2 * b2[d] - b1[d]) + (2 * e2[1][d] - e2[2][d]));
-                c[3][d] = e2[2][d];
-                c[4][d] = e2[3][d];
+    cs = malloc(sizeof *cs * 2 * (size_t)(nfan ? nfan : 1));
+    if (!cs) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
+    /* the spokes' inner poles (c10 = P + b (c20 - P) or 2 c20 - c30, in the tangent plane):
+     * the candidate with the smallest measured normal deviation across the spokes */
+    static const double BETA[5] = {-1, 0.3, 0.5, 0.7, 0.9};
+    double best = INFINITY, (*cbest)[5][5][3] = cs + nfan;
+    for (int cand = 0; cand < 5; cand++) {
+        double beta = BETA[cand];
+        for (int32_t k = 0; k < nsp; k++) { /* spoke k: sector k's u-axis, sector k-1's v-axis */
+            double (*c)[3] = sp[k], L[5][3], S[5][3];
+            if (k < nfan) { /* from sector k's cells N1 (and N2) across u = 2 */
+                side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 0, S);
+                side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 1, L);
+            } else { /* a boundary vertex's last spoke: sector k-1's cells M1, M2 across v = 2 */
+                side_poles((const double(*)[4][3])nb[k - 1][2], (const double(*)[4][3])nb[k - 1][3], 1, 0, S);
+                side_poles((const double(*)[4][3])nb[k - 1][2], (const double(*)[4][3])nb[k - 1][3], 1, 1, L);
             }
-        } else {
-            double X[3];
-            for (int d = 0; d < 3; d++) c[2][d] = 2 * c[3][d] - c[4][d];
-            for (int d = 0; d < 3; d++) X[d] = 2 * c[2][d] - c[3][d] - P[d];
-            double t = dot3(X, N);
-            for (int d = 0; d < 3; d++) c[1][d] = P[d] + X[d] - t * N[d];
+            memcpy(c[4], S[0], sizeof c[4]);
+            memcpy(c[3], L[0], sizeof c[3]);
+            memcpy(c[0], P, sizeof P);
+            if (bnd && (k == 0 || k == nsp - 1)) { /* the boundary curve: exact */
+                /* second span = the boundary row of cell A (sector 0) / column of cell B (last) */
+                const double (*E)[4][3] = (const double(*)[4][3])(k == 0 ? nb[0][4] : nb[nfan - 1][5]);
+                double e2[4][3];
+                for (int q = 0; q < 4; q++) memcpy(e2[q], k == 0 ? E[q][0] : E[0][q], sizeof e2[q]);
+                int32_t e = ccn__fan_edge(m, w, k), eo = ccn__fan_edge(m, w, k == 0 ? nsp - 1 : 0);
+                int32_t end = fan_end(m, w, k);
+                double D0 = m->eknot[e], Dm = m->eknot[eo], b1[3], b2[3];
+                double al = Dm / (Dm + 2 * D0), ga = (Dm + D0) / (Dm + 2 * D0); /* D_1 = D_0 */
+                for (int d = 0; d < 3; d++) {
+                    b1[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d];
+                    b2[d] = (1 - ga) * m->pos[3 * (size_t)w + d] + ga * m->pos[3 * (size_t)end + d];
+                    c[1][d] = b1[d];
+                    c[2][d] = 0.5 * ((2 * b2[d] - b1[d]) + (2 * e2[1][d] - e2[2][d]));
+                    c[3][d] = e2[2][d];
+                    c[4][d] = e2[3][d];
+                }
+            } else {
+                double X[3];
+                for (int d = 0; d < 3; d++) c[2][d] = 2 * c[3][d] - c[4][d];
+                for (int d = 0; d < 3; d++) X[d] = beta < 0 ? 2 * c[2][d] - c[3][d] - P[d] : beta * (c[2][d] - P[d]);
+                double t = dot3(X, N);
+                for (int d = 0; d < 3; d++) c[1][d] = P[d] + X[d] - t * N[d];
+            }
+        }
+        for (int32_t k = 0; k < nfan; k++) {
+            double (*c)[5][3] = cs[k], S[5][3], L[5][3];
+            memset(c, 0, sizeof cs[k]);
+            int cnt[5][5];
+            memset(cnt, 0, sizeof cnt);
+            for (int pass = 0; pass < 2; pass++) { /* u-side from N1, N2; v-side from M1, M2 */
+                const double (*a)[4][3] = (const double(*)[4][3])nb[k][pass ? 2 : 0];
+                const double (*b)[4][3] = (const double(*)[4][3])nb[k][pass ? 3 : 1];
+                side_poles(a, b, pass, 0, S);
+                side_poles(a, b, pass, 1, L);
+                for (int q = 0; q < 5; q++)
+                    for (int lay = 0; lay < 2; lay++) {
+                        int i = pass ? q : 4 - lay, j = pass ? 4 - lay : q;
+                        for (int d = 0; d < 3; d++) c[i][j][d] += lay ? L[q][d] : S[q][d];
+                        cnt[i][j]++;
+                    }
+            }
+            for (int i = 0; i < 5; i++) /* the far corner comes from both sides: their mean */
+                for (int j = 0; j < 5; j++)
+                    for (int d = 0; d < 3 && cnt[i][j] > 1; d++) c[i][j][d] /= cnt[i][j];
+            for (int j = 1; j < 3; j++) /* inner layers: linear continuations of the outer two */
+                for (int d = 0; d < 3; d++) {
+                    c[2][j][d] = 2 * c[3][j][d] - c[4][j][d];
+                    c[j][2][d] = 2 * c[j][3][d] - c[j][4][d];
+                }
+            for (int d = 0; d < 3; d++) {
+                c[2][2][d] = 0.5 * ((2 * c[3][2][d] - c[4][2][d]) + (2 * c[2][3][d] - c[2][4][d]));
+                c[1][1][d] = 0.5 * ((2 * c[2][1][d] - c[3][1][d]) + (2 * c[1][2][d] - c[1][3][d]));
+            }
+            for (int q = 0; q < 5; q++) { /* spokes exactly (shared with the next sector) */
+                memcpy(c[q][0], sp[k][q], sizeof c[q][0]);
+                memcpy(c[0][q], sp[(k + 1) % nsp][q], sizeof c[0][q]);
+            }
+        }
+        spoke_planes(m, w, nb, cs, nfan, nsp, bnd, N);
+        double dev = spoke_deviation(cs, nfan, nsp, bnd);
+        if (dev < best || cand == 0) {
+            best = dev;
+            memcpy(cbest, cs, sizeof *cs * (size_t)nfan);
         }
     }
+    memcpy(cs, cbest, sizeof *cs * (size_t)nfan);
     static const double K[9] = {0, 0, 0, 0, 1, 2, 2, 2, 2};
     for (int32_t k = 0; k < nfan && !st; k++) {
-        double c[5][5][3], S[5][3], L[5][3];
-        memset(c, 0, sizeof c);
-        int cnt[5][5];
-        memset(cnt, 0, sizeof cnt);
-        for (int pass = 0; pass < 2; pass++) { /* u-side from N1, N2; v-side from M1, M2 */
-            const double (*a)[4][3] = (const double(*)[4][3])nb[k][pass ? 2 : 0];
-            const double (*b)[4][3] = (const double(*)[4][3])nb[k][pass ? 3 : 1];
-            side_poles(a, b, pass, 0, S);
-            side_poles(a, b, pass, 1, L);
-            for (int q = 0; q < 5; q++)
-                for (int lay = 0; lay < 2; lay++) {
-                    int i = pass ? q : 4 - lay, j = pass ? 4 - lay : q;
-                    for (int d = 0; d < 3; d++) c[i][j][d] += lay ? L[q][d] : S[q][d];
-                    cnt[i][j]++;
-                }
-        }
-        for (int i = 0; i < 5; i++) /* the far corner comes from both sides: their mean */
-            for (int j = 0; j < 5; j++)
-                for (int d = 0; d < 3 && cnt[i][j] > 1; d++) c[i][j][d] /= cnt[i][j];
-        for (int j = 1; j < 3; j++) /* inner layers: linear continuations of the outer two */
-            for (int d = 0; d < 3; d++) {
-                c[2][j][d] = 2 * c[3][j][d] - c[4][j][d];
-                c[j][2][d] = 2 * c[j][3][d] - c[j][4][d];
-            }
-        for (int d = 0; d < 3; d++) {
-            c[2][2][d] = 0.5 * ((2 * c[3][2][d] - c[4][2][d]) + (2 * c[2][3][d] - c[2][4][d]));
-            c[1][1][d] = 0.5 * ((2 * c[2][1][d] - c[3][1][d]) + (2 * c[1][2][d] - c[1][3][d]));
-        }
-        for (int q = 0; q < 5; q++) { /* spokes exactly (shared with the next sector) */
-            memcpy(c[q][0], sp[k][q], sizeof c[q][0]);
-            memcpy(c[0][q], sp[(k + 1) % nsp][q], sizeof c[0][q]);
-        }
+        double (*c)[5][3] = cs[k];
         int32_t g = m->hface[bk[k].g], r = bk[k].g - m->fstart[g];
         ccn__xplace q1, q2;
         ccn__xplace_rotate(&fpl[g], r, &q1); /* the sector's [0,1]^2: its face at w */
@@ -361,7 +488,7 @@ static ccn_status fill_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const cc
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)");
             break;
         }
-        memcpy((void *)xm->faces[f].s.poles, c, sizeof c);
+        memcpy((void *)xm->faces[f].s.poles, c, sizeof cs[k]);
         xm->faces[f].fill = fill_id;
         ccn__xcell *cl = &xm->cells[xm->faces[f].cell0];
         cl->uv[0] = 0; cl->uv[1] = 2; cl->uv[2] = 0; cl->uv[3] = 2;
@@ -373,6 +500,7 @@ done:
     free(sp);
     free(nb);
     free(bk);
+    free(cs);
     return st;
 }
 
