@@ -202,12 +202,19 @@ typedef struct {
     double st[3][2];
 } ccn_export_cell;
 
+/* One exported face: where it lies and its polynomial B-spline surface as written (valid
+ * during the call). Its domain is [t_p, t_n] per direction of the flat knot vector t (n
+ * poles, degree p); periodic: the last p pole rows repeat the first ones (closed). */
 typedef struct {
     int32_t index;   /* face number in the file's shell order, from 0 */
     int32_t kind;    /* ccn_export_face_kind */
     int32_t patch;   /* index in ccn_plan_patches' output, -1 if the face is none of them */
     int32_t num_cells;
-    const ccn_export_cell *cells; /* valid during the call */
+    const ccn_export_cell *cells;
+    int32_t degree[2], num_poles[2], num_knots[2], periodic[2]; /* u, v */
+    const double *knots[2];  /* distinct values, increasing */
+    const int32_t *mults[2]; /* their multiplicities */
+    const double *poles;     /* num_poles[0] x num_poles[1] x 3, first index along u */
 } ccn_export_face;
 typedef void (*ccn_export_face_fn)(void *user, const ccn_export_face *face);
 /* Output sink: returns 0 on success, non-zero to stop (the export returns CCN_ERR_IO). */

@@ -215,7 +215,22 @@ static void face_map(const ccn_export_options *o, const ccn__xmodel *xm) {
             memcpy(cells[i].uv, x->uv, sizeof cells[i].uv);
             memcpy(cells[i].st, x->pl.p, sizeof cells[i].st);
         }
-        ccn_export_face ef = {f, X->kind, X->patch, nc, cells};
+        ccn_export_face ef;
+        memset(&ef, 0, sizeof ef);
+        ef.index = f;
+        ef.kind = X->kind;
+        ef.patch = X->patch;
+        ef.num_cells = nc;
+        ef.cells = cells;
+        for (int d = 0; d < 2; d++) {
+            ef.degree[d] = X->s.degree[d];
+            ef.num_poles[d] = X->s.num_poles[d];
+            ef.num_knots[d] = X->s.num_knots[d];
+            ef.periodic[d] = X->s.periodic[d];
+            ef.knots[d] = X->s.knots[d];
+            ef.mults[d] = X->s.mults[d];
+        }
+        ef.poles = X->s.poles;
         o->face_fn(o->face_user, &ef);
     }
     free(cells);

@@ -1,7 +1,8 @@
 // Independent oracle for the CAD writers (test-only): reads a STEP or IGES file with
 // OpenCASCADE and reports what a CAD system would see, as "key: value" lines on stdout.
 //
-//   occt_read [--no-heal] [--grid N --points FILE] [--samples K] model.step|model.igs
+//   occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]
+//             [--fallback FACES] model.step|model.igs
 //   occt_read --build SURF.txt --grid N --points FILE
 //
 // Report: reader status, counts of solids/shells/faces/wires/edges/vertices, whether
@@ -15,6 +16,11 @@
 // n1.n2) (accurate near 0). With --points, every face is evaluated on an N x N grid of its
 // surface's parameter bounds: lines "face i j u v x y z nx ny nz" (normal of the oriented
 // face), in face order (TopExp_Explorer over the file's shape).
+//
+// --eval REQ --out RES: REQ has lines "face u v" (face index in TopExp order, parameters of
+// its surface); RES gets "face u v x y z nx ny nz" (the oriented normal, 0 0 0 if undefined).
+// --fallback FACES: face indices (whitespace separated) whose edges are reported apart:
+// normal_angle_max covers the edges with no such face, normal_angle_fallback_max the others.
 //
 // --no-heal: no shape healing after the translation (the reader's ShapeFix sequence is
 // replaced by an undefined one), so a wrongly oriented edge use or a gap the writer left
@@ -86,7 +92,8 @@
 #include <vector>
 
 static int usage() {
-    std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE] [--samples K] FILE.step|FILE.igs\n"
+    std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]\n"
+                         "                 [--fallback FACES] FILE.step|FILE.igs\n"
                          "       occt_read --build SURF.txt --grid N --points FILE\n");
     return 2;
 }
@@ -244,10 +251,38 @@ static void write_grid(FILE *out, int fi, const TopoDS_Face &F, int N) {
         }
 }
 
+// --eval: the faces at the requested parameters.
+static bool eval_requests(const TopoDS_Shape &shape, const char *req, const char *res) {
+    TopTools_IndexedMapOfShape fmap;
+    TopExp::MapShapes(shape, TopAbs_FACE, fmap);
+    std::vector<BRepAdaptor_Surface *> ad(fmap.Extent() + 1, nullptr);
+    std::ifstream in(req);
+    FILE *out = std::fopen(res, "w");
+    if (!in || !out) { if (out) std::fclose(out); return false; }
+    int fi;
+    double u, v;
+    bool ok = true;
+    while (in >> fi >> u >> v) {
+        if (fi < 0 || fi >= fmap.Extent()) { ok = false; break; }
+        if (!ad[fi]) ad[fi] = new BRepAdaptor_Surface(TopoDS::Face(fmap(fi + 1)), Standard_False);
+        gp_Pnt P;
+        gp_Dir D(0, 0, 1);
+        bool nd = face_normal(TopoDS::Face(fmap(fi + 1)), *ad[fi], u, v, P, D);
+        std::fprintf(out, "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", fi, u, v, P.X(), P.Y(), P.Z(),
+                     nd ? D.X() : 0.0, nd ? D.Y() : 0.0, nd ? D.Z() : 0.0);
+    }
+    for (auto *a : ad) delete a;
+    return std::fclose(out) == 0 && ok;
+}
+
 // Normal angles across edges used twice (two faces, or a seam of one face).
-static void edge_angles(const TopoDS_Shape &shape, int K) {
+static void edge_angles(const TopoDS_Shape &shape, int K, const std::vector<char> &fallback) {
     TopTools_IndexedDataMapOfShapeListOfShape ef;
     TopExp::MapShapesAndAncestors(shape, TopAbs_EDGE, TopAbs_FACE, ef);
+    TopTools_IndexedMapOfShape fmap;
+    TopExp::MapShapes(shape, TopAbs_FACE, fmap);
+    double fbmax = 0;
+    long fbpairs = 0;
     double amax = 0, asum = 0;
     long count = 0, undefined = 0, pairs = 0;
     int worst = -1;
@@ -270,7 +305,11 @@ static void edge_angles(const TopoDS_Shape &shape, int K) {
         } else {
             continue;
         }
-        pairs++;
+        int ia = fmap.FindIndex(fa) - 1, ib = fmap.FindIndex(fb) - 1;
+        bool fb_edge = (ia >= 0 && ia < (int)fallback.size() && fallback[ia]) ||
+                       (ib >= 0 && ib < (int)fallback.size() && fallback[ib]);
+        if (fb_edge) fbpairs++;
+        else pairs++;
         double f0, l0;
         BRep_Tool::Range(E, f0, l0);
         BRepAdaptor_Surface Sa(fa), Sb(fb);
@@ -289,6 +328,7 @@ static void edge_angles(const TopoDS_Shape &shape, int K) {
             }
             gp_Vec a(Na), b(Nb);
             double ang = std::atan2(a.Crossed(b).Magnitude(), a.Dot(b));
+            if (fb_edge) { fbmax = std::max(fbmax, ang); continue; }
             if (ang > amax) { amax = ang; worst = e; }
             asum += ang;
             count++;
@@ -297,9 +337,10 @@ static void edge_angles(const TopoDS_Shape &shape, int K) {
     std::printf("edge_pairs: %ld\nnormal_samples: %ld\nnormal_undefined: %ld\n", pairs, count, undefined);
     std::printf("normal_angle_max: %.6e\nnormal_angle_mean: %.6e\nnormal_angle_worst_edge: %d\n", amax,
                 count ? asum / count : 0.0, worst);
+    std::printf("fallback_edge_pairs: %ld\nnormal_angle_fallback_max: %.6e\n", fbpairs, fbmax);
 }
 
-static void report(const TopoDS_Shape &shape, int K) {
+static void report(const TopoDS_Shape &shape, int K, const std::vector<char> &fallback) {
     TopTools_IndexedMapOfShape m;
     static const struct { TopAbs_ShapeEnum t; const char *name; } kinds[] = {
         {TopAbs_SOLID, "solids"}, {TopAbs_SHELL, "shells"}, {TopAbs_FACE, "faces"},
@@ -348,7 +389,7 @@ static void report(const TopoDS_Shape &shape, int K) {
     std::printf("max_edge_tolerance: %.6e\nmax_vertex_tolerance: %.6e\n", etol, vtol);
     int i = 0;
     for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) print_surface(i++, TopoDS::Face(ex.Current()));
-    edge_angles(shape, K);
+    edge_angles(shape, K, fallback);
 }
 
 // ---- --build ---------------------------------------------------------------------------
@@ -398,17 +439,30 @@ static Handle(Geom_BSplineSurface) build_surface(const char *path) {
 
 int main(int argc, char **argv) {
     int N = 0, K = 8, heal = 1;
-    const char *points = nullptr, *build = nullptr, *file = nullptr;
+    const char *points = nullptr, *build = nullptr, *file = nullptr, *req = nullptr, *res = nullptr;
+    std::vector<char> fallback;
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--grid") && i + 1 < argc) N = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--points") && i + 1 < argc) points = argv[++i];
         else if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) K = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--build") && i + 1 < argc) build = argv[++i];
         else if (!std::strcmp(argv[i], "--no-heal")) heal = 0;
+        else if (!std::strcmp(argv[i], "--eval") && i + 1 < argc) req = argv[++i];
+        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) res = argv[++i];
+        else if (!std::strcmp(argv[i], "--fallback") && i + 1 < argc) {
+            std::ifstream fin(argv[++i]);
+            int x;
+            while (fin >> x) {
+                if (x < 0) return usage();
+                if ((size_t)x >= fallback.size()) fallback.resize(x + 1, 0);
+                fallback[x] = 1;
+            }
+        }
         else if (argv[i][0] == '-') return usage();
         else file = argv[i];
     }
-    if ((points && N < 2) || K < 1 || (!file && !build) || (build && (file || !points))) return usage();
+    if ((points && N < 2) || K < 1 || (!file && !build) || (build && (file || !points)) || (!req != !res))
+        return usage();
     // the readers' progress and warning messages go to stderr, not into the report
     Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_Printer));
     if (build) {
@@ -459,7 +513,8 @@ int main(int argc, char **argv) {
         return 1;
     }
     std::printf("shape_type: %s\n", TopAbs::ShapeTypeToString(shape.ShapeType()));
-    report(shape, K);
+    report(shape, K, fallback);
+    if (req && !eval_requests(shape, req, res)) { std::fprintf(stderr, "occt_read: --eval failed\n"); return 1; }
     if (points) {
         FILE *out = std::fopen(points, "w");
         if (!out) { std::perror(points); return 1; }

@@ -1,0 +1,513 @@
+/* ccn_plan_export (issue 17): the exported faces, evaluated here by an independent Cox-de Boor
+ * recursion on the surfaces the face callback reports, against
+ *   - the plan's own limit samples (ccn_plan_evaluate, level 3): every sample lies in some
+ *     face (located by the cells' places, decoded here from the documented order of the
+ *     output faces) and equals it <= 1e-12 x size, fills apart;
+ *   - a global refinement (ccn_refine) for the exact pieces around holes: every
+ *     CCN_EXPORT_FACE_REFINED face equals the strict bicubic patch of its face in the
+ *     globally refined mesh (the export refines locally);
+ * and the cells tile every cage face (areas sum to 1 per quad), the packed regular torus is
+ * one periodic face whose knots are the ring intervals, bad input is rejected with a status
+ * and a message naming the problem, a failing sink gives CCN_ERR_IO, output is deterministic.
+ */
+#include "ccnurbs.h"
+#include "surface/patches.h"
+#include "testlib.h"
+
+#define MAXF 20000
+
+/* ---- captured faces --------------------------------------------------------------- */
+
+typedef struct {
+    int kind, patch, ncells;
+    ccn_export_cell *cells;
+    int deg[2], np[2], per[2];
+    double *t[2]; /* flat knots */
+    int nt[2];
+    double *P;
+} face;
+
+typedef struct { face *f; int n; } faces;
+
+static void capture(void *user, const ccn_export_face *e) {
+    faces *F = user;
+    if (F->n >= MAXF) return;
+    face *f = &F->f[F->n++];
+    f->kind = e->kind;
+    f->patch = e->patch;
+    f->ncells = e->num_cells;
+    f->cells = malloc(sizeof(ccn_export_cell) * (size_t)e->num_cells);
+    memcpy(f->cells, e->cells, sizeof(ccn_export_cell) * (size_t)e->num_cells);
+    for (int d = 0; d < 2; d++) {
+        f->deg[d] = e->degree[d];
+        f->np[d] = e->num_poles[d];
+        f->per[d] = e->periodic[d];
+        int n = 0;
+        for (int k = 0; k < e->num_knots[d]; k++) n += e->mults[d][k];
+        f->t[d] = malloc(sizeof(double) * (size_t)n);
+        f->nt[d] = n;
+        n = 0;
+        for (int k = 0; k < e->num_knots[d]; k++)
+            for (int m = 0; m < e->mults[d][k]; m++) f->t[d][n++] = e->knots[d][k];
+    }
+    size_t np = 3 * (size_t)e->num_poles[0] * (size_t)e->num_poles[1];
+    f->P = malloc(sizeof(double) * np);
+    memcpy(f->P, e->poles, sizeof(double) * np);
+}
+
+static void faces_free(faces *F) {
+    for (int i = 0; i < F->n; i++) {
+        free(F->f[i].cells); free(F->f[i].t[0]); free(F->f[i].t[1]); free(F->f[i].P);
+    }
+    free(F->f);
+}
+
+/* N_{i,p}(x), Cox-de Boor; half-open spans except the domain's last. */
+static double cdb(const double *t, int i, int p, double x, double end) {
+    if (p == 0) {
+        if (x == end) return t[i] < x && x == t[i + 1];
+        return t[i] <= x && x < t[i + 1];
+    }
+    double a = 0, b = 0;
+    if (t[i + p] > t[i]) a = (x - t[i]) / (t[i + p] - t[i]) * cdb(t, i, p - 1, x, end);
+    if (t[i + p + 1] > t[i + 1]) b = (t[i + p + 1] - x) / (t[i + p + 1] - t[i + 1]) * cdb(t, i + 1, p - 1, x, end);
+    return a + b;
+}
+
+static void feval(const face *f, double u, double v, double out[3]) {
+    double u1 = f->t[0][f->np[0]], v1 = f->t[1][f->np[1]];
+    out[0] = out[1] = out[2] = 0;
+    for (int i = 0; i < f->np[0]; i++) {
+        double a = cdb(f->t[0], i, f->deg[0], u, u1);
+        if (a == 0) continue;
+        for (int j = 0; j < f->np[1]; j++) {
+            double w = a * cdb(f->t[1], j, f->deg[1], v, v1);
+            for (int k = 0; k < 3; k++) out[k] += w * f->P[3 * (i * f->np[1] + j) + k];
+        }
+    }
+}
+
+/* ---- helpers ------------------------------------------------------------------------ */
+
+typedef struct { char *d; size_t n, cap; int fail_after; } sink;
+
+static int sink_fn(void *user, const char *data, size_t len) {
+    sink *s = user;
+    if (s->fail_after >= 0 && s->n + len > (size_t)s->fail_after) return 1;
+    if (s->n + len > s->cap) {
+        s->cap = 2 * (s->n + len) + 4096;
+        s->d = realloc(s->d, s->cap);
+    }
+    memcpy(s->d + s->n, data, len);
+    s->n += len;
+    return 0;
+}
+
+static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn_options *o) {
+    char path[256];
+    snprintf(path, sizeof path, "tests/data/%s.obj", name);
+    size_t len;
+    char *text = tl_slurp(path, &len);
+    if (!text) return NULL;
+    ccn_error err;
+    ccn_plan *p = NULL;
+    if (ccn_obj_parse(text, len, obj, &err) || ccn_obj_cage(*obj, cage) || ccn_plan_create(cage, o, &p, &err))
+        p = NULL;
+    free(text);
+    return p;
+}
+
+static ccn_status run(ccn_plan *p, ccn_export_options *eo, faces *F, sink *s, ccn_export_info *info,
+                      ccn_error *err) {
+    if (F) {
+        F->f = calloc(MAXF, sizeof(face));
+        F->n = 0;
+        eo->face_fn = capture;
+        eo->face_user = F;
+    }
+    return ccn_plan_export(p, NULL, eo, sink_fn, s, info, err);
+}
+
+static int contains(const char *d, size_t n, const char *w) {
+    size_t k = strlen(w);
+    for (size_t i = 0; i + k <= n; i++)
+        if (!memcmp(d + i, w, k)) return 1;
+    return 0;
+}
+
+static const double UNIT[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+
+/* Place (3 corners) of face q of the level-L output: the documented order (see file comment). */
+static void place_of(const ccn_cage *cage, int L, int q, int *c, int *sub, double p[3][2]) {
+    int chain[32], n = 0, f = q;
+    for (int l = L; l > 1; l--) { chain[n++] = f % 4; f /= 4; }
+    int start = 0, cf = 0;
+    while (start + cage->face_sizes[cf] <= f) start += cage->face_sizes[cf++];
+    int j1 = f - start;
+    double P[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+    *c = cf;
+    *sub = -1;
+    if (cage->face_sizes[cf] == 4) chain[n++] = j1;
+    else *sub = j1;
+    for (int k = n - 1; k >= 0; k--) {
+        int j = chain[k];
+        double a[2], b[2], d[2], Q[3][2];
+        for (int e = 0; e < 2; e++) {
+            a[e] = UNIT[j][e];
+            b[e] = (UNIT[j][e] + UNIT[(j + 1) % 4][e]) / 2;
+            d[e] = (UNIT[j][e] + UNIT[(j + 3) % 4][e]) / 2;
+        }
+        const double *pts[3] = {a, b, d};
+        for (int r = 0; r < 3; r++)
+            for (int e = 0; e < 2; e++)
+                Q[r][e] = P[0][e] + pts[r][0] * (P[1][e] - P[0][e]) + pts[r][1] * (P[2][e] - P[0][e]);
+        memcpy(P, Q, sizeof P);
+    }
+    memcpy(p, P, sizeof P);
+}
+
+/* (u,v) of local point st in cell c, or 0 if outside. */
+static int cell_uv(const ccn_export_cell *c, const double st[2], double *u, double *v) {
+    double e1[2] = {c->st[1][0] - c->st[0][0], c->st[1][1] - c->st[0][1]};
+    double e2[2] = {c->st[2][0] - c->st[0][0], c->st[2][1] - c->st[0][1]};
+    double det = e1[0] * e2[1] - e1[1] * e2[0], r[2] = {st[0] - c->st[0][0], st[1] - c->st[0][1]};
+    double x = (r[0] * e2[1] - r[1] * e2[0]) / det, y = (e1[0] * r[1] - e1[1] * r[0]) / det;
+    if (x < -1e-12 || x > 1 + 1e-12 || y < -1e-12 || y > 1 + 1e-12) return 0;
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    y = y < 0 ? 0 : y > 1 ? 1 : y;
+    *u = c->uv[0] + x * (c->uv[1] - c->uv[0]);
+    *v = c->uv[2] + y * (c->uv[3] - c->uv[2]);
+    return 1;
+}
+
+/* Every level-3 limit sample against the faces containing it; returns the number of faces
+ * touched; *worst = max distance / size (fills apart), *unmatched samples. */
+static int against_limit(ccn_plan *p, const ccn_cage *cage, const faces *F, double *worst,
+                         double *fill_worst, int *unmatched) {
+    ccn_sizes sz;
+    ccn_plan_sizes(p, &sz);
+    int L = sz.levels;
+    double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
+    int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)sz.num_faces);
+    ccn_limit_mesh lm = {pos, NULL, fv, NULL};
+    ccn_error err;
+    int touched = 0;
+    *worst = *fill_worst = 0;
+    *unmatched = 0;
+    if (ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK) {
+        double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+        for (int i = 0; i < sz.num_verts; i++)
+            for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], pos[3 * i + k]); hi[k] = fmax(hi[k], pos[3 * i + k]); }
+        double size = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        char *hit = calloc((size_t)F->n, 1);
+        for (int q = 0; q < sz.num_faces; q++) {
+            int c, sub;
+            double P[3][2];
+            place_of(cage, L, q, &c, &sub, P);
+            for (int k = 0; k < 4; k++) {
+                double st[2];
+                for (int e = 0; e < 2; e++)
+                    st[e] = k == 0 ? P[0][e] : k == 1 ? P[1][e] : k == 2 ? P[1][e] + P[2][e] - P[0][e] : P[2][e];
+                const double *x = pos + 3 * fv[4 * q + k];
+                int found = 0;
+                for (int i = 0; i < F->n; i++)
+                    for (int j = 0; j < F->f[i].ncells; j++) {
+                        const ccn_export_cell *cl = &F->f[i].cells[j];
+                        double u, v, y[3];
+                        if (cl->cage_face != c || cl->sub != sub || !cell_uv(cl, st, &u, &v)) continue;
+                        feval(&F->f[i], u, v, y);
+                        double d = sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2])) / size;
+                        double *w = F->f[i].kind == CCN_EXPORT_FACE_FILL ? fill_worst : worst;
+                        if (d > *w) *w = d;
+                        found = 1;
+                        hit[i] = 1;
+                    }
+                *unmatched += !found;
+            }
+        }
+        for (int i = 0; i < F->n; i++) touched += hit[i];
+        free(hit);
+    }
+    free(pos);
+    free(fv);
+    return touched;
+}
+
+/* ---- tests ---------------------------------------------------------------------------- */
+
+static void check_cage(const char *name, int closed, int fills) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 3;
+    ccn_plan *p = load(name, &obj, &cage, &o);
+    CHECK(p != NULL, "%s: plan", name);
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    ccn_status st = run(p, &eo, &F, &s, &info, &err);
+    CHECK(st == CCN_OK, "%s: export: %s", name, err.message);
+    CHECK(info.num_faces == F.n, "%s: %d faces reported, %d called back", name, (int)info.num_faces, F.n);
+    CHECK(info.num_packs + info.num_bicubic + info.num_bi5 + info.num_refined + info.num_fill_faces == info.num_faces,
+          "%s: counts by kind", name);
+    CHECK(info.closed == closed && (closed ? info.num_boundary_edges == 0 : info.num_boundary_edges > 0),
+          "%s: closed %d, %d boundary edges", name, (int)info.closed, (int)info.num_boundary_edges);
+    CHECK(info.num_shells == 1, "%s: %d shells", name, (int)info.num_shells);
+    CHECK(info.num_fills == fills, "%s: %d fills, expected %d", name, (int)info.num_fills, fills);
+    CHECK(info.max_g1_deviation <= 1e-8, "%s: G1 deviation %g", name, info.max_g1_deviation);
+    CHECK(info.bytes == (int64_t)s.n && s.n > 0, "%s: bytes", name);
+    /* cells tile every cage face (quad) or level-1 quad of an n-gon: areas sum to 1 */
+    int nsub = 0;
+    for (int c = 0; c < cage.num_faces; c++) nsub += cage.face_sizes[c] == 4 ? 1 : cage.face_sizes[c];
+    double *area = calloc((size_t)nsub, sizeof(double));
+    int *first = malloc(sizeof(int) * (size_t)cage.num_faces), acc = 0;
+    for (int c = 0; c < cage.num_faces; c++) { first[c] = acc; acc += cage.face_sizes[c] == 4 ? 1 : cage.face_sizes[c]; }
+    for (int i = 0; i < F.n; i++)
+        for (int j = 0; j < F.f[i].ncells; j++) {
+            const ccn_export_cell *c = &F.f[i].cells[j];
+            double a = fabs((c->st[1][0] - c->st[0][0]) * (c->st[2][1] - c->st[0][1]) -
+                            (c->st[1][1] - c->st[0][1]) * (c->st[2][0] - c->st[0][0]));
+            area[first[c->cage_face] + (c->sub < 0 ? 0 : c->sub)] += a;
+        }
+    double amax = 0;
+    for (int i = 0; i < nsub; i++) amax = fmax(amax, fabs(area[i] - 1));
+    CHECK(amax <= 1e-12, "%s: the cells do not tile the cage (area error %g)", name, amax);
+    free(area);
+    free(first);
+    double worst, fill_worst;
+    int unmatched, touched = against_limit(p, &cage, &F, &worst, &fill_worst, &unmatched);
+    CHECK(unmatched == 0, "%s: %d limit samples in no face", name, unmatched);
+    CHECK(worst <= 1e-12, "%s: faces vs limit samples %g x size", name, worst);
+    printf("  %s: %d faces (%d packs, %d bicubic, %d bi-5, %d refined, %d fill), %d touched by "
+           "level-3 samples, max distance %.2e x size (fills %.2e), G1 %.2e (fills %.2e), %lld bytes\n",
+           name, F.n, (int)info.num_packs, (int)info.num_bicubic, (int)info.num_bi5, (int)info.num_refined,
+           (int)info.num_fill_faces, touched, worst, fill_worst, info.max_g1_deviation,
+           info.max_fill_g1_deviation, (long long)info.bytes);
+    /* STEP and IGES: deterministic */
+    sink s2 = {NULL, 0, 0, -1};
+    eo.face_fn = NULL;
+    ccn_export_info i2;
+    CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s2, &i2, &err) == CCN_OK && s2.n == s.n &&
+          memcmp(s.d, s2.d, s.n) == 0, "%s: STEP output differs between two runs", name);
+    eo.format = CCN_EXPORT_IGES;
+    sink s3 = {NULL, 0, 0, -1};
+    CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s3, &i2, &err) == CCN_OK && i2.num_faces == info.num_faces &&
+          i2.num_edges == info.num_edges && i2.max_g1_deviation == info.max_g1_deviation,
+          "%s: IGES figures differ", name);
+    free(s.d); free(s2.d); free(s3.d);
+    faces_free(&F);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
+static void test_cages(void) {
+    check_cage("torus", 1, 0);
+    check_cage("cube", 1, 0);
+    check_cage("cube_tri", 1, 0);
+    check_cage("ngon_prism", 1, 0);
+    check_cage("lshape", 0, 6);
+    check_cage("pole12", 0, 0);
+    check_cage("flip35", 0, 4);
+    check_cage("fig18_v8", 0, 8);
+    check_cage("fig16_v6", 0, 7);
+    check_cage("mixed_boundary", 0, 11);
+}
+
+/* The exact pieces around holes equal the strict patches of a global refinement. */
+static void test_refined(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 1;
+    ccn_plan *p = load("grid4", &obj, &cage, &o);
+    CHECK(p != NULL, "plan");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    eo.fill_levels = 3;
+    eo.flags = CCN_EXPORT_UNPACKED; /* one face per refined face: each is one mesh face */
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "export: %s", err.message);
+    ccn_sizes sz;
+    ccn_plan_sizes(p, &sz);
+    int top = info.fill_level;
+    CHECK(top == sz.refine_levels + 3, "fill level %d (patch level %d + 3)", top, (int)sz.refine_levels);
+    ccn_mesh *cm = NULL, *ref[8] = {NULL};
+    CHECK(ccn_mesh_create(&cage, &cm, &err) == CCN_OK, "mesh");
+    for (int l = 1; l <= top && l < 8; l++) CHECK(ccn_refine(cm, l, &o, &ref[l], &err) == CCN_OK, "refine %d", l);
+    int checked = 0;
+    double worst = 0;
+    for (int i = 0; i < F.n; i++) {
+        const face *f = &F.f[i];
+        if (f->kind != CCN_EXPORT_FACE_REFINED) continue;
+        const ccn_export_cell *c = &f->cells[0];
+        double side = fabs(c->st[1][0] - c->st[0][0]) + fabs(c->st[1][1] - c->st[0][1]);
+        int l = (int)lround(-log2(side));
+        CHECK(l >= 1 && l <= top && l < 8, "refined face %d has level %d", i, l);
+        if (l < 1 || l > top || l >= 8) continue;
+        ccn_mesh_info mi;
+        ccn_mesh_info_get(ref[l], &mi);
+        int found = -1;
+        double Q[3][2];
+        for (int q = 0; q < mi.num_faces && found < 0; q++) { /* the level-l face at this place */
+            int cf, sub;
+            place_of(&cage, l, q, &cf, &sub, Q);
+            double ca[2] = {Q[1][0] + Q[2][0] - Q[0][0], Q[1][1] + Q[2][1] - Q[0][1]};
+            double cb[2] = {c->st[1][0] + c->st[2][0] - c->st[0][0], c->st[1][1] + c->st[2][1] - c->st[0][1]};
+            double mida[2] = {(Q[0][0] + ca[0]) / 2, (Q[0][1] + ca[1]) / 2}, midb[2] = {(c->st[0][0] + cb[0]) / 2, (c->st[0][1] + cb[1]) / 2};
+            if (cf == c->cage_face && fabs(mida[0] - midb[0]) + fabs(mida[1] - midb[1]) < 1e-12) found = q;
+        }
+        CHECK(found >= 0, "refined face %d: no level-%d face there", i, l);
+        if (found < 0) continue;
+        double bez[4][4][3];
+        CHECK(ccn__bicubic_patch(ref[l], found, 0, 1, bez), "refined face %d: level-%d face %d is not strict", i, l, found);
+        for (int a = 0; a <= 4; a++)
+            for (int b = 0; b <= 4; b++) { /* the same point: via the cell and via the face */
+                double x = a / 4.0, y = b / 4.0, st[2], u, v, X[3], Y[3] = {0, 0, 0};
+                for (int e = 0; e < 2; e++)
+                    st[e] = c->st[0][e] + x * (c->st[1][e] - c->st[0][e]) + y * (c->st[2][e] - c->st[0][e]);
+                cell_uv(c, st, &u, &v);
+                feval(f, u, v, X);
+                /* st in the level-l face's own frame */
+                double e1[2] = {Q[1][0] - Q[0][0], Q[1][1] - Q[0][1]}, e2[2] = {Q[2][0] - Q[0][0], Q[2][1] - Q[0][1]};
+                double det = e1[0] * e2[1] - e1[1] * e2[0], r[2] = {st[0] - Q[0][0], st[1] - Q[0][1]};
+                double fu = (r[0] * e2[1] - r[1] * e2[0]) / det, fw = (e1[0] * r[1] - e1[1] * r[0]) / det;
+                for (int I = 0; I < 4; I++)
+                    for (int J = 0; J < 4; J++) {
+                        double bi = (I == 0 ? 1 : I == 3 ? 1 : 3) * pow(fu, I) * pow(1 - fu, 3 - I);
+                        double bj = (J == 0 ? 1 : J == 3 ? 1 : 3) * pow(fw, J) * pow(1 - fw, 3 - J);
+                        for (int k = 0; k < 3; k++) Y[k] += bi * bj * bez[I][J][k];
+                    }
+                double d = sqrt((X[0] - Y[0]) * (X[0] - Y[0]) + (X[1] - Y[1]) * (X[1] - Y[1]) + (X[2] - Y[2]) * (X[2] - Y[2]));
+                worst = fmax(worst, d);
+            }
+        checked++;
+    }
+    CHECK(checked == info.num_refined && checked > 0, "%d of %d refined faces checked", checked, (int)info.num_refined);
+    CHECK(worst <= 1e-12 * info.size, "refined faces vs the global refinement: %g", worst);
+    printf("  grid4: %d refined faces (levels %d..%d) = the global refinement's patches, max %.2e\n",
+           checked, (int)sz.refine_levels + 1, top, worst);
+    for (int l = 1; l < 8; l++) ccn_mesh_destroy(ref[l]);
+    ccn_mesh_destroy(cm);
+    free(s.d);
+    faces_free(&F);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
+/* A regular torus: one periodic face, knots = the ring intervals. */
+static void test_torus_pack(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load("torus", &obj, &cage, NULL);
+    CHECK(p != NULL, "plan");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "export: %s", err.message);
+    CHECK(F.n == 1 && info.num_packs == 1 && info.num_edges == 2 && info.num_vertices == 1 && info.closed,
+          "%d faces, %d edges, %d vertices", F.n, (int)info.num_edges, (int)info.num_vertices);
+    if (F.n == 1) {
+        const face *f = &F.f[0];
+        CHECK(f->per[0] && f->per[1] && f->deg[0] == 3 && f->np[0] == 8 + 3 && f->np[1] == 6 + 3,
+              "periodic %d %d, %d x %d poles", f->per[0], f->per[1], f->np[0], f->np[1]);
+        for (int k = 0; k + 1 < f->nt[0]; k++) CHECK(fabs(f->t[0][k + 1] - f->t[0][k] - 1) < 1e-15, "u knot %d", k);
+    }
+    /* unpacked: one face per cage quad */
+    eo.flags = CCN_EXPORT_UNPACKED;
+    sink s2 = {NULL, 0, 0, -1};
+    eo.face_fn = NULL;
+    CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s2, &info, &err) == CCN_OK && info.num_faces == 48 &&
+          info.num_packed_cage_faces == 48 && info.closed, "unpacked: %d faces", (int)info.num_faces);
+    free(s.d); free(s2.d);
+    faces_free(&F);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
+static void progress_fn(void *user, double x) {
+    double *last = user;
+    CHECK(x >= last[0] && x <= 1, "progress %g after %g", x, last[0]);
+    last[0] = x;
+}
+
+static void test_bad_input(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load("cube", &obj, &cage, NULL);
+    CHECK(p != NULL, "plan");
+    if (!p) return;
+    ccn_export_options eo;
+    ccn_error err;
+    sink s = {NULL, 0, 0, -1};
+#define BAD(expr, want, what)                                                                  \
+    do {                                                                                       \
+        s.n = 0;                                                                               \
+        ccn_status st_ = (expr);                                                               \
+        CHECK(st_ == (want) && err.message[0] && s.n == 0, "%s: status %d (%s), %zu bytes", what, \
+              (int)st_, err.message, s.n);                                                     \
+    } while (0)
+    memset(&eo, 0, sizeof eo);
+    BAD(ccn_plan_export(NULL, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "NULL plan");
+    BAD(ccn_plan_export(p, NULL, &eo, NULL, &s, NULL, &err), CCN_ERR_ARGUMENT, "NULL callback");
+    eo.format = 7;
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "format 7");
+    CHECK(strstr(err.message, "format") != NULL, "message: %s", err.message);
+    eo.format = 0;
+    eo.flags = 0x10;
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "flags");
+    eo.flags = 0;
+    eo.fill_levels = 13;
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "fill_levels 13");
+    eo.fill_levels = 0;
+    eo.name = "it's";
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "quote in name");
+    eo.name = NULL;
+    eo.timestamp = "yesterday";
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "timestamp");
+    eo.timestamp = NULL;
+    eo.tolerance = NAN;
+    BAD(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "NaN tolerance");
+    eo.tolerance = 0;
+    double bad[24];
+    for (int i = 0; i < 24; i++) bad[i] = cage.positions[i];
+    bad[3 * 5 + 1] = NAN;
+    BAD(ccn_plan_export(p, bad, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "NaN position");
+    CHECK(err.element_kind == CCN_ELEM_VERTEX && err.element == 5, "names vertex 5: %d %d (%s)",
+          (int)err.element_kind, (int)err.element, err.message);
+    s.fail_after = 1000;
+    s.n = 0;
+    CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err) == CCN_ERR_IO, "failing sink: %s", err.message);
+    s.fail_after = -1;
+    double last = 0;
+    eo.progress = progress_fn;
+    eo.progress_user = &last;
+    eo.name = "cube part";
+    eo.timestamp = "2024-05-06T07:08:09";
+    s.n = 0;
+    CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err) == CCN_OK && last == 1.0, "progress ends at %g", last);
+    CHECK(s.n > 0 && contains(s.d, s.n, "cube part") && contains(s.d, s.n, "2024-05-06T07:08:09"),
+          "name and timestamp in the file");
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
+int main(void) {
+    RUN(test_bad_input);
+    RUN(test_torus_pack);
+    RUN(test_refined);
+    RUN(test_cages);
+    return TEST_SUMMARY();
+}
