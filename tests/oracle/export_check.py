@@ -6,7 +6,10 @@ faces' corners in order: face q at level l >= 2 is corner q % 4 of face q // 4; 
 corners of the cage faces in order), the patches' values from a Bernstein evaluation here.
 
   export_check.py --cage C.obj --limit C.lim.obj --map C.map [--patches C.bv]
-                  --occt build/occt_read FILE.step|FILE.igs ...
+                  [--fallback FACES] --occt build/occt_read FILE.step|FILE.igs ...
+
+occt_read runs once per file, with --eval and (--fallback FACES) its full report, which is
+written to FILE.rep for the caller's checks.
 
 For every limit vertex, every place (cage face, sub-quad, s, t) it has; the face map's cells
 containing it give the face and its (u, v); OpenCASCADE evaluates those (occt_read --eval)
@@ -141,6 +144,7 @@ def main():
     ap.add_argument("--map", required=True)
     ap.add_argument("--patches")
     ap.add_argument("--occt", required=True)
+    ap.add_argument("--fallback")
     ap.add_argument("files", nargs="+")
     a = ap.parse_args()
     sizes = read_cage_sizes(a.cage)
@@ -166,8 +170,9 @@ def main():
                 o.write("%d %.17g %.17g\n" % (r[0], r[1], r[2]))
         for path in a.files:
             rs = os.path.join(T, "res")
-            p = subprocess.run([a.occt, "--eval", rq, "--out", rs, path], stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
+            cmd = [a.occt] + (["--fallback", a.fallback] if a.fallback else []) + ["--eval", rq, "--out", rs, path]
+            with open(path + ".rep", "w") as rep:
+                p = subprocess.run(cmd, stdout=rep, stderr=subprocess.DEVNULL)
             tag = "iges" if path.endswith((".igs", ".iges")) else "step"
             if p.returncode != 0:
                 print("%s_eval: failed" % tag)

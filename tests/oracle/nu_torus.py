@@ -1,5 +1,5 @@
 """A regular torus cage with random (seeded) ring intervals, and the same surface as the
-OpenCASCADE B-spline the cage defines, for the packed-export check (run_cad_patches.sh).
+OpenCASCADE B-spline the cage defines, for the packed-export check (run_export.sh).
 
   python3 nu_torus.py SEED out.obj out_build.txt
 

@@ -12,10 +12,5 @@ $(B)/occt_read: tests/oracle/occt_read.cpp
 	@mkdir -p $(@D)
 	$(CXX) -std=c++14 -O1 -Wall -Wextra -Werror $(OCCT_INC) $< -o $@ $(OCCT_LIBS)
 
-# Prototype of the unpacked export (tests/oracle/EXPORT_DESIGN.md): plan patches -> CAD faces.
-$(B)/cad_from_patches: tests/oracle/cad_from_patches.c tests/oracle/cad_pack.h $(B)/libccnurbs.a $(HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
-
-TEST_DEPS += $(B)/occt_read $(B)/cad_from_patches
+TEST_DEPS += $(B)/occt_read
 .DEFAULT_GOAL := $(OCCT_SAVED_GOAL)

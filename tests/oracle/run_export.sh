@@ -1,0 +1,151 @@
+#!/bin/sh
+# `ccnurbs export` (ccn_plan_export) vs OpenCASCADE (build/occt_read), issue 17's acceptance:
+# cages: cube, torus, the Fig. 16-18 star cages (non-uniform intervals), the tear box
+# (make_tearbox.py), n-gons (ngon_prism), boundaries (lshape, mixed_boundary),
+# the 2.5k-face production-like cage (tests/bench/make_bench_cages.py), the cube with
+# --cap refine (every EV a fill). For each, STEP and IGES:
+#   - read with no load or transfer failure, the loops as written closed and every edge used at
+#     most once each way, BRepCheck valid, one shell, no edge with more than two face uses, as
+#     many free edges as the export reports boundary edges (closed cages: a closed shell with
+#     positive volume), no sewing;
+#   - normals across every shared edge <= 1e-8 rad except edges of fill faces (the counted
+#     fallbacks, listed to occt_read --fallback), whose largest angle is printed;
+#   - every sample of `ccnurbs limit` (same options) lies in a face (by the face map) and
+#     OpenCASCADE's evaluation of that face there equals it <= 1e-9 x size (fills apart:
+#     printed); every face that is one of the plan's patches equals `ccnurbs patches` on a 4x4
+#     grid <= 1e-9 x size (tests/oracle/export_check.py);
+#   - the IGES file gives the same figures as the STEP file.
+# Then the packed export of regular tori with random ring intervals (nu_torus.py): exactly one
+# periodic B-spline face whose knots are the ring intervals, equal to the B-spline OpenCASCADE
+# builds from the cage's vertices and intervals (occt_read --build) <= 1e-12.
+cd "$(dirname "$0")/../.." || exit 2
+T=$(mktemp -d) || exit 2
+trap 'rm -rf "$T"' EXIT
+pass=0; fail=0
+val() { sed -n "s/^$1: //p" "$2" | head -n 1; }
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
+python3 tests/oracle/make_tearbox.py "$T/tearbox.obj" || exit 2
+python3 tests/bench/make_bench_cages.py "$T" > /dev/null || exit 2
+
+check() { # name obj limit-level [options]
+  name=$1 obj=$2 L=$3; shift 3
+  e=""
+  if ! build/ccnurbs export "$@" --face-map "$T/$name.map" "$obj" "$T/$name.step" > "$T/$name.info.step" 2> "$T/err" ||
+     ! build/ccnurbs export "$@" --format iges "$obj" "$T/$name.igs" > "$T/$name.info.iges" 2>> "$T/err"; then
+    fail=$((fail+1)); echo "FAIL $name: export: $(cat "$T/err")"; return
+  fi
+  awk '$1 == "F" && $3 == 4 { print $2 }' "$T/$name.map" > "$T/$name.fb"
+  closed=$(val closed "$T/$name.info.step") bnd=$(val boundary_edges "$T/$name.info.step")
+  cap="" pat="--patches $T/$name.bv"
+  case " $* " in *" --cap refine "*) cap="--cap refine" pat="" ;; esac # `ccnurbs patches` has no --cap
+  build/ccnurbs limit --levels "$L" $cap "$obj" "$T/$name.lim.obj" 2> /dev/null &&
+    { [ -z "$pat" ] || build/ccnurbs patches "$obj" "$T/$name.bv" 2> /dev/null; } &&
+    python3 tests/oracle/export_check.py --cage "$obj" --limit "$T/$name.lim.obj" --map "$T/$name.map" \
+      $pat --fallback "$T/$name.fb" --occt build/occt_read "$T/$name.step" "$T/$name.igs" > "$T/$name.chk" 2>&1 ||
+    { fail=$((fail+1)); echo "FAIL $name: limit check: $(tail -n 3 "$T/$name.chk" 2> /dev/null)"; return; }
+  for ext in step igs; do
+    r="$T/$name.$ext.rep"
+    for kv in reader_status=done valid=1 shells=1 edges_other=0 file_loops_broken=0 file_edges_misused=0 \
+              load_fails=0 transfer_fails=0 load_warnings=0 normal_undefined=0 closed_shells=$closed \
+              free_edges=$bnd faces=$(val faces "$T/$name.info.step"); do
+      k=${kv%%=*} want=${kv#*=}
+      [ "$(val "$k" "$r")" = "$want" ] || e="$e $ext:$k=$(val "$k" "$r")(want $want)"
+    done
+    le "$(val normal_angle_max "$r")" 1e-8 || e="$e $ext:normal_angle_max=$(val normal_angle_max "$r")"
+    if [ "$closed" = 1 ] && ! awk -v v="$(val volume "$r")" 'BEGIN { exit !(v > 0) }'; then e="$e $ext:volume"; fi
+  done
+  for k in faces edges vertices closed_shells free_edges normal_angle_max normal_angle_fallback_max; do
+    [ "$(val $k "$T/$name.step.rep")" = "$(val $k "$T/$name.igs.rep")" ] ||
+      e="$e iges-differs:$k=$(val $k "$T/$name.step.rep")/$(val $k "$T/$name.igs.rep")"
+  done
+  for k in faces packs bicubic bi5 refined fill_faces fills edges vertices closed max_g1_deviation max_fill_g1_deviation; do
+    [ "$(val $k "$T/$name.info.step")" = "$(val $k "$T/$name.info.iges")" ] || e="$e iges-info-differs:$k"
+  done
+  c="$T/$name.chk"
+  [ "$(val unmatched_vertices "$c")" = 0 ] || e="$e unmatched_limit_samples=$(val unmatched_vertices "$c")"
+  for ext in step iges; do
+    le "$(val ${ext}_max_rel_dist "$c")" 1e-9 || e="$e $ext:limit_dist=$(val ${ext}_max_rel_dist "$c")"
+    if [ -n "$(val faces_patch_checked "$c")" ] && [ "$(val faces_patch_checked "$c")" != 0 ]; then
+      le "$(val ${ext}_patch_max_rel_dist "$c")" 1e-9 || e="$e $ext:patch_dist=$(val ${ext}_patch_max_rel_dist "$c")"
+    fi
+  done
+  i="$T/$name.info.step"
+  if [ -z "$e" ]; then
+    pass=$((pass+1))
+    echo "ok   $name: $(val faces "$i") faces ($(val packs "$i") packs, $(val bicubic "$i") bicubic, $(val bi5 "$i") bi-5, $(val refined "$i") refined, $(val fill_faces "$i") fill), closed=$closed, $(val bytes "$i") B; vs limit L$L: $(val step_samples "$c") samples $(val step_max_rel_dist "$c") x size, patches $(val step_patch_max_rel_dist "$c"); normals $(val normal_angle_max "$T/$name.step.rep") rad; fills: $(val fills "$i") (level $(val fill_level "$i")) G1 $(val normal_angle_fallback_max "$T/$name.step.rep") rad, dist $(val step_fill_max_rel_dist "$c") x size; STEP = IGES"
+  else
+    fail=$((fail+1)); echo "FAIL $name:$e"
+  fi
+}
+
+check cube tests/data/cube.obj 4
+check cube_refine tests/data/cube.obj 3 --cap refine
+check torus tests/data/torus.obj 3
+check fig16_v6 tests/data/fig16_v6.obj 3
+check fig17_v7 tests/data/fig17_v7.obj 3
+check fig18_v8 tests/data/fig18_v8.obj 3
+check tearbox "$T/tearbox.obj" 3
+check ngon_prism tests/data/ngon_prism.obj 3
+check lshape tests/data/lshape.obj 3
+check mixed_boundary tests/data/mixed_boundary.obj 3
+check carlike_2.5k "$T/carlike.obj" 2
+
+# The CLI contract: errors print a message, exit 2 and leave no output file (nor a temporary).
+printf 'v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n' > "$T/nan.obj"
+cli_error() { # name message args...
+  n=$1 msg=$2; shift 2
+  rm -f "$T/out.step" "$T/out.map"
+  build/ccnurbs export "$@" > /dev/null 2> "$T/stderr"; rc=$?
+  if [ "$rc" -ne 2 ] || ! grep -q -- "$msg" "$T/stderr" || [ -e "$T/out.step" ] || [ -e "$T/out.map" ] ||
+     ls "$T"/out.step.tmp* "$T"/out.map.tmp* > /dev/null 2>&1; then
+    fail=$((fail+1)); echo "FAIL cli $n: exit $rc, $(cat "$T/stderr")"
+  else pass=$((pass+1)); echo "ok   cli $n: exit 2, '$msg', no output"; fi
+}
+cli_error "bad format" "bad --format" --format dxf tests/data/cube.obj "$T/out.step"
+cli_error "NaN vertex" "vertex 1 has a non-finite" --face-map "$T/out.map" "$T/nan.obj" "$T/out.step"
+cli_error "missing input" "cannot open" "$T/none.obj" "$T/out.step"
+cli_error "bad fill levels" "fill-levels" --fill-levels 0 tests/data/cube.obj "$T/out.step"
+cli_error "quote in name" "printable ASCII" --name "a'b" tests/data/cube.obj "$T/out.step"
+cli_error "bad cap" "bad --cap" --cap foo tests/data/cube.obj "$T/out.step"
+cli_error "no output path" "need an input and an output" tests/data/cube.obj
+cli_error "unwritable output" "cannot write" tests/data/cube.obj "$T/no/such/dir/out.step"
+
+# Packed export of regular tori with random ring intervals.
+griddiff() { # max |xyz| difference and max parameter difference, rows matched by (face, i, j)
+  awk 'NR == FNR { k = $1 " " $2 " " $3; x[k] = $6; y[k] = $7; z[k] = $8; u[k] = $4; v[k] = $5; next }
+       { k = $1 " " $2 " " $3; if (!(k in x)) { miss++; next }
+         n++; for (c = 6; c <= 8; c++) { d = $c - (c == 6 ? x[k] : c == 7 ? y[k] : z[k]); if (d < 0) d = -d; if (d > m) m = d }
+         d = $4 - u[k]; if (d < 0) d = -d; e = $5 - v[k]; if (e < 0) e = -e; if (d > pm) pm = d; if (e > pm) pm = e }
+       END { printf "%d %.3e %.3e %d\n", n, m, pm, miss + 0 }' "$1" "$2"
+}
+for seed in 1 2 3; do
+  python3 tests/oracle/nu_torus.py $seed "$T/nut.obj" "$T/nut_build.txt" &&
+    build/ccnurbs export "$T/nut.obj" "$T/nut.step" > "$T/p" 2>&1 &&
+    build/ccnurbs export "$T/nut.obj" "$T/nut.igs" >> "$T/p" 2>&1 &&
+    build/occt_read --build "$T/nut_build.txt" --grid 9 --points "$T/built.pts" > /dev/null 2>&1 ||
+    { fail=$((fail+1)); echo "FAIL torus seed $seed: $(cat "$T/p")"; continue; }
+  for ext in step igs; do
+    r="$T/nut.$ext.rep"
+    build/occt_read --grid 9 --points "$T/nut.$ext.pts" "$T/nut.$ext" > "$r" 2> /dev/null
+    e=""
+    for kv in valid=1 faces=1 edges=2 vertices=1 closed_shells=1 edges_seam=2 file_loops_broken=0; do
+      k=${kv%%=*} want=${kv#*=}
+      [ "$(val "$k" "$r")" = "$want" ] || e="$e $k=$(val "$k" "$r")"
+    done
+    line=$(grep '^face 0:' "$r")
+    case "$line" in *"upoles 8 vpoles 6 uperiodic 1 vperiodic 1"*) ;; *) e="$e not-one-periodic-8x6-face" ;; esac
+    got=$(echo "$line" | sed 's/.* uknots [0-9]* \([^a-z]*\) umults.* vknots [0-9]* \([^a-z]*\) vmults.*/\1 \2/')
+    want=$(sed -n 's/^[uv]knots [0-9]* //p' "$T/nut_build.txt" | tr '\n' ' ')
+    awk -v a="$got" -v b="$want" 'BEGIN { n = split(a, x, " "); m = split(b, y, " "); if (n != m) exit 1
+      for (i = 1; i <= n; i++) { d = x[i] - y[i]; if (d < 0) d = -d; if (d > 1e-12) exit 1 } }' || e="$e knots($got)!=($want)"
+    set -- $(griddiff "$T/built.pts" "$T/nut.$ext.pts")
+    awk -v n="$1" -v d="$2" -v p="$3" 'BEGIN { exit !(n == 81 && d <= 1e-12 && p <= 1e-12) }' || e="$e surface-diff=$2 param-diff=$3 points=$1"
+    if [ -z "$e" ]; then
+      pass=$((pass+1)); echo "ok   packed NU torus seed $seed .$ext: one periodic face, knots = ring intervals, = OCCT's B-spline of the cage (diff $2)"
+    else
+      fail=$((fail+1)); echo "FAIL packed NU torus seed $seed .$ext:$e"
+    fi
+  done
+done
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
