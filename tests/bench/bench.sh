@@ -23,6 +23,8 @@ done
 echo "refine ratio = ccn_refine (topology + points) / OSD uniform refinement (topology + points);"
 echo "evaluate ratio = plan evaluate (positions + normals) / OSD re-interpolation + Limit with tangents;"
 echo "plan ratio = plan creation / OSD topology + points + limit."
+echo "CAD export (ccn_plan_export, issue 17) of the production-like cages, into memory:"
+for cage in carlike carlike_knots; do build/bench/export_bench "$D/$cage.obj" 3 || exit 2; done
 if command -v blender > /dev/null; then
   echo "Blender $(blender --version 2>/dev/null | head -n 1 | cut -d' ' -f2): CCNURBS modifier vs Subdivision Surface, same density (ratio = ours / Subsurf):"
   tmp=$(mktemp -d) || exit 2
