@@ -249,7 +249,7 @@ static ccn_status build_faces(ccn__xmodel *xm, const ccn__plan_view *v, const re
     uint8_t *drop = calloc(rl->n + 1, 1);
     uint8_t *okl = calloc((size_t)v->lev[lvl]->nf + 1, 1);
     int32_t *rec_of = malloc(sizeof(int32_t) * ((size_t)v->lev[lvl]->nf + 1));
-    int32_t *holes = malloc(sizeof(int32_t) * (rl->n + 1));
+    int32_t *holes = malloc(sizeof(int32_t) * (2 * rl->n + 1));
     ccn__pack *pk = NULL;
     int32_t npk = 0;
     if (!ok0 || !cage_of || !drop || !okl || !rec_of || !holes) {
@@ -295,20 +295,15 @@ static ccn_status build_faces(ccn__xmodel *xm, const ccn__plan_view *v, const re
         for (int32_t f = 0; f < ml->nf; f++)
             if (okl[f] && rec_of[f] >= 0) drop[rec_of[f]] = 1;
     }
-    /* the plan's other patches */
-    int32_t nh = 0, hole_level = -1;
+    /* the plan's other patches; holes by level (the patch level, or one finer around an
+     * exact-surround cap) */
+    int32_t nh[2] = {0, 0};
     for (size_t i = 0; i < rl->n; i++) {
         const rec *r = &rl->r[i];
         if (drop[i]) continue;
         if (r->pl.kind == CCN__PATCH_HOLE) {
-            if (hole_level >= 0 && r->pl.level != hole_level) {
-                st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, cage_of[i],
-                               "holes on two levels (%d, %d) near cage face %d", (int)hole_level,
-                               (int)r->pl.level, (int)cage_of[i]);
-                goto done;
-            }
-            hole_level = r->pl.level;
-            holes[nh++] = r->pl.face;
+            int k = r->pl.level != lvl;
+            holes[k * rl->n + nh[k]++] = r->pl.face;
             continue;
         }
         ccn__xplace q, s;
@@ -320,11 +315,12 @@ static ccn_status build_faces(ccn__xmodel *xm, const ccn__plan_view *v, const re
         xm->faces[f].patch = r->pl.index;
     }
     progress(o, 0.3);
-    if (nh) {
+    for (int k = 0; k < 2; k++) {
+        if (!nh[k]) continue;
         ccn__fill_opts fo = {o->fill_levels ? o->fill_levels : CCN_EXPORT_DEFAULT_FILL_LEVELS, packed, 0, -1};
-        if ((st = ccn__fill_holes(xm, v, hole_level, holes, nh, &fo, err))) goto done;
-        inf->num_fills = fo.num_fills;
-        inf->fill_level = fo.fill_level;
+        if ((st = ccn__fill_holes(xm, v, lvl + k, holes + k * rl->n, nh[k], &fo, err))) goto done;
+        inf->num_fills += fo.num_fills;
+        if (fo.fill_level > inf->fill_level) inf->fill_level = fo.fill_level;
     }
     if (xm->oom) goto oom;
     goto done;

@@ -504,6 +504,8 @@ done:
     return st;
 }
 
+#define CCN_FILL_MAX_LEVEL 16 /* deepest level a fill goes to when its vertices are close */
+
 /* ---- the levels ---------------------------------------------------------------------- */
 
 ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t level,
@@ -521,8 +523,8 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
     if (!reg || !regpl) goto oom;
     memcpy(reg, faces, sizeof(int32_t) * (size_t)n);
     for (int32_t i = 0; i < n; i++) ccn__xplace_of(v->lev, level, faces[i], &regpl[i]);
-    for (int32_t j = 0; j < o->levels && nreg > 0; j++) {
-        int last = j + 1 == o->levels;
+    for (int32_t j = 0; nreg > 0; j++) {
+        int last = j + 1 >= o->levels;
         sel = calloc((size_t)cm->nf, 1);
         vmark = malloc((size_t)cm->nv + 1);
         inv = malloc(sizeof(int32_t) * (size_t)cm->nf);
@@ -578,6 +580,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if (last) { /* the fill faces around each irregular vertex cover what is left */
             uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
             if (!done_v || !cov) { free(done_v); free(cov); goto oom; }
+            int32_t nf0 = xm->num_faces, nc0 = xm->num_cells, nfill0 = o->num_fills;
             for (int32_t i = 0; i < nreg && !st; i++)
                 for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && !st; h++) {
                     int32_t w = T->hvert[h];
@@ -592,8 +595,25 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
                                    (int)tpl[reg[i]].cage_face);
             free(done_v);
             free(cov);
-            if (st) goto done;
-            o->fill_level = level + j + 1;
+            if (st == CCN_ERR_INTERNAL && level + j + 1 < CCN_FILL_MAX_LEVEL) {
+                /* irregular vertices still too close for the fill's blocks: one level more */
+                for (int32_t f = nf0; f < xm->num_faces; f++) {
+                    ccn__cad_surface *sf = &xm->faces[f].s;
+                    free((void *)sf->poles);
+                    for (int d = 0; d < 2; d++) { free((void *)sf->knots[d]); free((void *)sf->mults[d]); }
+                }
+                xm->num_faces = nf0;
+                xm->num_cells = nc0;
+                o->num_fills = nfill0;
+                st = CCN_OK;
+                ccn__ok(err);
+                last = 0;
+            } else if (st) {
+                goto done;
+            } else {
+                o->fill_level = level + j + 1;
+                nreg = 0; /* done */
+            }
         }
         free(sel); free(vmark); free(inv); free(fmap); free(mask);
         sel = vmark = mask = NULL;
