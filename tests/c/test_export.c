@@ -318,17 +318,17 @@ static void test_cages(void) {
 }
 
 /* The exact pieces around holes equal the strict patches of a global refinement. */
-static void test_refined(void) {
+static void check_refined(const char *name, int fill_levels) {
     ccn_obj *obj;
     ccn_cage cage;
     ccn_options o = {0};
     o.levels = 1;
-    ccn_plan *p = load("grid4", &obj, &cage, &o);
+    ccn_plan *p = load(name, &obj, &cage, &o);
     CHECK(p != NULL, "plan");
     if (!p) return;
     ccn_export_options eo;
     memset(&eo, 0, sizeof eo);
-    eo.fill_levels = 3;
+    eo.fill_levels = fill_levels;
     eo.flags = CCN_EXPORT_UNPACKED; /* one face per refined face: each is one mesh face */
     faces F;
     sink s = {NULL, 0, 0, -1};
@@ -338,7 +338,9 @@ static void test_refined(void) {
     ccn_sizes sz;
     ccn_plan_sizes(p, &sz);
     int top = info.fill_level;
-    CHECK(top == sz.refine_levels + 3, "fill level %d (patch level %d + 3)", top, (int)sz.refine_levels);
+    int plevel = top - fill_levels; /* the patch level: the deepest without caps */
+    CHECK(sz.num_caps == 0 && plevel == sz.refine_levels, "%s: fill level %d, patch level %d + %d",
+          name, top, (int)sz.refine_levels, fill_levels);
     ccn_mesh *cm = NULL, *ref[8] = {NULL};
     CHECK(ccn_mesh_create(&cage, &cm, &err) == CCN_OK, "mesh");
     for (int l = 1; l <= top && l < 8; l++) CHECK(ccn_refine(cm, l, &o, &ref[l], &err) == CCN_OK, "refine %d", l);
@@ -390,16 +392,22 @@ static void test_refined(void) {
             }
         checked++;
     }
-    CHECK(checked == info.num_refined && checked > 0, "%d of %d refined faces checked", checked, (int)info.num_refined);
-    CHECK(worst <= 1e-12 * info.size, "refined faces vs the global refinement: %g", worst);
-    printf("  grid4: %d refined faces (levels %d..%d) = the global refinement's patches, max %.2e\n",
-           checked, (int)sz.refine_levels + 1, top, worst);
+    CHECK(checked == info.num_refined && checked > 0, "%s: %d of %d refined faces checked", name, checked, (int)info.num_refined);
+    CHECK(worst <= 1e-12 * info.size, "%s: refined faces vs the global refinement: %g", name, worst);
+    printf("  %s: %d refined faces (levels %d..%d) = the global refinement's patches, max %.2e\n",
+           name, checked, plevel + 1, top, worst);
     for (int l = 1; l < 8; l++) ccn_mesh_destroy(ref[l]);
     ccn_mesh_destroy(cm);
     free(s.d);
     faces_free(&F);
     ccn_plan_destroy(p);
     ccn_obj_destroy(obj);
+}
+
+static void test_refined(void) {
+    check_refined("grid4", 3);    /* smooth valence-2 corners */
+    check_refined("fig16_v6", 3); /* an interior EV whose cap folds (1:10), non-uniform */
+    check_refined("bfan5", 3);    /* a boundary EV */
 }
 
 /* A regular torus: one periodic face, knots = the ring intervals. */
