@@ -46,7 +46,8 @@ class ccn_cage(ctypes.Structure):
                 ("face_verts", c_int32_p),
                 ("edge_verts", c_int32_p),
                 ("edge_knots", c_double_p),
-                ("edge_creases", c_double_p)]
+                ("edge_creases", c_double_p),
+                ("vertex_creases", c_double_p)]
 
 
 class ccn_options(ctypes.Structure):
@@ -54,7 +55,8 @@ class ccn_options(ctypes.Structure):
                 ("cap", ctypes.c_int),
                 ("levels", ctypes.c_int32),
                 ("boundary_corners", ctypes.c_int32),
-                ("threads", ctypes.c_int32)]
+                ("threads", ctypes.c_int32),
+                ("crease_method", ctypes.c_int32)]
 
 
 class ccn_sizes(ctypes.Structure):
@@ -69,14 +71,18 @@ class ccn_sizes(ctypes.Structure):
                 ("num_ev_fallbacks", ctypes.c_int32),
                 ("num_ring_conflicts", ctypes.c_int32),
                 ("num_ignored_verts", ctypes.c_int32),
-                ("num_ignored_edges", ctypes.c_int32)]
+                ("num_ignored_edges", ctypes.c_int32),
+                ("num_sharp_edges", ctypes.c_int32),
+                ("num_sharp_vertices", ctypes.c_int32),
+                ("num_sharp_corners", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):
     _fields_ = [("positions", c_double_p),
                 ("normals", c_double_p),
                 ("face_verts", c_int32_p),
-                ("face_origin", c_int32_p)]
+                ("face_origin", c_int32_p),
+                ("corner_normals", c_double_p)]
 
 
 _lib = None
