@@ -24,8 +24,8 @@ POS_TOL = 1e-5
 # Python calls push no undo step unless asked: ('EXEC_DEFAULT', True) makes an operator call push
 # its step exactly as a button or menu does (and only if the operator has the UNDO flag).
 UNDO = ('EXEC_DEFAULT', True)
-HANDLER_EVENTS = ("depsgraph_update_post", "load_post", "undo_post", "redo_post", "render_init",
-                  "save_pre")
+HANDLER_EVENTS = ("depsgraph_update_post", "frame_change_post", "load_post", "undo_post",
+                  "redo_post", "render_complete", "render_cancel", "save_pre", "save_post")
 
 
 class _Package:

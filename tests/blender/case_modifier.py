@@ -36,9 +36,9 @@ class TestModifier(AddonTestCase):
         s = ob.ccnurbs
         self.assertEqual((s.levels, s.render_levels, s.scheme, s.cap, s.boundary_smooth),
                          (2, 3, 'EIGEN', 'GUIDED_BI5', 'ALL'))
-        for p in (s.proxy, s.render_proxy):
+        for p in ccn.modifier.proxies(ob):
             self.assertEqual(len(p.users_collection), 0, "proxy must not be in a scene")
-        self.assertNotIn(s.proxy, list(bpy.context.scene.objects))
+        self.assertNotIn(ccn.modifier.proxy(ob, 'VIEW'), list(bpy.context.scene.objects))
 
     def test_closed_cage_with_ngons(self):
         ob = add_modifier(load_cage("Prism", os.path.join(DATA, "ngon_prism.obj")), levels=2)
@@ -50,7 +50,7 @@ class TestModifier(AddonTestCase):
         cagelib.set_knots(me, {k: 1.0 for k in cagelib.edge_keys(me)})
         add_modifier(ob)
         self.assertMatchesCLI(ob)
-        proxy_me = ob.ccnurbs.proxy.data
+        proxy_me = ccn.modifier.proxy(ob, 'VIEW').data
         loops_before = np.empty(len(proxy_me.loops), np.int32)
         proxy_me.loops.foreach_get("vertex_index", loops_before)
         st = dict(ccn.sync.stats)
@@ -64,8 +64,8 @@ class TestModifier(AddonTestCase):
         self.assertEqual(d["rebuilds"], 0, d)
         self.assertLessEqual(d["handler_calls"], 3, d)
         loops_after = np.empty(len(proxy_me.loops), np.int32)
-        ob.ccnurbs.proxy.data.loops.foreach_get("vertex_index", loops_after)
-        self.assertIs(ob.ccnurbs.proxy.data, proxy_me)
+        ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
+        self.assertIs(ccn.modifier.proxy(ob, 'VIEW').data, proxy_me)
         np.testing.assert_array_equal(loops_before, loops_after)
 
         # nothing changed: further updates do nothing (no loop)
@@ -76,8 +76,8 @@ class TestModifier(AddonTestCase):
         # what a proxy write looks like to the depsgraph (the cage is re-evaluated because its
         # modifier reads the proxy): the handler runs, sees the same content key, writes nothing
         st = dict(ccn.sync.stats)
-        ob.ccnurbs.proxy.data.update()
-        ob.ccnurbs.render_proxy.data.update()
+        ccn.modifier.proxy(ob, 'VIEW').data.update()
+        ccn.modifier.proxy(ob, 'RENDER').data.update()
         update()
         d = {k: ccn.sync.stats[k] - st[k] for k in st}
         self.assertGreaterEqual(d["handler_calls"], 1, d)
@@ -127,7 +127,7 @@ class TestModifier(AddonTestCase):
 
             def render(self, depsgraph):
                 for inst in depsgraph.object_instances:
-                    if inst.object.original.name == ob.name:
+                    if inst.object.original.name == ob.name and not inst.is_instance:
                         seen["verts"] = len(inst.object.data.vertices)
                         seen["positions"] = cagelib.mesh_positions(inst.object.data)
                 r = self.begin_result(0, 0, 4, 4)
@@ -151,16 +151,9 @@ class TestModifier(AddonTestCase):
         self.assertEqual(len(evaluated_positions(ob)), n_view, "viewport result not restored")
         self.assertMatchesCLI(ob, normals=False)
 
-    def test_save_reload_without_addon(self):
-        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
-        add_modifier(ob, scheme='NURSS', levels=2, render_levels=3)
-        ob.data.vertices[0].co.z = 1.3
-        ob.data.update()
-        update()
-        R, _ = reference(ob)
-        R3, _ = reference(ob, levels=3)
-        path = os.path.join(TMP, "reload.blend")
-        bpy.ops.wm.save_as_mainfile(filepath=path)
+    def _reload_without_addon(self, path):
+        """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender
+        without the add-on."""
         out = os.path.join(TMP, "reload.npy")
         script = os.path.join(TMP, "reload_check.py")
         with open(script, "w") as fh:
@@ -172,18 +165,54 @@ class TestModifier(AddonTestCase):
                 "me = ob.evaluated_get(dg).data\n"
                 "co = np.empty(3 * len(me.vertices), np.float32)\n"
                 "me.vertices.foreach_get('co', co)\n"
-                "rp = [o for o in bpy.data.objects if o.name.startswith('.CCNURBS render')][0]\n"
+                "n = [len(o.data.vertices) for p in ('.CCNURBS view', '.CCNURBS render')\n"
+                "     for o in bpy.data.objects if o.name.startswith(p)]\n"
                 "np.save(%r, co.reshape(-1, 3))\n"
-                "np.save(%r, np.array([len(rp.data.vertices)]))\n"
-                % (out, out + ".render.npy"))
+                "np.save(%r, np.array(n))\n" % (out, out + ".n.npy"))
         r = subprocess.run(blender_command(script, path), capture_output=True, text=True,
                            timeout=120)
         self.assertEqual(r.returncode, 0, r.stdout[-2000:] + r.stderr[-2000:])
-        P = np.load(out).astype(np.float64)
-        self.assertEqual(P.shape, R.shape)
-        self.assertLessEqual(np.abs(P - R).max(), POS_TOL)
-        self.assertEqual(int(np.load(out + ".render.npy")[0]), len(R3),
-                         "the saved render proxy is not at render_levels")
+        return np.load(out).astype(np.float64), list(np.load(out + ".n.npy"))
+
+    def test_save_reload_without_addon(self):
+        """Default: the file holds the cage and empty proxies; without the add-on it shows the
+        cage (as a file with Subsurf shows what Blender computes, here nothing to compute)."""
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob, scheme='NURSS', levels=2, render_levels=3)
+        ob.data.vertices[0].co.z = 1.3
+        ob.data.update()
+        update()
+        path = os.path.join(TMP, "reload.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        self.assertMatchesCLI(ob)  # the session keeps its limit across the save
+        P, counts = self._reload_without_addon(path)
+        np.testing.assert_array_equal(P, cagelib.mesh_positions(ob.data))
+        self.assertEqual(counts, [0, 0], "proxy meshes were saved")
+
+    def test_store_render_mesh_in_file(self):
+        """Store Render Mesh in File: the render-levels limit is in the file and shows (viewport
+        and render) where the add-on is not installed; the panel states its size."""
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob, scheme='NURSS', levels=2, render_levels=3)
+        ob.ccnurbs.store_render_mesh = True
+        ob.data.vertices[0].co.z = 1.3
+        ob.data.update()
+        update()
+        R3, _ = reference(ob, levels=3)
+        bpy.context.view_layer.objects.active = ob
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertRegex(shown, r"Render mesh in file: %d vertices, [0-9.]+ MB" % len(R3))
+        path = os.path.join(TMP, "reload_store.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        P, counts = self._reload_without_addon(path)
+        self.assertEqual(counts, [0, len(R3)])
+        self.assertEqual(P.shape, R3.shape)
+        self.assertLessEqual(np.abs(P - R3).max(), POS_TOL)
+        ob.ccnurbs.store_render_mesh = False
+        update()
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertIn("Render mesh: computed per frame when rendering, not saved", shown)
+        self.assertEqual(len(ccn.modifier.proxy(ob, 'RENDER').data.vertices), 0)
 
     def test_non_manifold_cage(self):
         ob = add_modifier(grid(2))
@@ -241,7 +270,7 @@ class TestModifier(AddonTestCase):
         dup = bpy.context.object
         self.assertIsNot(dup, ob)
         update()
-        self.assertIsNot(dup.ccnurbs.proxy, ob.ccnurbs.proxy)
+        self.assertIsNot(ccn.modifier.proxy(dup, 'VIEW'), ccn.modifier.proxy(ob, 'VIEW'))
         dup.data.vertices[4].co.z = 2.0
         dup.data.update()
         update()
@@ -283,7 +312,7 @@ class TestModifier(AddonTestCase):
 
     def test_remove(self):
         ob = add_modifier(grid(2, "Rm"))
-        proxy_name = ob.ccnurbs.proxy.name
+        proxy_name = ccn.modifier.proxy(ob, 'VIEW').name
         bpy.context.view_layer.objects.active = ob
         bpy.ops.ed.undo_push(message="before remove")
         self.assertEqual(bpy.ops.object.ccnurbs_remove(*UNDO), {'FINISHED'})

@@ -37,7 +37,7 @@ run() {
   tb=$(sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -c '^Traceback')
   if [ "$tb" -ne 0 ]; then
     echo "  run_blender: $tb Python traceback(s) in Blender's output:"
-    sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -A 12 '^Traceback' | sed 's/^/    /'
+    sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -A 16 "^Traceback" | sed 's/^/    /'
   fi
   if [ -z "$summary" ]; then
     echo "  run_blender: exited with $rc before the tests finished; last output:"

@@ -1,0 +1,244 @@
+"""Persistent app handlers: when to read the taps, sync, clean up. Handlers never raise.
+
+* depsgraph_update_post: the cages whose geometry changed → their taps in this depsgraph →
+  viewport proxies (Blender re-evaluates at once after our write, before drawing). Also the cheap
+  hygiene triggers (hygiene.suspicious, object/group counts).
+* frame_change_post: frame_set, playback and every frame of a render. Viewport depsgraph: the
+  viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
+  them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
+  then `depsgraph.update()` so the engine renders them (headless included).
+* render_complete / render_cancel: render proxies emptied and render plans freed (unless the
+  cage stores its render mesh in the file).
+* save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write; nothing is
+  evaluated or rebuilt.
+* load_post, undo_post, redo_post: hygiene, then every cage re-read.
+"""
+import traceback
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import hygiene, modifier, overlay, proxies, sync, tap
+
+_busy = [False]
+_counts = [None]
+
+
+def _guarded(fn, *args):
+    if _busy[0]:
+        return None
+    _busy[0] = True
+    try:
+        return fn(*args)
+    except Exception:
+        sync.stats["internal_errors"] += 1
+        traceback.print_exc()
+    finally:
+        _busy[0] = False
+    return None
+
+
+def run_collect():
+    renamed, fresh, _ = hygiene.collect()
+    for old, new in renamed:
+        sync.rename(old, new)
+    _counts[0] = hygiene.counts()
+    return fresh
+
+
+def _shown(obj, depsgraph):
+    mod = modifier.get_modifier(obj)
+    if mod is None:
+        return False
+    if depsgraph.mode == 'RENDER':
+        return mod.show_render
+    if obj.mode == 'EDIT' and not mod.show_in_editmode:
+        return False
+    return mod.show_viewport
+
+
+def sync_cages(depsgraph, objs, kind='VIEW', force=False):
+    """Reads the taps of `objs` from `depsgraph` and syncs their `kind` proxies. Returns the
+    number of proxies written."""
+    objs = [o for o in objs if modifier.is_cage(o) and o.library is None and _shown(o, depsgraph)]
+    taps = tap.read(depsgraph, objs)
+    written = 0
+    for obj in objs:
+        cage = taps.get(obj.name_full)
+        if cage is None:
+            sync.missing_tap(obj, kind)
+            continue
+        before = sync.stats["syncs"]
+        sync.sync_object(obj, kind, cage, force=force)
+        written += sync.stats["syncs"] - before
+        if kind == 'VIEW' and obj.ccnurbs.store_render_mesh and bpy.app.background:
+            sync.sync_object(obj, 'RENDER', cage)  # farm files from scripts: no idle timer here
+        elif kind == 'VIEW' and obj.ccnurbs.store_render_mesh:
+            _render_dirty.add(obj.name_full)
+    if _render_dirty and not bpy.app.background:
+        if bpy.app.timers.is_registered(_render_timer):
+            bpy.app.timers.unregister(_render_timer)
+        bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
+    return written
+
+
+RENDER_DELAY = 1.0  # seconds of quiet before stored render meshes are refreshed (UI only)
+_render_dirty = set()
+
+
+def _render_timer():
+    if _busy[0]:
+        return 0.2
+    names = set(_render_dirty)
+    _render_dirty.clear()
+    objs = [o for o in bpy.data.objects if o.name_full in names]
+
+    def run():
+        dg = bpy.context.evaluated_depsgraph_get()
+        sync_cages(dg, [o for o in objs if o.ccnurbs.store_render_mesh], 'RENDER')
+    _guarded(run)
+    return None
+
+
+def sync_all(depsgraph=None, force=False):
+    dg = depsgraph or bpy.context.evaluated_depsgraph_get()
+    return sync_cages(dg, modifier.cages(), 'VIEW', force)
+
+
+def _updated(depsgraph):
+    objs, meshes, geometry = set(), set(), set()
+    for u in depsgraph.updates:
+        idd = u.id.original if u.id.original is not None else u.id
+        if isinstance(idd, bpy.types.Object):
+            objs.add(idd)
+            if u.is_updated_geometry:
+                geometry.add(idd)
+        elif isinstance(idd, bpy.types.Mesh) and u.is_updated_geometry:
+            meshes.add(idd)
+    if meshes:
+        extra = {o for o in bpy.data.objects if o.data in meshes}
+        objs |= extra
+        geometry |= extra
+    return objs, geometry
+
+
+def _on_update(depsgraph):
+    objs, geometry = _updated(depsgraph)
+    if _counts[0] != hygiene.counts() or any(hygiene.suspicious(o) for o in objs):
+        fresh = run_collect()
+        geometry |= set(fresh)
+    sync_cages(depsgraph, [o for o in geometry if o.type == 'MESH'], 'VIEW')
+    overlay.on_objects_updated(geometry)
+
+
+@persistent
+def on_depsgraph_update_post(scene, depsgraph=None):
+    sync.stats["handler_calls"] += 1
+    _guarded(_on_update, depsgraph or bpy.context.evaluated_depsgraph_get())
+
+
+def _on_frame(depsgraph):
+    if depsgraph is None:
+        return
+    if depsgraph.mode == 'RENDER':
+        cages = modifier.cages(depsgraph.scene.objects)
+        if sync_cages(depsgraph, cages, 'RENDER'):
+            sync.stats["render_frames"] += 1
+            depsgraph.update()
+        return
+    if sync_cages(depsgraph, modifier.cages(depsgraph.scene.objects), 'VIEW'):
+        depsgraph.update()
+
+
+@persistent
+def on_frame_change_post(scene, depsgraph=None):
+    _guarded(_on_frame, depsgraph)
+
+
+def _after_render():
+    for obj in modifier.cages():
+        if not obj.ccnurbs.store_render_mesh and obj.library is None:
+            proxies.clear(modifier.proxy(obj, 'RENDER'))
+    sync.free_render_plans()
+
+
+@persistent
+def on_render_done(*args):
+    _guarded(_after_render)
+
+
+def _before_save():
+    run_collect()
+    proxies.detach_for_save([modifier.proxy(o, 'VIEW') for o in modifier.cages()])
+
+
+@persistent
+def on_save_pre(*args):
+    _guarded(_before_save)
+
+
+@persistent
+def on_save_post(*args):
+    _guarded(proxies.reattach_after_save)
+
+
+def _reload(forget):
+    if forget:
+        sync.forget_all()
+    run_collect()
+    sync_all()
+
+
+@persistent
+def on_load_post(*args):
+    _guarded(_reload, True)
+
+
+@persistent
+def on_undo_redo(*args):
+    _guarded(_reload, False)
+
+
+HANDLERS = (("depsgraph_update_post", on_depsgraph_update_post),
+            ("frame_change_post", on_frame_change_post), ("load_post", on_load_post),
+            ("undo_post", on_undo_redo), ("redo_post", on_undo_redo),
+            ("render_complete", on_render_done), ("render_cancel", on_render_done),
+            ("save_pre", on_save_pre), ("save_post", on_save_post))
+
+
+def _is_ours(fn, name):
+    """A handler of this module, also one left by an earlier load of it (same module name)."""
+    return getattr(fn, "__name__", None) == name and getattr(fn, "__module__", None) == __name__
+
+
+def _refresh_after_enable():
+    _guarded(_reload, False)
+    return None
+
+
+def register():
+    for event, fn in HANDLERS:
+        lst = getattr(bpy.app.handlers, event)
+        for h in [h for h in lst if _is_ours(h, fn.__name__)]:
+            lst.remove(h)
+        lst.append(fn)
+    # Enabling the add-on refreshes every surface: now if bpy.data is usable, else (Blender
+    # still starting) from a timer.
+    try:
+        bpy.data.objects
+    except AttributeError:
+        bpy.app.timers.register(_refresh_after_enable, first_interval=0.0)
+    else:
+        _refresh_after_enable()
+
+
+def unregister():
+    for event, fn in HANDLERS:
+        lst = getattr(bpy.app.handlers, event)
+        for h in [h for h in lst if h is fn or _is_ours(h, fn.__name__)]:
+            lst.remove(h)
+    for t in (_render_timer, _refresh_after_enable):
+        if bpy.app.timers.is_registered(t):
+            bpy.app.timers.unregister(t)
+    _render_dirty.clear()
+    sync.forget_all()
