@@ -245,15 +245,17 @@ def ensure(obj, context=None, fresh=False):
     if (fresh or not is_group(group) or view is None or render is None
             or owner_of(group) != obj.name_full):
         group = new_group_and_proxies(obj)  # hygiene.collect() deletes the old one if unused
-    if mod is None:
+    created = mod is None
+    if created:
         mod = obj.modifiers.new(MOD_NAME, 'NODES')
         mod.show_in_editmode = True
+    if mod.node_group != group:
+        mod.node_group = group  # before anything that may run the handlers (and hygiene)
+    if created:
         try:
             compat.move_modifier_first(obj, mod, context)
         except (RuntimeError, TypeError):
             pass  # stays last: still correct when no modifier before it changes geometry
-    if mod.node_group != group:
-        mod.node_group = group
     return mod
 
 
