@@ -123,6 +123,16 @@ def set_vertex_creases(mesh, values):
         mesh.vertex_creases[0].data.foreach_set("value", values)
 
 
+def drop_custom_normals(mesh):
+    """Removes custom normals where they are an attribute (4.4+: "custom_normal"); 3.x keeps
+    them (removing them needs an operator). Returns whether they went."""
+    a = mesh.attributes.get("custom_normal")
+    if a is None:
+        return False
+    mesh.attributes.remove(a)
+    return True
+
+
 def has_custom_normals(mesh):
     return bool(mesh.has_custom_normals)
 

@@ -22,6 +22,8 @@ from . import hygiene, modifier, overlay, proxies, sync, tap
 
 _busy = [False]
 _counts = [None]
+_saving = [False]  # between save_pre and save_post: the proxies are swapped out, read nothing
+_echo = set()      # cages whose proxies the save swapped back: their next update is our echo
 
 
 def _guarded(fn, *args):
@@ -122,18 +124,39 @@ def _updated(depsgraph):
     return objs, geometry
 
 
+def _is_echo(objs, geometry, depsgraph):
+    """The update only re-evaluated cages because the save swapped their proxies back."""
+    if not _echo:
+        return False
+    names = {o.name_full for o in objs}
+    cages = {n for n in names if n in _echo}
+    others = {o for o in objs if o.name_full not in cages and o.ccnurbs.role
+              not in hygiene.PROXY_ROLES}
+    meshes = [u for u in depsgraph.updates if isinstance(u.id, bpy.types.Mesh)
+              and not u.id.name.startswith(".CCNURBS")]
+    _echo.clear()
+    return not others and not meshes
+
+
 def _on_update(depsgraph):
     objs, geometry = _updated(depsgraph)
+    if _is_echo(objs, geometry, depsgraph):
+        return
+    fresh = []
     if _counts[0] != hygiene.counts() or any(hygiene.suspicious(o) for o in objs):
         fresh = run_collect()
-        geometry |= set(fresh)
-    sync_cages(depsgraph, [o for o in geometry if o.type == 'MESH'], 'VIEW')
+    sync_cages(depsgraph, [o for o in geometry if o.type == 'MESH' and o not in fresh], 'VIEW')
+    if fresh:  # new groups (copies): evaluate them now, then read their taps
+        depsgraph.update()
+        sync_cages(depsgraph, fresh, 'VIEW')
     overlay.on_objects_updated(geometry)
 
 
 @persistent
 def on_depsgraph_update_post(scene, depsgraph=None):
     sync.stats["handler_calls"] += 1
+    if _saving[0]:
+        return
     _guarded(_on_update, depsgraph or bpy.context.evaluated_depsgraph_get())
 
 
@@ -170,6 +193,13 @@ def on_render_done(*args):
 def _before_save():
     run_collect()
     proxies.detach_for_save([modifier.proxy(o, 'VIEW') for o in modifier.cages()])
+    _saving[0] = True
+
+
+def _after_save():
+    _saving[0] = False
+    if proxies.reattach_after_save():
+        _echo.update(o.name_full for o in modifier.cages())
 
 
 @persistent
@@ -179,7 +209,7 @@ def on_save_pre(*args):
 
 @persistent
 def on_save_post(*args):
-    _guarded(proxies.reattach_after_save)
+    _guarded(_after_save)
 
 
 def _reload(forget):

@@ -11,13 +11,14 @@ after updates that change the object or group count or touch a cage whose owners
   append with a new name): the group, its proxies and their names follow;
 * two live groups naming the same proxy (a duplicated node tree): the proxy stays with the
   group whose owner it records; the other cage gets new proxies;
-* a cage whose modifier is gone (Apply, X) stops being a cage;
+* a cage whose modifier is gone (Apply, X) stops being a cage; an applied limit loses its
+  marker attribute (and, 4.4+, the custom normals: the mesh Subsurf's Apply would give);
 * groups no live cage uses, proxies no live group names, and our empty/scratch meshes are
   deleted, so a saved file holds only what its scenes use.
 """
 import bpy
 
-from . import modifier, proxies
+from . import compat, modifier, proxies
 
 SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "normals",
             "store_render_mesh")
@@ -58,6 +59,19 @@ def _adopt(group, obj):
                 p.data.name = p.name
 
 
+def _applied(me):
+    """An applied limit (it carries the limit marker) keeps positions and faces like Subsurf's
+    Apply: the marker goes, and so do the custom normals where Python can remove them (4.4+),
+    so the mesh is what Subsurf's Apply would store (README: file size)."""
+    if me is None or me.library is not None:
+        return
+    a = me.attributes.get(proxies.LIMIT_ATTR)
+    if a is None:
+        return
+    me.attributes.remove(a)
+    compat.drop_custom_normals(me)
+
+
 def collect():
     """One hygiene pass. Returns (renamed [(old, new)], fresh [objects], removed count)."""
     users = {}
@@ -68,6 +82,7 @@ def collect():
         if mod is None:
             if o.ccnurbs.role == 'CAGE':
                 o.ccnurbs.role = 'NONE'  # applied or removed by hand
+                _applied(o.data)
             continue
         if is_live(o) and modifier.is_group(mod.node_group):
             users.setdefault(mod.node_group, []).append(o)

@@ -13,6 +13,7 @@ from . import compat
 
 EMPTY_NAME = ".CCNURBS empty"
 KEY_PROP = "ccnurbs_key"
+LIMIT_ATTR = "ccn_limit"  # FACE bool on every limit face: tells an applied limit from a cage
 TOPO_PROP = "ccnurbs_topology"
 
 _detached = []  # (proxy name, mesh name) swapped out for a save
@@ -46,9 +47,10 @@ def write_topology(me, res, cage, exact=True):
     me.loops.foreach_set("vertex_index", fv)
     compat.set_face_loops(me, np.arange(0, 4 * nf, 4, dtype=np.int32), np.full(nf, 4, np.int32))
     me.polygons.foreach_set("use_smooth", np.ones(nf, bool))
-    if cage.material_index is not None and len(cage.material_index):
+    if cage.material_index is not None and cage.material_index.any():  # all 0: no attribute
         origin = np.clip(res["face_origin"], 0, len(cage.material_index) - 1)
         me.polygons.foreach_set("material_index", cage.material_index[origin])
+    me.attributes.new(LIMIT_ATTR, 'BOOLEAN', 'FACE').data.foreach_set("value", np.ones(nf, bool))
     me.update(calc_edges=True)
     write_normals(me, res["normals"], exact)
 
@@ -109,6 +111,8 @@ def detach_for_save(view_proxies):
 
 
 def reattach_after_save():
+    """Gives the viewport proxies their meshes back; returns whether any was swapped."""
+    swapped = bool(_detached)
     for pname, mname in _detached:
         p, me = bpy.data.objects.get(pname), bpy.data.meshes.get(mname)
         if p is not None and me is not None:
@@ -117,3 +121,4 @@ def reattach_after_save():
     me = bpy.data.meshes.get(EMPTY_NAME)
     if me is not None and me.users == 0:
         bpy.data.meshes.remove(me)
+    return swapped
