@@ -118,8 +118,13 @@ def set_vertex_creases(mesh, values):
                                                                       'POINT')
         a.data.foreach_set("value", values)
     else:
-        if not mesh.vertex_creases:
-            mesh.vertex_creases.new()
+        if not mesh.vertex_creases:  # 3.x: the layer can only be made through BMesh
+            import bmesh
+            bm = bmesh.new()
+            bm.from_mesh(mesh)
+            bm.verts.layers.crease.verify()
+            bm.to_mesh(mesh)
+            bm.free()
         mesh.vertex_creases[0].data.foreach_set("value", values)
 
 
