@@ -24,6 +24,7 @@ _busy = [False]
 _counts = [None]
 _saving = [False]  # between save_pre and save_post: the proxies are swapped out, read nothing
 _echo = set()      # cages whose proxies the save swapped back: their next update is our echo
+_refresh = [False]  # enabled while bpy.data was restricted: refresh at the first chance
 
 
 def _guarded(fn, *args):
@@ -139,6 +140,10 @@ def _is_echo(objs, geometry, depsgraph):
 
 
 def _on_update(depsgraph):
+    if _refresh[0]:
+        _refresh[0] = False
+        run_collect()
+        sync_all(depsgraph)
     objs, geometry = _updated(depsgraph)
     if _is_echo(objs, geometry, depsgraph):
         return
@@ -241,8 +246,12 @@ def _is_ours(fn, name):
     return getattr(fn, "__name__", None) == name and getattr(fn, "__module__", None) == __name__
 
 
-def _refresh_after_enable():
-    _guarded(_reload, False)
+def refresh_after_enable():
+    """Every surface re-read after the add-on is enabled (a timer: add-ons register while
+    bpy.data is restricted; headless, where no timer fires, the first update does it)."""
+    if _refresh[0]:
+        _refresh[0] = False
+        _guarded(_reload, False)
     return None
 
 
@@ -252,14 +261,8 @@ def register():
         for h in [h for h in lst if _is_ours(h, fn.__name__)]:
             lst.remove(h)
         lst.append(fn)
-    # Enabling the add-on refreshes every surface: now if bpy.data is usable, else (Blender
-    # still starting) from a timer.
-    try:
-        bpy.data.objects
-    except AttributeError:
-        bpy.app.timers.register(_refresh_after_enable, first_interval=0.0)
-    else:
-        _refresh_after_enable()
+    _refresh[0] = True
+    bpy.app.timers.register(refresh_after_enable, first_interval=0.0)
 
 
 def unregister():
@@ -267,7 +270,7 @@ def unregister():
         lst = getattr(bpy.app.handlers, event)
         for h in [h for h in lst if h is fn or _is_ours(h, fn.__name__)]:
             lst.remove(h)
-    for t in (_render_timer, _refresh_after_enable):
+    for t in (_render_timer, refresh_after_enable):
         if bpy.app.timers.is_registered(t):
             bpy.app.timers.unregister(t)
     _render_dirty.clear()
