@@ -218,6 +218,7 @@ def on_save_post(*args):
 
 
 def _reload(forget):
+    _saving[0] = False  # a save that failed between save_pre and save_post ends here
     if forget:
         sync.forget_all()
     run_collect()
@@ -238,7 +239,8 @@ HANDLERS = (("depsgraph_update_post", on_depsgraph_update_post),
             ("frame_change_post", on_frame_change_post), ("load_post", on_load_post),
             ("undo_post", on_undo_redo), ("redo_post", on_undo_redo),
             ("render_complete", on_render_done), ("render_cancel", on_render_done),
-            ("save_pre", on_save_pre), ("save_post", on_save_post))
+            ("save_pre", on_save_pre), ("save_post", on_save_post)) + \
+    ((("save_post_fail", on_save_post),) if hasattr(bpy.app.handlers, "save_post_fail") else ())
 
 
 def _is_ours(fn, name):

@@ -17,6 +17,7 @@ after updates that change the object or group count or touch a cage whose owners
   deleted, so a saved file holds only what its scenes use.
 """
 import bpy
+import numpy as np
 
 from . import compat, modifier, proxies
 
@@ -69,7 +70,13 @@ def _applied(me):
     if a is None:
         return
     me.attributes.remove(a)
-    compat.drop_custom_normals(me)
+    if compat.drop_custom_normals(me):  # and the all-False sharp_edge custom normals made
+        e = me.attributes.get("sharp_edge")
+        if e is not None and e.domain == 'EDGE' and e.data_type == 'BOOLEAN':
+            v = np.empty(len(e.data), bool)
+            e.data.foreach_get("value", v)
+            if not v.any():
+                me.attributes.remove(e)
 
 
 def collect():

@@ -64,3 +64,45 @@ class TestPackage(unittest.TestCase):
             self.assertEqual(name, "bl_ext.user_default.ccnurbs")
         else:
             self.assertEqual(name, "ccnurbs")
+
+
+class TestSources(unittest.TestCase):
+    """Python standards of the add-on, checked on the shipped sources: no module over 800
+    lines, no import cycle among its modules (imports inside functions included)."""
+
+    def _sources(self):
+        with zipfile.ZipFile(ZIP) as z:
+            return {n.split("/")[1][:-3]: z.read(n).decode() for n in z.namelist()
+                    if n.endswith(".py")}
+
+    def test_small_modules(self):
+        for name, text in self._sources().items():
+            self.assertLessEqual(text.count("\n"), 800, name)
+
+    def test_no_import_cycles(self):
+        import ast
+        src = self._sources()
+        graph = {}
+        for name, text in src.items():
+            deps = set()
+            for node in ast.walk(ast.parse(text)):
+                if isinstance(node, ast.ImportFrom) and node.level == 1:
+                    if node.module:
+                        deps.add(node.module.split(".")[0])
+                    else:
+                        deps.update(a.name for a in node.names)
+            graph[name] = deps & set(src) - {name}
+        graph.pop("__init__", None)
+        state = {}
+
+        def visit(n, path):
+            state[n] = 1
+            for d in graph.get(n, ()):
+                if state.get(d) == 1:
+                    self.fail("import cycle: " + " -> ".join(path + [n, d]))
+                if d not in state:
+                    visit(d, path + [n])
+            state[n] = 2
+        for n in graph:
+            if n not in state:
+                visit(n, [])
