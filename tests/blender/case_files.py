@@ -249,5 +249,7 @@ class TestSaveCost(AddonTestCase):
               % (times["SUBSURF"][0], times["CCNURBS"][0], ratio, times["SUBSURF"][1],
                  times["CCNURBS"][1], ratio_next, sizes["SUBSURF"], sizes["CCNURBS"]))
         self.assertLessEqual(sizes["CCNURBS"], 1.2 * sizes["SUBSURF"], "the file holds more")
-        # the write itself, generous margin (target 1.2x); the evaluation after it is printed
-        self.assertLessEqual(ratio, 3.0, "saving is far slower than with Subsurf (target 1.2x)")
+        # the write itself, generous margin against millisecond noise (target 1.2x); the
+        # evaluation after it is printed
+        self.assertLessEqual(times["CCNURBS"][0], 3.0 * times["SUBSURF"][0] + 0.05,
+                             "saving is far slower than with Subsurf (target 1.2x)")
