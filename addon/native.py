@@ -161,32 +161,39 @@ class Plan:
     """A ccn_plan: topology, knot intervals and options, evaluated for new positions.
 
     cage: positions (V,3), face_sizes (F,), face_verts (sum,), edge_verts (E,2) or None,
-    edge_knots (E,) or None. options: dict scheme/cap/boundary (enum identifiers), levels.
+    edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None (passed as
+    ccn_cage.edge_creases, which the library reserves and does not use yet).
+    options: scheme/cap/boundary (enum identifiers), levels.
     """
 
     def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
-                 scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0):
+                 scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0,
+                 edge_sharpness=None):
         lib = load()
         self._lib = lib
         self._handle = None
         pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
         fs = np.ascontiguousarray(face_sizes, dtype=np.int32).reshape(-1)
         fv = np.ascontiguousarray(face_verts, dtype=np.int32).reshape(-1)
-        ev = ek = None
+        ev = ek = es = None
         if edge_verts is not None and len(edge_verts):
             ev = np.ascontiguousarray(edge_verts, dtype=np.int32).reshape(-1)
+            for name, arr in (("edge_knots", edge_knots), ("edge_sharpness", edge_sharpness)):
+                if arr is not None and np.size(arr) * 2 != ev.size:
+                    raise CCNError("CCN_ERR_ARGUMENT", "%s has %d values for %d edges"
+                                   % (name, np.size(arr), ev.size // 2))
             if edge_knots is not None:
                 ek = np.ascontiguousarray(edge_knots, dtype=np.float64).reshape(-1)
-                if ek.size * 2 != ev.size:
-                    raise CCNError("CCN_ERR_ARGUMENT", "edge_knots has %d values for %d edges"
-                                   % (ek.size, ev.size // 2))
+            if edge_sharpness is not None:  # ccn_cage.edge_creases: OpenSubdiv sharpness
+                es = np.ascontiguousarray(edge_sharpness, dtype=np.float64).reshape(-1)
         if pos.size % 3:
             raise CCNError("CCN_ERR_ARGUMENT", "positions must be 3 floats per vertex")
         cage = ccn_cage(num_verts=pos.size // 3, num_faces=fs.size,
                         num_edges=(ev.size // 2) if ev is not None else 0,
                         positions=_ptr(pos, ctypes.c_double), face_sizes=_ptr(fs, ctypes.c_int32),
                         face_verts=_ptr(fv, ctypes.c_int32), edge_verts=_ptr(ev, ctypes.c_int32),
-                        edge_knots=_ptr(ek, ctypes.c_double), edge_creases=None)
+                        edge_knots=_ptr(ek, ctypes.c_double),
+                        edge_creases=_ptr(es, ctypes.c_double))
         opts = ccn_options(scheme=SCHEMES[scheme], cap=CAPS[cap], levels=int(levels),
                            boundary_corners=CORNERS[boundary], threads=int(threads))
         handle = ctypes.c_void_p()
