@@ -61,6 +61,11 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     boundary_smooth: EnumProperty(name="Boundary Smooth", items=BOUNDARY_ITEMS, default='ALL',
                                   update=_tag)
     normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
+    use_creases: BoolProperty(
+        name="Use Creases", default=True, update=_tag,
+        description="Use the mesh's edge and vertex creases (Shift+E) as sharpness, mapped as the "
+                    "Subdivision Surface modifier does (sharpness 10 c²: crease 1 is infinitely "
+                    "sharp)")
     store_render_mesh: BoolProperty(
         name="Store Render Mesh in File", default=False, update=_store_changed,
         description="Keep the Render-levels limit mesh computed (refreshed a second after "
@@ -70,7 +75,7 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
 
     def option_tuple(self):
-        return (self.scheme, self.cap, self.boundary_smooth, self.normals)
+        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.use_creases)
 
 
 def _overlay_toggled(self, context):
