@@ -16,18 +16,24 @@ TEST_BIN = $(TEST_SRC:tests/c/%.c=$(B)/tests/%)
 HDRS     = $(wildcard csrc/*/*.h tests/c/*.h)
 
 APT_PKGS = build-essential clang libclang-rt-14-dev libosd-dev liblapacke-dev liblapack-dev \
-           python3 python3-numpy zip
+           python3 python3-numpy zip curl xz-utils
 
 .PHONY: all deps build test demo clean
 
 all: build
 
+# Each tests/*/NAME.mk may also append to DEPS_SCRIPTS: idempotent scripts run after the Debian
+# packages are in (downloads they make are cached outside the checkout).
+DEPS_SCRIPTS =
+
 # Each tests/*/NAME.mk may add rules and append to TEST_DEPS (built before tests run).
 TEST_DEPS =
 -include $(wildcard tests/*/*.mk)
 
+
 deps:
 	@./tests/deps.sh $(APT_PKGS)
+	@for s in $(DEPS_SCRIPTS); do sh $$s >/dev/null || exit 1; done
 
 build: $(B)/libccnurbs.so $(B)/libccnurbs.a $(B)/ccnurbs
 

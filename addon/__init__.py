@@ -17,8 +17,9 @@ bl_info = {
     "doc_url": "",
 }
 
-_SUBMODULES = ("compat", "native", "cage", "props", "knots", "modifier", "sync", "operators",
-               "overlay", "ui")
+_SUBMODULES = ("compat", "native", "cage", "props", "values", "knots", "modifier", "tap",
+               "proxies", "sync", "hygiene", "overlay", "handlers", "objio", "operators", "errors",
+               "ui")
 if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency order
     import importlib
     for _name in _SUBMODULES:
@@ -27,26 +28,28 @@ if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency ord
 
 import bpy  # noqa: E402
 
-from . import (compat, native, cage, props, knots, modifier, sync, operators,  # noqa: E402
-               overlay, ui)
+from . import (compat, native, cage, props, values, knots, modifier, tap, proxies,  # noqa: E402
+               sync, hygiene, overlay, handlers, objio, operators, errors, ui)
 
-_modules = (compat, native, cage, props, knots, modifier, sync, operators, overlay, ui)
-_classes = props.classes + knots.classes + operators.classes + ui.classes
+_classes = (props.classes + knots.classes + objio.classes + operators.classes + errors.classes
+            + ui.classes)
 
 
 def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
     props.register()
-    sync.register()
     overlay.register()
     ui.register()
+    objio.register()
+    handlers.register()
 
 
 def unregister():
+    handlers.unregister()
+    objio.unregister()
     ui.unregister()
     overlay.unregister()
-    sync.unregister()
     props.unregister()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

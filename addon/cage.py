@@ -1,8 +1,14 @@
-"""Reads a cage mesh into numpy arrays: positions, polygons, edges, knot intervals.
+"""Reads a cage mesh into numpy arrays: positions, polygons, edges, knot intervals, creases.
 
-Object mode reads the Mesh with foreach_get. Edit mode reads through bmesh: the edit BMesh is
-copied into a scratch Mesh (`BMesh.to_mesh`, one C call) and read the same way, so no Python
-loop ever runs over vertices or edges.
+Two sources: the evaluated input tap of the modifier (tap.py: the mesh after the modifiers above
+CCNURBS, true positions in the point attribute "ccn_co"), which the modifier computes from; and
+the object's own mesh (object mode: the Mesh; edit mode: the edit BMesh copied into a scratch
+Mesh with one C call), which the knot operators act on. Every array is read with foreach_get;
+no Python loop runs over elements.
+
+Values, one meaning everywhere: a knot interval <= 0, NaN or Inf is unset (= 1); the library
+reads it the same way. Creases are Blender's [0, 1] values; `sharpness()` maps them as Blender's
+Subdivision Surface does (10 c^2, OpenSubdiv sharpness).
 """
 import hashlib
 
@@ -10,13 +16,16 @@ import bmesh
 import bpy
 import numpy as np
 
+from . import compat
+
 KNOT_ATTR = "knot_interval"
 SCRATCH_NAME = ".ccnurbs_scratch"
 
 
 class Cage:
     __slots__ = ("positions", "face_sizes", "face_verts", "loop_edges", "edge_verts", "knots",
-                 "material_index", "edge_select", "num_materials")
+                 "material_index", "edge_select", "num_materials", "edge_creases",
+                 "vertex_creases")
 
     @property
     def num_verts(self):
@@ -26,19 +35,40 @@ class Cage:
     def num_edges(self):
         return len(self.edge_verts)
 
-    def topology_key(self, *settings):
+    def loose_counts(self):
+        """(vertices in no face, edges in no face): computed here, whatever the library says."""
+        used_v = np.zeros(self.num_verts, bool)
+        used_v[self.face_verts] = True
+        used_e = np.zeros(self.num_edges, bool)
+        used_e[self.loop_edges] = True
+        return int((~used_v).sum()), int((~used_e).sum())
+
+    def topology_key(self, *settings, creases=False):
         """Hash of everything a plan (and the proxy's topology) depends on except positions:
-        polygons, edges, intervals, material indices, settings."""
+        polygons, edges, intervals, material indices, settings (and creases once the library
+        uses them)."""
         h = hashlib.blake2b(digest_size=16)
         for a in (self.face_sizes, self.face_verts, self.edge_verts, self.material_index):
             h.update(np.ascontiguousarray(a).tobytes())
             h.update(b"|")
         h.update(b"K" + (self.knots.tobytes() if self.knots is not None else b"-"))
+        if creases:
+            for a in (self.edge_creases, self.vertex_creases):
+                h.update(b"C" + (a.tobytes() if a is not None else b"-"))
         h.update(repr((len(self.positions),) + settings).encode())
         return h.hexdigest()
 
     def position_key(self):
         return hashlib.blake2b(self.positions.tobytes(), digest_size=16).hexdigest()
+
+
+def sharpness(creases):
+    """Blender crease c in [0, 1] -> OpenSubdiv sharpness 10 c^2 (Blender's Subdivision Surface
+    mapping, `BKE_subdiv_crease_to_sharpness_f`); None stays None."""
+    if creases is None:
+        return None
+    c = np.clip(np.nan_to_num(creases, nan=0.0), 0.0, 1.0)
+    return 10.0 * c * c
 
 
 _scratch = [SCRATCH_NAME]  # actual name (a library may already use SCRATCH_NAME)
@@ -53,9 +83,8 @@ def _scratch_mesh():
 
 
 def source_mesh(obj, editmesh=True):
-    """The Mesh holding the cage's current state: the object's mesh, or (edit mode) a scratch
-    copy of the edit BMesh. editmesh=False reads the Mesh even in edit mode (render threads:
-    Blender flushes edit data before rendering; the scratch copy would write bpy.data)."""
+    """The Mesh holding the object's own current state: its mesh, or (edit mode) a scratch copy
+    of the edit BMesh."""
     me = obj.data
     if me.is_editmode and editmesh:
         bm = bmesh.from_edit_mesh(me)
@@ -72,12 +101,22 @@ def knot_attribute(me):
     return None
 
 
-def read_mesh(me, selection=False):
-    c = Cage()
-    nv, ne, nl, nf = len(me.vertices), len(me.edges), len(me.loops), len(me.polygons)
+def _positions(me, position_attr):
+    nv = len(me.vertices)
     co = np.empty(3 * nv, np.float32)
-    me.vertices.foreach_get("co", co)
-    c.positions = co.reshape(nv, 3).astype(np.float64)
+    a = me.attributes.get(position_attr) if position_attr else None
+    if a is not None and a.domain == 'POINT' and a.data_type == 'FLOAT_VECTOR':
+        a.data.foreach_get("vector", co)
+    else:
+        me.vertices.foreach_get("co", co)
+    return co.reshape(nv, 3).astype(np.float64)
+
+
+def read_mesh(me, selection=False, position_attr=None, attributes=True):
+    """attributes=False: positions and topology only (knots, creases None; material 0)."""
+    c = Cage()
+    ne, nl, nf = len(me.edges), len(me.loops), len(me.polygons)
+    c.positions = _positions(me, position_attr)
     c.face_sizes = np.empty(nf, np.int32)
     me.polygons.foreach_get("loop_total", c.face_sizes)
     c.face_verts = np.empty(nl, np.int32)
@@ -93,15 +132,18 @@ def read_mesh(me, selection=False):
     ev = np.empty(2 * ne, np.int32)
     me.edges.foreach_get("vertices", ev)
     c.edge_verts = ev.reshape(ne, 2)
-    a = knot_attribute(me)
-    if a is not None:
+    a = knot_attribute(me) if attributes else None
+    if a is not None and len(a.data) == ne:
         k = np.empty(ne, np.float32)
         a.data.foreach_get("value", k)
         c.knots = k.astype(np.float64)
     else:
         c.knots = None
-    c.material_index = np.empty(nf, np.int32)
-    me.polygons.foreach_get("material_index", c.material_index)
+    c.edge_creases = compat.edge_creases(me) if attributes else None
+    c.vertex_creases = compat.vertex_creases(me) if attributes else None
+    c.material_index = np.zeros(nf, np.int32)
+    if attributes or compat.VERSION < (4, 0, 0):
+        me.polygons.foreach_get("material_index", c.material_index)
     c.num_materials = len(me.materials)
     if selection:
         s = np.empty(ne, bool)
@@ -113,5 +155,5 @@ def read_mesh(me, selection=False):
 
 
 def read(obj, selection=False, editmesh=True):
-    """The cage of a mesh object (edit mode included)."""
+    """The object's own mesh as a cage (edit mode included): what the knot operators edit."""
     return read_mesh(source_mesh(obj, editmesh), selection)

@@ -1,6 +1,6 @@
 """Every Blender 3.x / 4.x API difference used by the add-on lives here.
 
-Tested on Blender 3.4; written for 4.2+ (extension platform) from the 4.x API documentation.
+Tested headless on Blender 3.4.1 (Debian), 4.5 LTS and 5.0 (PyPI `bpy` wheels).
 """
 import bpy
 
@@ -44,6 +44,14 @@ def set_vertex_normals(mesh, normals):
     mesh.normals_split_custom_set_from_vertices(normals)
 
 
+def set_corner_normals(mesh, normals):
+    """Custom split normals per face corner (loop order), smooth shading: each side of a crease
+    keeps its own exact normal. < 4.1 needs `use_auto_smooth`, as above."""
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = True
+    mesh.normals_split_custom_set(normals)
+
+
 def use_plain_normals(mesh):
     """Blender's own smooth vertex normals (no custom normals): < 4.1 turns auto smooth off
     (custom normals are then ignored); 4.1+ has none after `clear_geometry`."""
@@ -63,6 +71,79 @@ def corner_normals(mesh):
         mesh.calc_normals_split()
         mesh.loops.foreach_get("normal", out)
     return out.reshape(n, 3)
+
+
+def edge_creases(mesh):
+    """Edge creases in [0, 1] as float64, or None if the mesh has none: the `crease_edge`
+    attribute (4.0+) vs `MeshEdge.crease` (3.x, zeros when unset)."""
+    import numpy as np
+    n = len(mesh.edges)
+    a = mesh.attributes.get("crease_edge") if VERSION >= (4, 0, 0) else None
+    out = np.empty(n, np.float32)
+    if a is not None and a.domain == 'EDGE' and a.data_type == 'FLOAT' and len(a.data) == n:
+        a.data.foreach_get("value", out)
+    elif VERSION < (4, 0, 0) and n:
+        mesh.edges.foreach_get("crease", out)
+        if not out.any():
+            return None
+    else:
+        return None
+    return out.astype(np.float64)
+
+
+def vertex_creases(mesh):
+    """Vertex creases in [0, 1] as float64, or None: the `crease_vert` attribute (4.0+) vs the
+    `Mesh.vertex_creases` layer (3.x)."""
+    import numpy as np
+    n = len(mesh.vertices)
+    out = np.empty(n, np.float32)
+    if VERSION >= (4, 0, 0):
+        a = mesh.attributes.get("crease_vert")
+        if a is None or a.domain != 'POINT' or a.data_type != 'FLOAT' or len(a.data) != n:
+            return None
+        a.data.foreach_get("value", out)
+    else:
+        layers = getattr(mesh, "vertex_creases", None)
+        if not layers or len(layers[0].data) != n:
+            return None
+        layers[0].data.foreach_get("value", out)
+    return out.astype(np.float64)
+
+
+def set_edge_creases(mesh, values):
+    """Writes edge creases (float array, one per edge): attribute (4.0+) / MeshEdge.crease."""
+    if VERSION >= (4, 0, 0):
+        a = mesh.attributes.get("crease_edge") or mesh.attributes.new("crease_edge", 'FLOAT',
+                                                                      'EDGE')
+        a.data.foreach_set("value", values)
+    else:
+        mesh.edges.foreach_set("crease", values)
+
+
+def set_vertex_creases(mesh, values):
+    if VERSION >= (4, 0, 0):
+        a = mesh.attributes.get("crease_vert") or mesh.attributes.new("crease_vert", 'FLOAT',
+                                                                      'POINT')
+        a.data.foreach_set("value", values)
+    else:
+        if not mesh.vertex_creases:  # 3.x: the layer can only be made through BMesh
+            import bmesh
+            bm = bmesh.new()
+            bm.from_mesh(mesh)
+            bm.verts.layers.crease.verify()
+            bm.to_mesh(mesh)
+            bm.free()
+        mesh.vertex_creases[0].data.foreach_set("value", values)
+
+
+def drop_custom_normals(mesh):
+    """Removes custom normals where they are an attribute (4.4+: "custom_normal"); 3.x keeps
+    them (removing them needs an operator). Returns whether they went."""
+    a = mesh.attributes.get("custom_normal")
+    if a is None:
+        return False
+    mesh.attributes.remove(a)
+    return True
 
 
 def has_custom_normals(mesh):
@@ -98,6 +179,12 @@ def blf_size(font_id, size):
 
 
 # ---- context ----------------------------------------------------------------------------------
+
+def has_evaluated_geometry():
+    """`Object.evaluated_geometry()` (4.3+): the evaluated GeometrySet with its instance
+    references, read per object instead of walking `depsgraph.object_instances`."""
+    return hasattr(bpy.types.Object, "evaluated_geometry")
+
 
 def temp_override(context, **kw):
     """Context override: `context.temp_override` (3.2+ and 4.x)."""

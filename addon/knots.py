@@ -2,8 +2,8 @@
 
 An interval belongs to an edge ring (opposite edges of every quad carry the same value), so the
 operators always act on whole rings. Values live in the EDGE float attribute `knot_interval`
-(<= 0 or absent = 1). Ring labels are computed with numpy from the cage arrays; the values are
-written through the edit BMesh layer, only on the edges that change.
+(absent, <= 0, NaN or Inf = unset = 1; values.py). Ring labels are computed with numpy from the
+cage arrays; the values are written through the edit BMesh layer, only on the edges that change.
 """
 import bmesh
 import bpy
@@ -11,6 +11,7 @@ import numpy as np
 from bpy.props import EnumProperty, FloatProperty
 
 from . import cage as cagemod
+from . import values
 
 KNOT_ATTR = cagemod.KNOT_ATTR
 
@@ -92,8 +93,9 @@ class MESH_OT_ccnurbs_set_knot_interval(_EditMeshOp, bpy.types.Operator):
     bl_label = "Set Knot Interval"
     bl_options = {'REGISTER', 'UNDO'}
 
-    value: FloatProperty(name="Interval", description="Knot interval of the rings "
-                         "(only ratios matter; 1 = uniform)", default=1.0, min=1e-6,
+    value: FloatProperty(name="Interval", description="Knot interval of the rings: a positive "
+                         "finite number (only ratios matter; 1 = uniform). Other values are "
+                         "refused with a message; Clear resets to 1", default=1.0,
                          soft_min=0.01, soft_max=100.0, precision=3)
 
     def invoke(self, context, event):
@@ -102,6 +104,10 @@ class MESH_OT_ccnurbs_set_knot_interval(_EditMeshOp, bpy.types.Operator):
         return self.execute(context)
 
     def execute(self, context):
+        refused = values.check_storable(self.value)
+        if refused:
+            self.report({'ERROR'}, refused)
+            return {'CANCELLED'}
         total_edges = total_rings = changed = 0
         for obj in _edit_objects(context):
             bm, idx, nrings, nsel = _selected_rings(obj)

@@ -1,18 +1,40 @@
-"""The CCNURBS modifier: a Geometry Nodes modifier whose group reads hidden proxy objects.
+"""The CCNURBS modifier: a Geometry Nodes modifier whose group shows a proxy mesh and hands its
+own input to Python.
 
 Python cannot define modifier types, so `object.ccnurbs_add` adds a Nodes modifier named
-"CCNURBS" with a per-cage group
+"CCNURBS" with a per-cage group:
 
-    Object Info(viewport proxy) ─┐
-    Object Info(render proxy)  ──┤ Switch(Is Viewport) ─┬──────────────────────┐
-    Is Viewport ─────────────────┘                      └ Domain Size > 0 ─ Switch → Output
-    Group Input (the cage) ─────────────────────────────────────────────────┘
+    Group Input ─ Separate Components ─ Mesh ─┬─ Store "ccn_co" ─ Geometry to Instance
+                                              │    ─ Scale Instances (0) ─────────────────── Join → Output
+                                              │                                              ↑
+    Object Info(viewport proxy) ┐             └──────────────────────────────┐ (no limit yet)│
+    Object Info(render proxy) ──┴ Switch(Is Viewport; own proxy, else the other) ┴ Switch ───┤
+                                      other components (curves, points, instances) ──────────┘
 
-(an empty proxy — no valid limit yet — shows the cage itself instead of nothing).
+* **The input tap.** The group's input is the cage as evaluated by every modifier above CCNURBS
+  (Mirror, Armature, shape keys, Lattice, Array, Solidify, Displace, Geometry Nodes...), with its
+  attributes (`knot_interval`, creases) propagated by Blender. The group outputs that mesh as one
+  instance scaled to zero (it draws and renders as nothing; the instance reference keeps the
+  true geometry), marked by the point attribute "ccn_co". Python (tap.py) reads it from the
+  evaluated object after each evaluation: no second evaluation of the stack, no copy of the
+  modifiers. Apply drops instances, so the applied mesh is the limit only. The input's own
+  instances are dropped (the tap is the only instance); curves, points and volumes pass.
+* **The output.** The viewport proxy (`levels`) in the viewport; in a render the render proxy
+  (`render_levels`), written per frame during the render (handlers.py); each falls back to the
+  other when empty (files keep at most the render mesh); the input mesh itself while there is
+  no valid limit (e.g. a file opened without the add-on).
 
-The proxies are mesh objects linked to no scene, written by the depsgraph handler (sync.py) at
-`levels` (viewport proxy) and `render_levels` (render proxy). They are saved in the .blend, so a
-file shows and renders its limit surface even where the add-on is not installed.
+Rejected designs (measured or tried headless on 3.4, 4.5 and 5.0; README "Design notes"):
+reading `obj.data` (ignores the stack); toggling the modifier off to evaluate the stack (a second
+full evaluation and an update loop per change); a hidden object with copies of the modifiers
+above (evaluates the stack twice and cannot follow drivers or modifier edits reliably); a
+fingerprint switch that passes the input through while the proxy is stale (no exact hash of a
+mesh in Geometry Nodes 3.4; a collision shows a stale surface).
+
+Ownership: a group records its cage (`group["ccnurbs_owner"]`) and is used by that cage only; the
+proxies are the objects its Object Info nodes name (no pointer on the cage, so deleting a cage
+leaves nothing holding them). hygiene.py gives duplicates and copied modifiers their own group
+and proxies and deletes whatever no live cage uses.
 """
 import bpy
 
@@ -20,10 +42,25 @@ from . import compat
 
 MOD_NAME = "CCNURBS"
 GROUP_TAG = "ccnurbs_group"
+OWNER_PROP = "ccnurbs_owner"
+TAP_ATTR = "ccn_co"
+VIEW_NODE, RENDER_NODE = "Viewport Proxy", "Render Proxy"
+PROXY_PREFIX = {'VIEW_PROXY': ".CCNURBS view ", 'RENDER_PROXY': ".CCNURBS render "}
+
+
+def is_group(group):
+    return group is not None and bool(group.get(GROUP_TAG))
 
 
 def get_modifier(obj):
-    mod = obj.modifiers.get(MOD_NAME) if obj is not None else None
+    """The object's CCNURBS modifier: a Nodes modifier using one of our groups (any name), or
+    the one named CCNURBS."""
+    if obj is None or obj.type != 'MESH':
+        return None
+    for mod in obj.modifiers:
+        if mod.type == 'NODES' and is_group(mod.node_group):
+            return mod
+    mod = obj.modifiers.get(MOD_NAME)
     return mod if mod is not None and mod.type == 'NODES' else None
 
 
@@ -36,132 +73,211 @@ def cages(objects=None):
     return [o for o in (bpy.data.objects if objects is None else objects) if is_cage(o)]
 
 
-def _new_proxy(obj, role):
-    name = (".CCNURBS view " if role == 'VIEW_PROXY' else ".CCNURBS render ") + obj.name
-    me = bpy.data.meshes.new(name)
-    proxy = bpy.data.objects.new(name, me)
-    proxy.ccnurbs.role = role
-    proxy.ccnurbs.owner_name = obj.name
-    return proxy
-
-
-def _group_proxies(group):
-    """(viewport, render) objects referenced by one of our node groups."""
+def group_proxies(group):
+    """(viewport, render) proxy objects named by one of our groups."""
     view = render = None
+    if group is None:
+        return view, render
     for node in group.nodes:
         if node.bl_idname == 'GeometryNodeObjectInfo':
-            ob = node.inputs[0].default_value
-            if node.name == "Viewport Proxy":
-                view = ob
-            elif node.name == "Render Proxy":
-                render = ob
+            if node.name == VIEW_NODE:
+                view = node.inputs[0].default_value
+            elif node.name == RENDER_NODE:
+                render = node.inputs[0].default_value
     return view, render
 
 
-def _build_group(obj, view, render):
-    group = bpy.data.node_groups.new("CCNURBS " + obj.name, 'GeometryNodeTree')
+def proxies(obj):
+    mod = get_modifier(obj)
+    return group_proxies(mod.node_group if mod is not None else None)
+
+
+def proxy(obj, kind):
+    view, render = proxies(obj)
+    return view if kind == 'VIEW' else render
+
+
+def proxy_name(role, owner_name):
+    return PROXY_PREFIX[role] + owner_name
+
+
+def new_proxy(owner_name, role):
+    name = proxy_name(role, owner_name)
+    me = bpy.data.meshes.new(name)
+    p = bpy.data.objects.new(name, me)
+    p.ccnurbs.role = role
+    p.ccnurbs.owner_name = owner_name
+    return p
+
+
+def _link(links, a, b):
+    links.new(a, b)
+
+
+def _store_vector_sockets(node):
+    node.data_type = 'FLOAT_VECTOR'
+    node.domain = 'POINT'
+    name = node.inputs["Name"]
+    value = [s for s in node.inputs if s.type == 'VECTOR' and s.enabled][0]
+    return name, value
+
+
+def _first_nonempty(nodes, links, first, second, location):
+    """Switch node output: `first` if it has points, else `second`."""
+    x, y = location
+    size = nodes.new('GeometryNodeAttributeDomainSize')
+    size.location = (x - 340, y - 80)
+    _link(links, first, size.inputs[0])
+    full = nodes.new('ShaderNodeMath')
+    full.operation = 'GREATER_THAN'
+    full.inputs[1].default_value = 0.5
+    full.location = (x - 170, y - 80)
+    _link(links, size.outputs['Point Count'], full.inputs[0])
+    sw = nodes.new('GeometryNodeSwitch')
+    sw.location = (x, y)
+    s, f_in, t_in, out = compat.switch_geometry_sockets(sw)
+    _link(links, full.outputs[0], s)
+    _link(links, second, f_in)
+    _link(links, first, t_in)
+    return out
+
+
+def build_group(owner_name, view, render):
+    group = bpy.data.node_groups.new("CCNURBS " + owner_name, 'GeometryNodeTree')
     group[GROUP_TAG] = 1
+    group[OWNER_PROP] = owner_name
     compat.new_group_socket(group, "Geometry", 'INPUT', 'NodeSocketGeometry')
     compat.new_group_socket(group, "Geometry", 'OUTPUT', 'NodeSocketGeometry')
     nodes, links = group.nodes, group.links
     gin = nodes.new('NodeGroupInput')
-    gin.location = (-600, 0)
+    gin.location = (-900, 0)
     gout = nodes.new('NodeGroupOutput')
-    gout.location = (300, 0)
+    gout.location = (1100, 0)
+    sep = nodes.new('GeometryNodeSeparateComponents')
+    sep.location = (-700, 0)
+    _link(links, gin.outputs[0], sep.inputs[0])
+    mesh_in = sep.outputs["Mesh"]
+    # the tap: the input mesh as one instance scaled to zero (draws and renders as nothing; its
+    # reference keeps true positions); "ccn_co" marks it (and keeps the positions once more)
+    store = nodes.new('GeometryNodeStoreNamedAttribute')
+    store.name = store.label = "Tap"
+    store.location = (-450, -350)
+    name_in, value_in = _store_vector_sockets(store)
+    name_in.default_value = TAP_ATTR
+    pos = nodes.new('GeometryNodeInputPosition')
+    pos.location = (-650, -450)
+    _link(links, mesh_in, store.inputs["Geometry"])
+    _link(links, pos.outputs[0], value_in)
+    inst = nodes.new('GeometryNodeGeometryToInstance')
+    inst.location = (-250, -350)
+    _link(links, store.outputs[0], inst.inputs[0])
+    hide = nodes.new('GeometryNodeScaleInstances')
+    hide.location = (-50, -350)
+    _link(links, inst.outputs[0], hide.inputs["Instances"])
+    hide.inputs["Scale"].default_value = (0.0, 0.0, 0.0)
+    # the output: a proxy, or the input mesh while there is no limit
     infos = []
-    for i, (name, ob) in enumerate((("Viewport Proxy", view), ("Render Proxy", render))):
+    for i, (name, ob) in enumerate(((VIEW_NODE, view), (RENDER_NODE, render))):
         info = nodes.new('GeometryNodeObjectInfo')
         info.name = info.label = name
         info.transform_space = 'ORIGINAL'
         info.inputs[0].default_value = ob
-        info.location = (-300, 150 - 250 * i)
+        info.location = (-450, 450 - 250 * i)
         infos.append(info)
+    # each depsgraph shows its own proxy if it has points, else the other one (a file saved with
+    # its render mesh but without the viewport one shows the render mesh in the viewport too)
+    view_geo, render_geo = infos[0].outputs['Geometry'], infos[1].outputs['Geometry']
+    view_or_render = _first_nonempty(nodes, links, view_geo, render_geo, (-80, 450))
+    render_or_view = _first_nonempty(nodes, links, render_geo, view_geo, (-80, 150))
     isview = nodes.new('GeometryNodeIsViewport')
-    isview.location = (-300, 300)
-    switch = nodes.new('GeometryNodeSwitch')
-    switch.location = (0, 0)
-    sw, false_in, true_in, proxy_out = compat.switch_geometry_sockets(switch)
-    links.new(isview.outputs[0], sw)
-    links.new(infos[0].outputs['Geometry'], true_in)
-    links.new(infos[1].outputs['Geometry'], false_in)
+    isview.location = (100, 450)
+    vsw = nodes.new('GeometryNodeSwitch')
+    vsw.location = (300, 300)
+    s, f_in, t_in, proxy_out = compat.switch_geometry_sockets(vsw)
+    _link(links, isview.outputs[0], s)
+    _link(links, render_or_view, f_in)
+    _link(links, view_or_render, t_in)
     size = nodes.new('GeometryNodeAttributeDomainSize')
-    size.location = (200, 200)
-    links.new(proxy_out, size.inputs[0])
+    size.location = (500, 200)
+    _link(links, proxy_out, size.inputs[0])
     nonempty = nodes.new('ShaderNodeMath')
     nonempty.operation = 'GREATER_THAN'
     nonempty.inputs[1].default_value = 0.5
-    nonempty.location = (400, 200)
-    links.new(size.outputs['Point Count'], nonempty.inputs[0])
+    nonempty.location = (650, 200)
+    _link(links, size.outputs['Point Count'], nonempty.inputs[0])
     fallback = nodes.new('GeometryNodeSwitch')
-    fallback.location = (600, 0)
-    sw2, cage_in, limit_in, out = compat.switch_geometry_sockets(fallback)
-    links.new(nonempty.outputs[0], sw2)
-    links.new(gin.outputs[0], cage_in)
-    links.new(proxy_out, limit_in)
-    gout.location = (850, 0)
-    links.new(out, gout.inputs[0])
+    fallback.location = (800, 50)
+    s, cage_in, limit_in, out = compat.switch_geometry_sockets(fallback)
+    _link(links, nonempty.outputs[0], s)
+    _link(links, mesh_in, cage_in)
+    _link(links, proxy_out, limit_in)
+    join = nodes.new('GeometryNodeJoinGeometry')
+    join.location = (950, 0)
+    _link(links, out, join.inputs[0])
+    for sock in sep.outputs:  # curves, points, volumes pass through (the input's instances do
+        if sock.name not in ("Mesh", "Instances"):  # not: the tap is the only instance)
+            _link(links, sock, join.inputs[0])
+    _link(links, hide.outputs[0], join.inputs[0])
+    _link(links, join.outputs[0], gout.inputs[0])
     return group
 
 
-def ensure(obj, context=None):
-    """Creates or repairs the modifier, its node group and the two proxies of a cage.
-    A duplicated cage (sharing its original's group) gets its own group and proxies."""
+def owner_of(group):
+    return group.get(OWNER_PROP, "") if group is not None else ""
+
+
+def new_group_and_proxies(obj):
+    """A fresh group and two fresh proxies for obj (duplicates, copied modifiers, new cages)."""
+    view = new_proxy(obj.name_full, 'VIEW_PROXY')
+    render = new_proxy(obj.name_full, 'RENDER_PROXY')
+    return build_group(obj.name_full, view, render)
+
+
+def ensure(obj, context=None, fresh=False):
+    """Creates or repairs the modifier, its node group and the two proxies of a cage. fresh=True
+    replaces a group that another object owns (a duplicate or a copied modifier)."""
     s = obj.ccnurbs
     if s.role != 'CAGE':
         s.role = 'CAGE'
     mod = get_modifier(obj)
     group = mod.node_group if mod is not None else None
-    view, render = s.proxy, s.render_proxy
-    if not _owned(view, obj):
-        view = s.proxy = _new_proxy(obj, 'VIEW_PROXY')
-    if not _owned(render, obj):
-        render = s.render_proxy = _new_proxy(obj, 'RENDER_PROXY')
-    if (group is None or not group.get(GROUP_TAG) or group.users > 1
-            or _group_proxies(group) != (view, render)):
-        group = _build_group(obj, view, render)
-    if mod is None:
+    view, render = group_proxies(group)
+    if (fresh or not is_group(group) or view is None or render is None
+            or owner_of(group) != obj.name_full):
+        group = new_group_and_proxies(obj)  # hygiene.collect() deletes the old one if unused
+    created = mod is None
+    if created:
         mod = obj.modifiers.new(MOD_NAME, 'NODES')
         mod.show_in_editmode = True
+    if mod.node_group != group:
+        mod.node_group = group  # before anything that may run the handlers (and hygiene)
+    if created:
         try:
             compat.move_modifier_first(obj, mod, context)
         except (RuntimeError, TypeError):
             pass  # stays last: still correct when no modifier before it changes geometry
-    if mod.node_group != group:
-        mod.node_group = group
     return mod
 
 
-def _owned(proxy, obj):
-    """A proxy belongs to the cage whose name it records: a duplicated or renamed cage gets
-    new proxies instead of sharing (and overwriting) another cage's."""
-    return (proxy is not None and proxy.type == 'MESH' and proxy.library is None
-            and proxy.ccnurbs.owner_name == obj.name)
-
-
-def needs_repair(obj):
-    s = obj.ccnurbs
-    mod = get_modifier(obj)
-    group = mod.node_group if mod is not None else None
-    return (not _owned(s.proxy, obj) or not _owned(s.render_proxy, obj) or group is None
-            or not group.get(GROUP_TAG) or group.users > 1
-            or _group_proxies(group) != (s.proxy, s.render_proxy))
+def remove_proxy(p):
+    if p is None or p.library is not None:
+        return
+    me = p.data
+    bpy.data.objects.remove(p)
+    if me is not None and me.users == 0 and me.library is None:
+        bpy.data.meshes.remove(me)
 
 
 def remove(obj):
     """Removes the modifier, its group and the proxies; keeps the cage and its intervals."""
-    s = obj.ccnurbs
     mod = get_modifier(obj)
     group = mod.node_group if mod is not None else None
+    view, render = group_proxies(group)
     if mod is not None:
         obj.modifiers.remove(mod)
-    if group is not None and group.users == 0 and group.get(GROUP_TAG):
+    if group is not None and group.users == 0 and is_group(group):
         bpy.data.node_groups.remove(group)
-    for attr in ("proxy", "render_proxy"):
-        p = getattr(s, attr)
-        setattr(s, attr, None)
-        if p is not None and p.ccnurbs.owner_name == obj.name and p.users == 0:
-            me = p.data
-            bpy.data.objects.remove(p)
-            if me is not None and me.users == 0:
-                bpy.data.meshes.remove(me)
-    s.role = 'NONE'
+        for p in (view, render):
+            if p is not None and p.users == 0:
+                remove_proxy(p)
+    obj.ccnurbs.role = 'NONE'

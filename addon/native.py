@@ -18,6 +18,7 @@ c_double_p = ctypes.POINTER(ctypes.c_double)
 SCHEMES = {"EIGEN": 0, "NURSS": 1, "CATMULL_CLARK": 2}
 CAPS = {"GUIDED_BI5": 0, "REFINE": 1}
 CORNERS = {"ALL": 0, "PRESERVE_CORNERS": 1}
+CREASE_METHODS = {"UNIFORM": 0, "CHAIKIN": 1}
 
 
 class CCNError(Exception):
@@ -46,7 +47,8 @@ class ccn_cage(ctypes.Structure):
                 ("face_verts", c_int32_p),
                 ("edge_verts", c_int32_p),
                 ("edge_knots", c_double_p),
-                ("edge_creases", c_double_p)]
+                ("edge_creases", c_double_p),
+                ("vertex_creases", c_double_p)]
 
 
 class ccn_options(ctypes.Structure):
@@ -54,7 +56,8 @@ class ccn_options(ctypes.Structure):
                 ("cap", ctypes.c_int),
                 ("levels", ctypes.c_int32),
                 ("boundary_corners", ctypes.c_int32),
-                ("threads", ctypes.c_int32)]
+                ("threads", ctypes.c_int32),
+                ("crease_method", ctypes.c_int32)]
 
 
 class ccn_sizes(ctypes.Structure):
@@ -69,14 +72,19 @@ class ccn_sizes(ctypes.Structure):
                 ("num_ev_fallbacks", ctypes.c_int32),
                 ("num_ring_conflicts", ctypes.c_int32),
                 ("num_ignored_verts", ctypes.c_int32),
-                ("num_ignored_edges", ctypes.c_int32)]
+                ("num_ignored_edges", ctypes.c_int32),
+                ("num_sharp_edges", ctypes.c_int32),
+                ("num_sharp_vertices", ctypes.c_int32),
+                ("num_sharp_corners", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):
     _fields_ = [("positions", c_double_p),
                 ("normals", c_double_p),
                 ("face_verts", c_int32_p),
-                ("face_origin", c_int32_p)]
+                ("face_origin", c_int32_p),
+                ("corner_normals", c_double_p),
+                ("corner_edge_origin", c_int32_p)]
 
 
 _lib = None
@@ -155,34 +163,50 @@ class Plan:
     """A ccn_plan: topology, knot intervals and options, evaluated for new positions.
 
     cage: positions (V,3), face_sizes (F,), face_verts (sum,), edge_verts (E,2) or None,
-    edge_knots (E,) or None. options: dict scheme/cap/boundary (enum identifiers), levels.
+    edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None and
+    vertex_sharpness (V,) or None (OpenSubdiv sharpness: ccn_cage.edge_creases / vertex_creases).
+    options: scheme/cap/boundary/crease_method (enum identifiers), levels.
     """
 
     def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
-                 scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0):
+                 scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0,
+                 edge_sharpness=None, vertex_sharpness=None, crease_method="UNIFORM"):
         lib = load()
         self._lib = lib
         self._handle = None
         pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
         fs = np.ascontiguousarray(face_sizes, dtype=np.int32).reshape(-1)
         fv = np.ascontiguousarray(face_verts, dtype=np.int32).reshape(-1)
-        ev = ek = None
+        ev = ek = es = None
         if edge_verts is not None and len(edge_verts):
             ev = np.ascontiguousarray(edge_verts, dtype=np.int32).reshape(-1)
+            for name, arr in (("edge_knots", edge_knots), ("edge_sharpness", edge_sharpness)):
+                if arr is not None and np.size(arr) * 2 != ev.size:
+                    raise CCNError("CCN_ERR_ARGUMENT", "%s has %d values for %d edges"
+                                   % (name, np.size(arr), ev.size // 2))
             if edge_knots is not None:
                 ek = np.ascontiguousarray(edge_knots, dtype=np.float64).reshape(-1)
-                if ek.size * 2 != ev.size:
-                    raise CCNError("CCN_ERR_ARGUMENT", "edge_knots has %d values for %d edges"
-                                   % (ek.size, ev.size // 2))
+            if edge_sharpness is not None:  # ccn_cage.edge_creases: OpenSubdiv sharpness
+                es = np.ascontiguousarray(edge_sharpness, dtype=np.float64).reshape(-1)
         if pos.size % 3:
             raise CCNError("CCN_ERR_ARGUMENT", "positions must be 3 floats per vertex")
+        vs = None
+        if vertex_sharpness is not None:
+            vs = np.ascontiguousarray(vertex_sharpness, dtype=np.float64).reshape(-1)
+            if vs.size * 3 != pos.size:
+                raise CCNError("CCN_ERR_ARGUMENT", "vertex_sharpness has %d values for %d vertices"
+                               % (vs.size, pos.size // 3))
+        self._keep = (pos, fs, fv, ev, ek, es, vs)  # the arrays must outlive plan creation
         cage = ccn_cage(num_verts=pos.size // 3, num_faces=fs.size,
                         num_edges=(ev.size // 2) if ev is not None else 0,
                         positions=_ptr(pos, ctypes.c_double), face_sizes=_ptr(fs, ctypes.c_int32),
                         face_verts=_ptr(fv, ctypes.c_int32), edge_verts=_ptr(ev, ctypes.c_int32),
-                        edge_knots=_ptr(ek, ctypes.c_double), edge_creases=None)
+                        edge_knots=_ptr(ek, ctypes.c_double),
+                        edge_creases=_ptr(es, ctypes.c_double),
+                        vertex_creases=_ptr(vs, ctypes.c_double))
         opts = ccn_options(scheme=SCHEMES[scheme], cap=CAPS[cap], levels=int(levels),
-                           boundary_corners=CORNERS[boundary], threads=int(threads))
+                           boundary_corners=CORNERS[boundary], threads=int(threads),
+                           crease_method=CREASE_METHODS[crease_method])
         handle = ctypes.c_void_p()
         err = ccn_error()
         st = lib.ccn_plan_create(ctypes.byref(cage), ctypes.byref(opts), ctypes.byref(handle),
@@ -198,19 +222,26 @@ class Plan:
         self.sizes = {name: int(getattr(s, name)) for name, _ in ccn_sizes._fields_}
 
     def evaluate(self, positions=None, topology=True):
-        """Returns dict positions (N,3) f64, normals (N,3) f64 and, if topology, face_verts
-        (F,4) int32 and face_origin (F,) int32."""
+        """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces
+        corner_normals (F*4,3) f64 (each face corner's own side), and, if topology, face_verts
+        (F,4) int32, face_origin (F,) int32 and corner_edge_origin (F,4) int32 (the cage face
+        corner whose edge each output corner's edge lies on, -1 inside a cage face)."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
         n, f = self.sizes["num_verts"], self.sizes["num_faces"]
         out = {"positions": np.empty((n, 3), np.float64), "normals": np.empty((n, 3), np.float64)}
+        if self.sizes.get("num_sharp_corners", 0) > 0:
+            out["corner_normals"] = np.empty((4 * f, 3), np.float64)
         if topology:
             out["face_verts"] = np.empty((f, 4), np.int32)
             out["face_origin"] = np.empty(f, np.int32)
+            out["corner_edge_origin"] = np.empty((f, 4), np.int32)
         lm = ccn_limit_mesh(positions=_ptr(out["positions"], ctypes.c_double),
                             normals=_ptr(out["normals"], ctypes.c_double),
                             face_verts=_ptr(out.get("face_verts"), ctypes.c_int32),
-                            face_origin=_ptr(out.get("face_origin"), ctypes.c_int32))
+                            face_origin=_ptr(out.get("face_origin"), ctypes.c_int32),
+                            corner_normals=_ptr(out.get("corner_normals"), ctypes.c_double),
+                            corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32))
         pos = None
         if positions is not None:
             pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)

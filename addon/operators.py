@@ -1,8 +1,8 @@
-"""Operators that add and remove the CCNURBS modifier (they use modifier.py and sync.py;
-neither imports this module)."""
+"""Operators that add and remove the CCNURBS modifier (they use modifier.py, handlers.py and
+sync.py; none of those imports this module)."""
 import bpy
 
-from . import modifier, sync
+from . import handlers, modifier, sync
 
 
 class OBJECT_OT_ccnurbs_add(bpy.types.Operator):
@@ -21,16 +21,19 @@ class OBJECT_OT_ccnurbs_add(bpy.types.Operator):
         if context.active_object not in objs:
             objs.append(context.active_object)
         msgs, level = [], 'INFO'
+        existed = {o.name_full: modifier.is_cage(o) for o in objs}
         for obj in objs:
-            existed = modifier.is_cage(obj)
             modifier.ensure(obj, context)
-            st = sync.sync_object(obj, 'VIEW', force=True)
+        handlers.sync_cages(context.evaluated_depsgraph_get(), objs, 'VIEW')  # no-op if done
+        for obj in objs:
+            st = sync.status(obj, 'VIEW') or sync.Status('VIEW', error="no input evaluated")
             if st.error:
                 level = 'WARNING'
                 msgs.append("%s: %s" % (obj.name, st.error))
             else:
                 msgs.append("%s: %s limit mesh, %d vertices, %d faces (levels %d)"
-                            % (obj.name, "updated" if existed else "added", st.num_verts,
+                            % (obj.name, "updated" if existed[obj.name_full] else "added",
+                               st.num_verts,
                                st.num_faces, obj.ccnurbs.levels))
         self.report({level}, "CCNURBS " + "; ".join(msgs))
         return {'FINISHED'}
@@ -49,6 +52,7 @@ class OBJECT_OT_ccnurbs_remove(bpy.types.Operator):
     def execute(self, context):
         obj = context.active_object
         modifier.remove(obj)
+        sync.forget(obj.name_full)
         self.report({'INFO'}, "CCNURBS removed from %s (knot intervals kept)" % obj.name)
         return {'FINISHED'}
 

@@ -1,4 +1,7 @@
-"""Settings: `Object.ccnurbs` (per cage / proxy) and `Scene.ccnurbs_tools` (knot editing)."""
+"""Settings: `Object.ccnurbs` (per cage / proxy) and `Scene.ccnurbs_tools` (knot editing).
+
+The cage holds no pointer to its proxies (the modifier's node group names them), so nothing but
+the group keeps a proxy alive."""
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
                        StringProperty)
@@ -30,6 +33,15 @@ ROLE_ITEMS = (('NONE', "None", ""), ('CAGE', "Cage", ""), ('VIEW_PROXY', "Viewpo
               ('RENDER_PROXY', "Render Proxy", ""))
 
 
+def _store_changed(self, context):
+    """Store Render Mesh off: the stored mesh goes now (it is computed again per render)."""
+    from . import modifier, proxies  # neither imports props: no cycle
+    obj = self.id_data
+    if not self.store_render_mesh and isinstance(obj, bpy.types.Object) and obj.library is None:
+        proxies.clear(modifier.proxy(obj, 'RENDER'))
+    _tag(self, context)
+
+
 def _tag(self, context):
     """A setting changed: tag the cage so the depsgraph handler re-evaluates it."""
     obj = self.id_data
@@ -49,13 +61,21 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     boundary_smooth: EnumProperty(name="Boundary Smooth", items=BOUNDARY_ITEMS, default='ALL',
                                   update=_tag)
     normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
-    proxy: PointerProperty(type=bpy.types.Object, name="Viewport Proxy", options={'HIDDEN'})
-    render_proxy: PointerProperty(type=bpy.types.Object, name="Render Proxy",
-                                  options={'HIDDEN'})
+    use_creases: BoolProperty(
+        name="Use Creases", default=True, update=_tag,
+        description="Use the mesh's edge and vertex creases (Shift+E) as sharpness, mapped as the "
+                    "Subdivision Surface modifier does (sharpness 10 c²: crease 1 is infinitely "
+                    "sharp)")
+    store_render_mesh: BoolProperty(
+        name="Store Render Mesh in File", default=False, update=_store_changed,
+        description="Keep the Render-levels limit mesh computed (refreshed a second after "
+        "edits stop) and saved in the .blend, so the file renders at Render levels where the "
+        "add-on is not installed (render farms). Off: render meshes are computed per frame "
+        "while rendering and never saved; a file without the add-on shows and renders the cage")
     owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
 
     def option_tuple(self):
-        return (self.scheme, self.cap, self.boundary_smooth, self.normals)
+        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.use_creases)
 
 
 def _overlay_toggled(self, context):
@@ -64,8 +84,9 @@ def _overlay_toggled(self, context):
 
 
 class CCNURBS_SceneTools(bpy.types.PropertyGroup):
-    knot_value: FloatProperty(name="Interval", description="Knot interval used by Set",
-                              default=2.0, min=1e-6, soft_min=0.01, soft_max=100.0, precision=3)
+    knot_value: FloatProperty(name="Interval", description="Knot interval used by Set: a positive "
+                              "finite number (only ratios matter; Clear resets to 1)",
+                              default=2.0, soft_min=0.01, soft_max=100.0, precision=3)
     show_overlay: BoolProperty(name="Knot Overlay", description="Colour edges by knot interval "
                                "in edit mode", default=False, update=_overlay_toggled)
 

@@ -1,321 +1,179 @@
-"""Keeps the proxies in step with their cages: persistent handlers, plan cache, proxy writes.
+"""Keeps the proxies in step with their cages: plan cache, status, one cage at a time.
 
-One direction only: cage (mesh or edit BMesh) + settings → library plan → proxy mesh → the
-Geometry Nodes modifier shows the proxy. The handler never reads what it wrote:
+One direction only: the modifier's input tap (the cage after the stack above; tap.py) +
+settings → library plan → proxy mesh → the Geometry Nodes modifier shows the proxy. Nothing here
+reads what it wrote:
 
 * a content key per proxy (topology+intervals+settings hash : position hash) is stored on the
   proxy mesh; an update whose key equals the stored one does nothing (this also ends the update
   our own write causes, and survives undo, which restores proxy and key together);
-* a re-entrancy flag stops nested calls;
 * same topology key → the cached plan is evaluated with new positions and only positions and
   normals are rewritten; otherwise a new plan is made and the proxy rebuilt;
-* any failure is recorded as the cage's status (shown in the panel); the proxy keeps the previous
-  limit; nothing is raised.
+* any failure is recorded as the cage's status (shown in the panel) and nothing is raised; the
+  proxy keeps the previous limit, except for a cage without faces, which shows itself.
+
+Each change costs two evaluations of the cage object (the one that produced the tap, and the one
+Blender runs at once after our write, reading the new proxy): Python cannot run inside an
+evaluation (measured in README "Design notes").
 """
-import threading
 import time
 import traceback
 
-import bpy
-import numpy as np
-from bpy.app.handlers import persistent
-
 from . import cage as cagemod
-from . import compat, modifier, native
+from . import modifier, native, proxies
 
-KEY_PROP = "ccnurbs_key"
-TOPO_PROP = "ccnurbs_topology"
-RENDER_DELAY = 1.0  # seconds of quiet before render proxies are refreshed
+# Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
+# ccn_cage.edge_creases / vertex_creases when the cage's Use Creases is on (the default).
 
-stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "skipped": 0,
-         "errors": 0, "internal_errors": 0}
-_busy = False
+stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "skipped": 0, "errors": 0,
+         "internal_errors": 0, "render_frames": 0}
 _plans = {}      # (object name, kind) -> (topology key, native.Plan)
 _status = {}     # (object name, kind) -> Status
-_render_dirty = set()
 
 
 class Status:
-    __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels")
+    __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
+                 "showing", "loose", "element")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
         self.num_verts = self.num_faces = 0
         self.sizes = {}
         self.seconds = 0.0
+        self.showing = "limit"   # limit | last valid limit | cage
+        self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
+        self.element = None      # (ccn_element_kind, index) an error names (errors.py)
 
 
 def status(obj, kind='VIEW'):
     return _status.get((obj.name_full, kind))
 
 
-# ---- writing a proxy ---------------------------------------------------------------------------
-
-def _write_normals(me, res, exact):
-    if exact:
-        compat.set_vertex_normals(me, res["normals"].astype(np.float32))
-    else:
-        compat.use_plain_normals(me)
-
-
-def _write_topology(me, res, cage, exact=True):
-    pos = res["positions"].astype(np.float32).ravel()
-    fv = res["face_verts"].ravel()
-    nv, nf = len(res["positions"]), len(res["face_verts"])
-    me.clear_geometry()
-    me.vertices.add(nv)
-    me.loops.add(4 * nf)
-    me.polygons.add(nf)
-    me.vertices.foreach_set("co", pos)
-    me.loops.foreach_set("vertex_index", fv)
-    compat.set_face_loops(me, np.arange(0, 4 * nf, 4, dtype=np.int32), np.full(nf, 4, np.int32))
-    me.polygons.foreach_set("use_smooth", np.ones(nf, bool))
-    if cage.material_index is not None and len(cage.material_index):
-        origin = np.clip(res["face_origin"], 0, len(cage.material_index) - 1)
-        me.polygons.foreach_set("material_index", cage.material_index[origin])
-    me.update(calc_edges=True)
-    _write_normals(me, res, exact)
+def rename(old, new):
+    """A cage was renamed: its plans and status follow it."""
+    for kind in ('VIEW', 'RENDER'):
+        for table in (_plans, _status):
+            if (old, kind) in table:
+                table[(new, kind)] = table.pop((old, kind))
 
 
-def _write_positions(me, res, exact=True):
-    me.vertices.foreach_set("co", res["positions"].astype(np.float32).ravel())
-    me.update()
-    _write_normals(me, res, exact)
+def forget(name, kinds=('VIEW', 'RENDER')):
+    for kind in kinds:
+        entry = _plans.pop((name, kind), None)
+        if entry is not None:
+            entry[1].close()
+        _status.pop((name, kind), None)
 
 
-def _sync_materials(obj, proxy):
-    src, dst = obj.data.materials, proxy.data.materials
-    if [m for m in src] != [m for m in dst]:
-        dst.clear()
-        for m in src:
-            dst.append(m)
+def forget_all():
+    for _, plan in _plans.values():
+        plan.close()
+    _plans.clear()
+    _status.clear()
 
 
-# ---- one cage ----------------------------------------------------------------------------------
+def free_render_plans():
+    for key in [k for k in _plans if k[1] == 'RENDER']:
+        _plans.pop(key)[1].close()
 
-def sync_object(obj, kind='VIEW', force=False, cage=None):
-    """Brings the cage's viewport ('VIEW') or render ('RENDER') proxy up to date. Returns the
-    Status; never raises."""
+
+def _plan_for(key_name, topo, cage, s, levels):
+    cached = _plans.get(key_name)
+    if cached is not None and cached[0] == topo:
+        return cached[1]
+    if cached is not None:
+        cached[1].close()
+        del _plans[key_name]
+    sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
+    vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
+    plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
+                       cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
+                       levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
+    _plans[key_name] = (topo, plan)
+    return plan
+
+
+def sync_object(obj, kind, cage, force=False):
+    """Brings the cage's viewport ('VIEW') or render ('RENDER') proxy up to date with `cage`
+    (the tap's arrays). Returns the Status; never raises."""
     s = obj.ccnurbs
     levels = s.levels if kind == 'VIEW' else s.render_levels
     key_name = (obj.name_full, kind)
     st = Status(kind, levels)
     t0 = time.perf_counter()
+    p = None
     try:
-        if obj.library is not None:
-            return _status.setdefault(key_name, st)
-        if modifier.needs_repair(obj):
-            modifier.ensure(obj)
-        proxy = s.proxy if kind == 'VIEW' else s.render_proxy
-        me = proxy.data
-        if cage is None:
-            main = threading.current_thread() is threading.main_thread()
-            cage = cagemod.read(obj, editmesh=main)
-        topo = cage.topology_key(levels, *s.option_tuple())
+        st.loose = cage.loose_counts()
+        p = modifier.proxy(obj, kind)
+        if p is None:
+            raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
+        topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases)
         key = topo + ":" + cage.position_key()
-        _sync_materials(obj, proxy)
+        proxies.sync_materials(obj.data, p)
         old = _status.get(key_name)
-        if not force and me.get(KEY_PROP) == key:
+        me = p.data
+        if not force and me.get(proxies.KEY_PROP) == key:
             stats["skipped"] += 1
             if old is None or old.error:  # unknown (file just loaded) or fixed by undo
                 old = Status(kind, levels)
                 old.num_verts, old.num_faces = len(me.vertices), len(me.polygons)
+                old.loose = st.loose
                 _status[key_name] = old
             return old
         stats["syncs"] += 1
-        cached = _plans.get(key_name)
-        if cached is not None and cached[0] == topo:
-            plan = cached[1]
-        else:
-            if cached is not None:
-                cached[1].close()
-                del _plans[key_name]
-            plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts,
-                               cage.edge_verts, cage.knots, scheme=s.scheme, cap=s.cap,
-                               boundary=s.boundary_smooth, levels=levels)
-            _plans[key_name] = (topo, plan)
-        same_topology = (me.get(TOPO_PROP) == topo
+        plan = _plan_for(key_name, topo, cage, s, levels)
+        me = proxies.own_mesh(p)
+        same_topology = (me.get(proxies.TOPO_PROP) == topo
                          and len(me.vertices) == plan.sizes["num_verts"]
                          and len(me.polygons) == plan.sizes["num_faces"])
-        if same_topology and me.get(KEY_PROP) == key:
+        exact = s.normals == 'EXACT'
+        if same_topology and me.get(proxies.KEY_PROP) == key:
             pass  # forced: the proxy is already right
         elif same_topology:
-            res = plan.evaluate(cage.positions, topology=False)
-            _write_positions(me, res, s.normals == 'EXACT')
+            proxies.write_positions(me, plan.evaluate(cage.positions, topology=False), exact)
             stats["position_updates"] += 1
         else:
-            _write_topology(me, plan.evaluate(cage.positions, topology=True), cage,
-                            s.normals == 'EXACT')
+            proxies.write_topology(me, plan.evaluate(cage.positions, topology=True), cage, exact)
             stats["rebuilds"] += 1
-        me[KEY_PROP] = key
-        me[TOPO_PROP] = topo
+        me[proxies.KEY_PROP] = key
+        me[proxies.TOPO_PROP] = topo
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:
         st.error = str(e)
+        st.element = (e.element_kind, e.element) if e.element >= 0 else None
         stats["errors"] += 1
+        if not len(cage.face_sizes) and p is not None:  # nothing to show but the cage itself
+            proxies.clear(p)
+            forget(obj.name_full, (kind,))
     except Exception as e:  # never let a handler raise: report it in the panel instead
         st.error = "internal error: %s: %s" % (type(e).__name__, e)
         stats["errors"] += 1
         stats["internal_errors"] += 1
         traceback.print_exc()
     st.seconds = time.perf_counter() - t0
-    if st.error and proxy_is_valid(obj, kind):
-        p = (s.proxy if kind == 'VIEW' else s.render_proxy).data
-        st.num_verts, st.num_faces = len(p.vertices), len(p.polygons)
+    if st.error:
+        shown = p.data if p is not None and p.data is not None else None
+        if shown is not None and len(shown.vertices):
+            st.showing = "last valid limit"
+            st.num_verts, st.num_faces = len(shown.vertices), len(shown.polygons)
+        else:
+            st.showing = "cage"
     _status[key_name] = st
     return st
 
 
-def proxy_is_valid(obj, kind):
-    p = obj.ccnurbs.proxy if kind == 'VIEW' else obj.ccnurbs.render_proxy
-    return p is not None and p.data is not None
+def missing_tap(obj, kind):
+    """The modifier is on but its input tap is not in the evaluated result."""
+    st = Status(kind, error="CCNURBS cannot read its input: a modifier below it realizes or "
+                "removes instances. Move CCNURBS below it, or turn that modifier off.")
+    p = modifier.proxy(obj, kind)
+    st.showing = "last valid limit" if p is not None and p.data and len(p.data.vertices) \
+        else "cage"
+    _status[(obj.name_full, kind)] = st
+    return st
 
 
-def sync_render(objects=None):
-    """Render proxies of every cage (or of `objects`) at render_levels."""
-    for obj in modifier.cages(objects):
-        mod = modifier.get_modifier(obj)
-        if mod.show_render:
-            sync_object(obj, 'RENDER')
-    _render_dirty.clear()
-
-
-def sync_all():
-    for obj in modifier.cages():
-        sync_object(obj, 'VIEW')
-
-
-# ---- handlers ----------------------------------------------------------------------------------
-
-def _updated_cages(depsgraph):
-    objs, meshes = set(), set()
-    for u in depsgraph.updates:
-        if not u.is_updated_geometry:
-            continue
-        idd = u.id.original if u.id.original is not None else u.id
-        if isinstance(idd, bpy.types.Object):
-            objs.add(idd)
-        elif isinstance(idd, bpy.types.Mesh):
-            meshes.add(idd)
-    if meshes:
-        objs.update(o for o in bpy.data.objects if o.data in meshes)
-    return [o for o in objs if o.type == 'MESH' and o.ccnurbs.role == 'CAGE'
-            and modifier.get_modifier(o) is not None], objs
-
-
-@persistent
-def on_depsgraph_update_post(scene, depsgraph=None):
-    global _busy
-    if _busy:
-        return
-    _busy = True
-    stats["handler_calls"] += 1
-    try:
-        if depsgraph is None:
-            depsgraph = bpy.context.evaluated_depsgraph_get()
-        cages, objs = _updated_cages(depsgraph)
-        for obj in cages:
-            mod = modifier.get_modifier(obj)
-            if not mod.show_viewport:
-                continue
-            st = sync_object(obj, 'VIEW')
-            if not st.error:
-                _render_dirty.add(obj.name_full)
-        from . import overlay
-        overlay.on_objects_updated(objs)
-        if _render_dirty and not bpy.app.background:
-            if bpy.app.timers.is_registered(_render_timer):
-                bpy.app.timers.unregister(_render_timer)
-            bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
-    except Exception:
-        stats["internal_errors"] += 1
-        traceback.print_exc()
-    finally:
-        _busy = False
-
-
-def _render_timer():
-    global _busy
-    if _busy:
-        return 0.2
-    _busy = True
-    try:
-        names = set(_render_dirty)
-        sync_render([o for o in bpy.data.objects if o.name_full in names])
-    except Exception:
-        traceback.print_exc()
-    finally:
-        _busy = False
-    return None
-
-
-def _guarded(fn):
-    global _busy
-    if _busy:
-        return
-    _busy = True
-    try:
-        fn()
-    except Exception:
-        stats["internal_errors"] += 1
-        traceback.print_exc()
-    finally:
-        _busy = False
-
-
-@persistent
-def on_load_post(*args):
-    for _, plan in _plans.values():
-        plan.close()
-    _plans.clear()
-    _status.clear()
-    _render_dirty.clear()
-    _guarded(sync_all)
-
-
-@persistent
-def on_undo_redo(*args):
-    _guarded(sync_all)
-
-
-@persistent
-def on_render_init(*args):
-    _guarded(sync_render)
-
-
-@persistent
-def on_save_pre(*args):
-    _guarded(lambda: (sync_all(), sync_render()))
-
-
-HANDLERS = (("depsgraph_update_post", on_depsgraph_update_post), ("load_post", on_load_post),
-            ("undo_post", on_undo_redo), ("redo_post", on_undo_redo),
-            ("render_init", on_render_init), ("save_pre", on_save_pre))
-
-
-def _is_ours(fn, name):
-    """A handler of this module, also one left by an earlier load of it (same module name)."""
-    return getattr(fn, "__name__", None) == name and getattr(fn, "__module__", None) == __name__
-
-
-def register():
-    for event, fn in HANDLERS:
-        lst = getattr(bpy.app.handlers, event)
-        for h in [h for h in lst if _is_ours(h, fn.__name__)]:
-            lst.remove(h)
-        lst.append(fn)
-
-
-def unregister():
-    for event, fn in HANDLERS:
-        lst = getattr(bpy.app.handlers, event)
-        for h in [h for h in lst if h is fn or _is_ours(h, fn.__name__)]:
-            lst.remove(h)
-    if bpy.app.timers.is_registered(_render_timer):
-        bpy.app.timers.unregister(_render_timer)
-    for _, plan in _plans.values():
-        plan.close()
-    _plans.clear()
-    _status.clear()
-    _render_dirty.clear()
+def render_bytes(obj):
+    p = modifier.proxy(obj, 'RENDER')
+    return proxies.size_bytes(p.data if p is not None else None)

@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import modifier, native, sync
+from . import errors, modifier, native, sync, tap, values
 
 
 def active_edge_interval(obj):
@@ -14,7 +14,7 @@ def active_edge_interval(obj):
         return None
     layer = bm.edges.layers.float.get(cagemod.KNOT_ATTR)
     v = act[layer] if layer is not None else 0.0
-    return v if v > 0 else 1.0
+    return float(values.effective(v))
 
 
 class VIEW3D_PT_ccnurbs_knots(bpy.types.Panel):
@@ -54,16 +54,29 @@ def _draw_status(layout, obj):
     if st.error:
         col = box.column()
         col.alert = True
-        col.label(text="Cage error — showing the last valid limit:", icon='ERROR')
+        col.label(text=error_heading(st), icon='ERROR')
         for line in _wrap(st.error, 48):
             col.label(text=line)
+        what = errors.advice(st.error)
+        if what:
+            col = box.column()
+            for i, line in enumerate(_wrap(what, 48)):
+                col.label(text=line, icon='QUESTION' if i == 0 else 'BLANK1')
+        if errors.selectable(st):
+            box.operator("object.ccnurbs_select_error", text="Select", icon='RESTRICT_SELECT_OFF')
         return
     box.label(text="Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces), icon='MESH_DATA')
-    z = st.sizes
+    z = dict(st.sizes)
+    z["num_ignored_verts"], z["num_ignored_edges"] = st.loose
     if z:
         box.label(text="Extraordinary: %d, caps: %d" % (z.get("num_extraordinary", 0),
                                                       z.get("num_caps", 0)))
         notes = []
+        if z.get("num_sharp_edges") or z.get("num_sharp_vertices"):
+            notes.append("creases: %d sharp edges, %d sharp vertices; %d limit vertices with "
+                         "one normal per side" % (z.get("num_sharp_edges", 0),
+                                                  z.get("num_sharp_vertices", 0),
+                                                  z.get("num_sharp_corners", 0)))
         if z.get("num_ring_conflicts"):
             notes.append("%d ring conflicts (mean used)" % z["num_ring_conflicts"])
         if z.get("num_ev_fallbacks"):
@@ -80,6 +93,10 @@ def _draw_status(layout, obj):
             box.label(text=lines[0], icon='INFO')
             for line in lines[1:]:
                 box.label(text=line, icon='BLANK1')
+        note = tap.edit_note.get(obj.name_full)
+        if note:
+            for i, line in enumerate(_wrap(note, 48)):
+                box.label(text=line, icon='INFO' if i == 0 else 'BLANK1')
         box.label(text="Updated in %.1f ms" % (1000 * st.seconds))
 
 
@@ -96,14 +113,31 @@ def _wrap(text, width):
     return lines
 
 
+def error_heading(st):
+    return {"limit": "Cage error:", "last valid limit": "Cage error — showing the last valid "
+            "limit:", "cage": "Cage error — showing the cage (no valid limit yet):"}[st.showing]
+
+
 def status_lines(obj):
     """The text the modifier panel shows for a cage (also used by tests)."""
     st = sync.status(obj, 'VIEW')
     if st is None:
         return []
     if st.error:
-        return ["Cage error — showing the last valid limit:", st.error]
+        return [error_heading(st), st.error]
     return ["Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces)]
+
+
+def render_mesh_line(obj):
+    """What the file holds for rendering (the Store Render Mesh in File line)."""
+    if not obj.ccnurbs.store_render_mesh:
+        return "Render mesh: computed per frame when rendering, not saved"
+    p = modifier.proxy(obj, 'RENDER')
+    me = p.data if p is not None else None
+    if me is None or not len(me.vertices):
+        return "Render mesh in file: not computed yet"
+    return "Render mesh in file: %d vertices, %.1f MB" % (len(me.vertices),
+                                                          sync.render_bytes(obj) / 1e6)
 
 
 class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
@@ -137,7 +171,10 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         layout.prop(s, "scheme")
         layout.prop(s, "cap")
         layout.prop(s, "boundary_smooth")
+        layout.prop(s, "use_creases")
         layout.prop(s, "normals")
+        layout.prop(s, "store_render_mesh")
+        layout.label(text=render_mesh_line(obj), icon='FILE_BLEND')
         _draw_status(layout, obj)
         rst = sync.status(obj, 'RENDER')
         if rst is not None and rst.error:

@@ -32,6 +32,14 @@ typedef enum { CCN_CAP_GUIDED_BI5 = 0, CCN_CAP_REFINE } ccn_cap;
 /* Valence-2 boundary corners: smooth (OpenSubdiv EDGE_ONLY, Blender "All") or pinned
  * (OpenSubdiv EDGE_AND_CORNER, Blender "Keep Corners"). */
 typedef enum { CCN_CORNERS_SMOOTH = 0, CCN_CORNERS_PINNED } ccn_corners;
+/* How semi-sharp creases decay per level (OpenSubdiv Sdc::Options::CreasingMethod):
+ * UNIFORM subtracts 1 (Blender's Subdivision Surface), CHAIKIN averages with the other
+ * semi-sharp edges at each end first (0.75 s + 0.25 mean of the others, minus 1). */
+typedef enum { CCN_CREASE_UNIFORM = 0, CCN_CREASE_CHAIKIN } ccn_crease_method;
+
+/* Sharpness (OpenSubdiv semantics): 0 = smooth, >= CCN_SHARPNESS_INFINITE = infinitely sharp,
+ * in between semi-sharp (sharp for floor(s) levels, then blended, then smooth). */
+#define CCN_SHARPNESS_INFINITE 10.0
 
 /* Which kind of element an error names (ccn_error.element_kind). */
 typedef enum {
@@ -45,8 +53,12 @@ typedef struct {
     char message[256];    /* human-readable, names the element ("face 12 has ...") */
 } ccn_error;
 
-/* A polygon soup cage. Knot intervals are given per edge, an edge being identified by its
- * two vertex indices (edge_verts). Values <= 0, NaN or Inf mean "unset". */
+/* A polygon soup cage. Knot intervals and creases are given per edge, an edge being identified
+ * by its two vertex indices (edge_verts). Knot values <= 0, NaN or Inf mean "unset" (1).
+ * Sharpness (edge_creases, vertex_creases): OpenSubdiv's, >= 0; <= 0 is smooth, values >= 10
+ * (and +Inf) are infinitely sharp; NaN is a CCN_ERR_ARGUMENT naming the edge or vertex. Where
+ * an edge is listed twice, a later unset knot (<= 0) or smooth crease (<= 0) does not replace
+ * an earlier value. */
 typedef struct {
     int32_t num_verts, num_faces, num_edges;
     const double *positions;   /* 3 * num_verts */
@@ -54,7 +66,8 @@ typedef struct {
     const int32_t *face_verts; /* sum(face_sizes) */
     const int32_t *edge_verts; /* 2 * num_edges, may be NULL (then num_edges = 0) */
     const double *edge_knots;  /* num_edges, NULL = all unset (interval 1) */
-    const double *edge_creases;/* num_edges, may be NULL (reserved; not used yet) */
+    const double *edge_creases;/* num_edges edge sharpness, may be NULL (all smooth) */
+    const double *vertex_creases; /* num_verts vertex sharpness (corners), may be NULL */
 } ccn_cage;
 
 typedef struct {
@@ -63,6 +76,7 @@ typedef struct {
     int32_t levels;           /* refinement levels / samples 2^levels per cage-face side */
     int32_t boundary_corners; /* ccn_corners, default SMOOTH */
     int32_t threads;          /* 0 = default */
+    int32_t crease_method;    /* ccn_crease_method, default UNIFORM */
 } ccn_options;
 
 /* ---- control meshes ------------------------------------------------------------ */
@@ -81,6 +95,8 @@ typedef struct {
     int32_t max_valence;
     int32_t num_ev_fallbacks;    /* EVs that fell back from eigen to NURSS rules (refine) */
     int32_t level;               /* refinement level of this mesh (0 = cage) */
+    int32_t num_sharp_edges;     /* edges with sharpness > 0 (boundary edges not counted) */
+    int32_t num_sharp_vertices;  /* vertices with sharpness > 0 */
 } ccn_mesh_info;
 
 /* Builds and validates a cage. Vertex indices of the resulting mesh are those of the cage
@@ -93,6 +109,9 @@ ccn_status ccn_mesh_info_get(const ccn_mesh *mesh, ccn_mesh_info *info);
  * edge_verts: 2*num_edges, edge_knots: num_edges (the resolved ring interval). */
 ccn_status ccn_mesh_copy(const ccn_mesh *mesh, double *positions, int32_t *face_sizes,
                          int32_t *face_verts, int32_t *edge_verts, double *edge_knots);
+/* Sharpness of the mesh's edges (num_edges, edge order of ccn_mesh_copy) and vertices
+ * (num_verts) at its level (refined creases decay); any pointer may be NULL. */
+ccn_status ccn_mesh_creases(const ccn_mesh *mesh, double *edge_sharpness, double *vertex_sharpness);
 /* Replaces the vertex positions (3*num_verts) keeping topology and intervals. */
 ccn_status ccn_mesh_set_positions(ccn_mesh *mesh, const double *positions, ccn_error *err);
 
@@ -131,6 +150,10 @@ typedef struct {
     int32_t num_cap_fallbacks;/* EVs that use the refined limit instead of the cap */
     int32_t num_ev_fallbacks; /* EVs whose eigen rules fell back to NURSS */
     int32_t num_ring_conflicts, num_ignored_verts, num_ignored_edges;
+    int32_t num_sharp_edges;  /* cage edges with sharpness > 0 */
+    int32_t num_sharp_vertices;
+    int32_t num_sharp_corners;/* output vertices whose faces see more than one tangent plane
+                                 (creases, corners): corner_normals differ from normals */
 } ccn_sizes;
 
 /* Caller-owned output buffers; sizes from ccn_plan_sizes. */
@@ -139,6 +162,16 @@ typedef struct {
     double *normals;      /* 3 * num_verts unit normals, may be NULL */
     int32_t *face_verts;  /* 4 * num_faces, counter-clockwise, may be NULL */
     int32_t *face_origin; /* num_faces: index of the cage face it lies on, may be NULL */
+    double *corner_normals; /* 3 * 4 * num_faces: the unit normal of each face at each of its
+                               corners, may be NULL. Equal to the vertex normal except on
+                               sharp creases and corners, where each face gets the normal
+                               of its own side (the vertex normal is then their mean). */
+    int32_t *corner_edge_origin; /* 4 * num_faces: the edge from corner k to corner k+1 lies
+                               on the edge of cage face face_origin that starts at cage face
+                               corner j (this array holds the index of that corner in the
+                               cage's face_verts, so its edge is face_verts[j] -> the face's next
+                               corner), or -1 inside the cage face; may be NULL. Carries
+                               creases, seams and sharp marks over to the limit mesh. */
 } ccn_limit_mesh;
 
 /* Output topology: the level-L refinement of the cage, i.e. every cage quad sampled on a
@@ -167,11 +200,31 @@ ccn_status ccn_plan_patches(const ccn_plan *plan, ccn_patch_fn fn, void *user,
 
 /* ---- OBJ ------------------------------------------------------------------------ */
 
-typedef struct ccn_obj ccn_obj; /* parsed OBJ: v, f and "# knot i j d" lines */
+/* Parsed OBJ: `v`, `f`, and the comment statements other readers skip (1-based indices):
+ *   # knot i j d      edge i-j has knot interval d
+ *   # crease i j s    edge i-j has sharpness s (OpenSubdiv's; 10 = infinitely sharp)
+ *   # corner i s      vertex i has sharpness s
+ * and OpenSubdiv's shape tags (0-based indices, regression/shapes): `t crease`, `t corner`,
+ * `t interpolateboundary`, `t creasemethod`, `t facevaryinginterpolateboundary`; other tags
+ * are ignored with a warning (ccn_obj_warning). */
+typedef struct ccn_obj ccn_obj;
 ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error *err);
 void ccn_obj_destroy(ccn_obj *obj);
 /* A view of the parsed data as a cage (valid while obj lives). */
 ccn_status ccn_obj_cage(const ccn_obj *obj, ccn_cage *cage);
+/* Options the file's tags ask for; -1 where the file has no such tag. */
+typedef struct {
+    int32_t boundary_corners; /* t interpolateboundary: 1 (EDGE_AND_CORNER) -> PINNED,
+                                 2 (EDGE_ONLY) and 0 (NONE) -> SMOOTH */
+    int32_t boundary_none;    /* 1 if the tag was 0 (NONE: OpenSubdiv makes the boundary faces
+                                 holes; here they are kept, refined as EDGE_ONLY) */
+    int32_t crease_method;    /* t creasemethod normal|chaikin -> ccn_crease_method */
+    int32_t fvar_boundary;    /* t facevaryinginterpolateboundary 0..5 */
+} ccn_obj_tags;
+ccn_status ccn_obj_get_tags(const ccn_obj *obj, ccn_obj_tags *tags);
+/* Statements the reader skipped with a reason (unknown tags): count and text. */
+int32_t ccn_obj_num_warnings(const ccn_obj *obj);
+const char *ccn_obj_warning(const ccn_obj *obj, int32_t i);
 
 const char *ccn_status_name(ccn_status s);
 

@@ -348,7 +348,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (st) return st;
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
-    ccn_limit_mesh lm = {malloc(sizeof(double) * 3 * (size_t)(sz.num_verts ? sz.num_verts : 1)), NULL, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = malloc(sizeof(double) * 3 * (size_t)(sz.num_verts ? sz.num_verts : 1))};
     if (!lm.positions) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)");
     st = ccn_plan_evaluate(plan, positions, &lm, err);
     free(lm.positions);

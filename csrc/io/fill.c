@@ -101,14 +101,19 @@ static ccn_status cut(const ccn_mesh *m, const uint8_t *sel, int32_t level, ccn_
     int32_t *fs = malloc(sizeof(int32_t) * (size_t)(nf ? nf : 1)), *fv = malloc(sizeof(int32_t) * (size_t)(nc ? nc : 1));
     int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)(ne ? ne : 1));
     double *ek = malloc(sizeof(double) * (size_t)(ne ? ne : 1));
+    double *es = m->esharp ? malloc(sizeof(double) * (size_t)(ne ? ne : 1)) : NULL;
+    double *vs = m->vsharp ? malloc(sizeof(double) * (size_t)(nv ? nv : 1)) : NULL;
     int32_t *fm = malloc(sizeof(int32_t) * (size_t)(nf ? nf : 1));
     ccn_status st = CCN_OK;
-    if (!pos || !fs || !fv || !ev || !ek || !fm) {
+    if (!pos || !fs || !fv || !ev || !ek || !fm || (m->esharp && !es) || (m->vsharp && !vs)) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)");
         goto done;
     }
     for (int32_t v = 0; v < m->nv; v++)
-        if (vmap[v] >= 0) memcpy(pos + 3 * (size_t)vmap[v], m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        if (vmap[v] >= 0) {
+            memcpy(pos + 3 * (size_t)vmap[v], m->pos + 3 * (size_t)v, sizeof(double) * 3);
+            if (vs) vs[vmap[v]] = m->vsharp[v];
+        }
     int32_t fi = 0, ci = 0, ei = 0;
     for (int32_t e = 0; e < m->ne; e++) emark[e] = 0;
     for (int32_t f = 0; f < m->nf; f++) {
@@ -122,10 +127,12 @@ static ccn_status cut(const ccn_mesh *m, const uint8_t *sel, int32_t level, ccn_
             emark[e] = 1;
             ev[2 * ei] = vmap[m->everts[2 * e]];
             ev[2 * ei + 1] = vmap[m->everts[2 * e + 1]];
+            if (es) es[ei] = m->esharp[e];
             ek[ei++] = m->eknot[e];
         }
     }
-    ccn_cage c = {nv, nf, ne, pos, fs, fv, ev, ek, NULL};
+    /* the creases of this level (already decayed; float -> double -> float is exact) */
+    ccn_cage c = {nv, nf, ne, pos, fs, fv, ev, ek, es, vs};
     ccn_mesh *sm = NULL;
     if ((st = ccn_mesh_create(&c, &sm, err))) goto done;
     sm->info.level = level; /* the rules of that level (level 0 differs at EVs) */
@@ -133,7 +140,7 @@ static ccn_status cut(const ccn_mesh *m, const uint8_t *sel, int32_t level, ccn_
     *face_map = fm;
     fm = NULL;
 done:
-    free(vmap); free(emark); free(pos); free(fs); free(fv); free(ev); free(ek); free(fm);
+    free(vmap); free(emark); free(pos); free(fs); free(fv); free(ev); free(ek); free(es); free(vs); free(fm);
     return st;
 }
 
@@ -535,7 +542,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         for (int32_t f = 0; f < cm->nf; f++) inv[f] = -1;
         for (int32_t f = 0; f < S->nf; f++) inv[fmap[f]] = f;
         ccn__level lv;
-        if ((st = ccn__level_prepare(&lv, S, v->scheme, v->pinned, err))) goto done;
+        if ((st = ccn__level_prepare(&lv, S, v->scheme, v->pinned, v->crease_method, err))) goto done;
         st = ccn__level_topology(&lv, &T, err);
         if (!st) ccn__level_points(&lv, T->pos);
         ccn__level_free(&lv);

@@ -1,22 +1,37 @@
-/* OBJ reader: `v x y z`, `f a b c ...` (a, a/b, a/b/c, a//c; negative = relative), and the
- * comment statements `# knot i j d` / `# crease i j c` (1-based vertex indices of an edge)
- * that other readers ignore (DESIGN §3). Other statements are skipped. Never reads past
- * `len`; any malformed number is a CCN_ERR_IO naming the line. */
+/* OBJ reader: `v x y z`, `f a b c ...` (a, a/b, a/b/c, a//c; negative = relative), the
+ * comment statements `# knot i j d`, `# crease i j s`, `# corner i s` (1-based vertex indices;
+ * other readers skip them), and OpenSubdiv's shape tags `t name nints/nfloats/nstrings ...`
+ * (regression/common/shape_utils.cpp: crease, corner with 0-based indices, interpolateboundary,
+ * creasemethod, facevaryinginterpolateboundary; other tags are skipped with a warning).
+ * A `# crease`/`# corner` comment whose next word is not an integer is prose (OpenSubdiv's
+ * shapes say "#  crease tags for perimeter:") and is skipped. Other statements are skipped.
+ * Never reads past `len`; any malformed number is a CCN_ERR_IO naming the line. */
 #include "ccnurbs.h"
 
 #include "base/error.h"
 
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define OBJ_MAX_WARNINGS 16
 
 struct ccn_obj {
     double *pos;   int32_t nv, cap_v;
     int32_t *fsz;  int32_t nf, cap_f;
     int32_t *fv;   int32_t nfv, cap_fv;
+    /* per-edge statements, in file order: knot (0 = none) and sharpness (0 = none) */
     int32_t *ev;   int32_t cap_e;
     double *knot;  int32_t nk, cap_k;
+    double *crease; int32_t cap_c;
+    int has_crease;
+    /* vertex sharpness by vertex index (grown on demand; 0 = none) */
+    double *vcrease; int32_t cap_vc, nvc;
+    ccn_obj_tags tags;
+    int32_t nwarn;
+    char warn[OBJ_MAX_WARNINGS][128];
 };
 
 static int grow(void **p, int32_t *cap, int32_t need, size_t elem) {
@@ -106,23 +121,148 @@ static ccn_status parse_f(ccn_obj *o, cursor *c, long line, ccn_error *err) {
     return CCN_OK;
 }
 
-/* "# knot i j d" (c is after '#'); other comments are ignored. */
-static ccn_status parse_comment(ccn_obj *o, cursor *c, long line, ccn_error *err) {
-    char t[64];
-    if (token(c, t) <= 0 || strcmp(t, "knot") != 0) return CCN_OK;
-    long i, j;
-    double d;
-    char a[64], b[64];
-    if (token(c, a) <= 0 || token(c, b) <= 0 || token(c, t) <= 0 || parse_int(a, &i) ||
-        parse_int(b, &j) || parse_double(t, &d) || i < 1 || j < 1 || i > INT32_MAX || j > INT32_MAX)
-        return bad(err, line, "expected '# knot i j d' with 1-based vertex indices");
+static ccn_status no_memory(ccn_error *err, long line) {
+    return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_LINE, (int32_t)line, "out of memory");
+}
+
+/* Appends an edge statement (0-based vertices a, b). */
+static ccn_status add_edge(ccn_obj *o, long a, long b, double knot, double crease, long line,
+                           ccn_error *err) {
     if (grow((void **)&o->knot, &o->cap_k, o->nk + 1, sizeof(double)) ||
+        grow((void **)&o->crease, &o->cap_c, o->nk + 1, sizeof(double)) ||
         grow((void **)&o->ev, &o->cap_e, 2 * (o->nk + 1), sizeof(int32_t)))
-        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_LINE, (int32_t)line, "out of memory");
-    o->ev[2 * o->nk] = (int32_t)(i - 1);
-    o->ev[2 * o->nk + 1] = (int32_t)(j - 1);
-    o->knot[o->nk++] = d;
+        return no_memory(err, line);
+    o->ev[2 * o->nk] = (int32_t)a;
+    o->ev[2 * o->nk + 1] = (int32_t)b;
+    o->knot[o->nk] = knot;
+    o->crease[o->nk] = crease;
+    o->nk++;
+    if (crease != 0.0) o->has_crease = 1;
     return CCN_OK;
+}
+
+/* Vertex a (0-based) gets sharpness s. */
+static ccn_status add_corner(ccn_obj *o, long a, double s, long line, ccn_error *err) {
+    if (grow((void **)&o->vcrease, &o->cap_vc, (int32_t)a + 1, sizeof(double))) return no_memory(err, line);
+    for (int32_t k = o->nvc; k <= (int32_t)a; k++) o->vcrease[k] = 0.0;
+    if (o->nvc < (int32_t)a + 1) o->nvc = (int32_t)a + 1;
+    o->vcrease[a] = s;
+    return CCN_OK;
+}
+
+static void warn(ccn_obj *o, long line, const char *what, const char *name) {
+    if (o->nwarn < OBJ_MAX_WARNINGS)
+        snprintf(o->warn[o->nwarn], sizeof o->warn[0], "OBJ line %ld: %s '%s' ignored", line, what, name);
+    o->nwarn++;
+}
+
+static int is_index(const char *t, long *out) {
+    char *e;
+    errno = 0;
+    long x = strtol(t, &e, 10);
+    if (e == t || *e != '\0' || errno == ERANGE) return 0;
+    *out = x;
+    return 1;
+}
+
+/* "# knot i j d", "# crease i j s", "# corner i s" (c is after '#'); other comments are
+ * ignored. */
+static ccn_status parse_comment(ccn_obj *o, cursor *c, long line, ccn_error *err) {
+    char t[64], a[64], b[64];
+    if (token(c, t) <= 0) return CCN_OK;
+    int knot = strcmp(t, "knot") == 0, crease = strcmp(t, "crease") == 0;
+    int corner = strcmp(t, "corner") == 0;
+    if (!knot && !crease && !corner) return CCN_OK;
+    long i, j = 0;
+    double d;
+    int na = token(c, a);
+    if ((crease || corner) && (na <= 0 || !is_index(a, &i))) return CCN_OK; /* prose */
+    if (corner) {
+        if (token(c, t) <= 0 || parse_double(t, &d) || i < 1 || i > INT32_MAX / 4)
+            return bad(err, line, "expected '# corner i s' with a 1-based vertex index");
+        return add_corner(o, i - 1, d, line, err);
+    }
+    if (na <= 0 || token(c, b) <= 0 || token(c, t) <= 0 || parse_int(a, &i) ||
+        parse_int(b, &j) || parse_double(t, &d) || i < 1 || j < 1 || i > INT32_MAX || j > INT32_MAX)
+        return bad(err, line, knot ? "expected '# knot i j d' with 1-based vertex indices"
+                                   : "expected '# crease i j s' with 1-based vertex indices");
+    return add_edge(o, i - 1, j - 1, knot ? d : 0.0, knot ? 0.0 : d, line, err);
+}
+
+#define TAG_MAX_VALUES 4096
+
+/* OpenSubdiv's `t name nints/nfloats/nstrings ints floats strings` (c is after "t"). */
+static ccn_status parse_tag(ccn_obj *o, cursor *c, long line, ccn_error *err) {
+    char name[64], cnt[64], t[64];
+    long n[3];
+    if (token(c, name) <= 0 || token(c, cnt) <= 0) return bad(err, line, "tag needs a name and nints/nfloats/nstrings");
+    {
+        char *p = cnt, *e;
+        for (int k = 0; k < 3; k++) {
+            errno = 0;
+            n[k] = strtol(p, &e, 10);
+            if (e == p || n[k] < 0 || n[k] > TAG_MAX_VALUES || errno || (k < 2 ? *e != '/' : *e != '\0'))
+                return bad(err, line, "tag counts must be nints/nfloats/nstrings");
+            p = e + 1;
+        }
+    }
+    int known = !strcmp(name, "crease") || !strcmp(name, "corner") || !strcmp(name, "interpolateboundary") ||
+                !strcmp(name, "creasemethod") || !strcmp(name, "facevaryinginterpolateboundary");
+    if (!known) { warn(o, line, "unsupported tag", name); return CCN_OK; }
+    long *ints = malloc(sizeof(long) * (size_t)(n[0] + 1));
+    double *fl = malloc(sizeof(double) * (size_t)(n[1] + 1));
+    char str[64] = "";
+    ccn_status st = CCN_OK;
+    if (!ints || !fl) { st = no_memory(err, line); goto done; }
+    for (long k = 0; k < n[0] && !st; k++)
+        if (token(c, t) <= 0 || !is_index(t, &ints[k])) st = bad(err, line, "tag integer expected");
+    for (long k = 0; k < n[1] && !st; k++)
+        if (token(c, t) <= 0 || parse_double(t, &fl[k])) st = bad(err, line, "tag number expected");
+    for (long k = 0; k < n[2] && !st; k++)
+        if (token(c, t) <= 0) st = bad(err, line, "tag string expected");
+        else if (k == 0) memcpy(str, t, sizeof str);
+    if (!st && token(c, t) != 0) st = bad(err, line, "tag has extra values");
+    if (st) goto done;
+    if (!strcmp(name, "crease")) {
+        long pairs = n[0] / 2;
+        if (n[0] < 2 || n[0] % 2 || !(n[1] == 1 || n[1] == pairs)) {
+            st = bad(err, line, "crease tag needs vertex pairs and one sharpness or one per pair");
+            goto done;
+        }
+        for (long k = 0; k < pairs && !st; k++) {
+            long a = ints[2 * k], b = ints[2 * k + 1];
+            if (a < 0 || b < 0 || a >= INT32_MAX || b >= INT32_MAX) { st = bad(err, line, "bad crease vertex"); break; }
+            double sh = fl[n[1] == 1 ? 0 : k];
+            st = add_edge(o, a, b, 0.0, sh > 0 ? sh : 0.0, line, err);
+        }
+    } else if (!strcmp(name, "corner")) {
+        if (n[0] < 1 || !(n[1] == 1 || n[1] == n[0])) {
+            st = bad(err, line, "corner tag needs vertices and one sharpness or one per vertex");
+            goto done;
+        }
+        for (long k = 0; k < n[0] && !st; k++) {
+            if (ints[k] < 0 || ints[k] >= INT32_MAX / 4) { st = bad(err, line, "bad corner vertex"); break; }
+            double sh = fl[n[1] == 1 ? 0 : k];
+            st = add_corner(o, ints[k], sh > 0 ? sh : 0.0, line, err);
+        }
+    } else if (!strcmp(name, "interpolateboundary")) {
+        if (n[0] != 1 || ints[0] < 0 || ints[0] > 2) { st = bad(err, line, "interpolateboundary needs one integer 0..2"); goto done; }
+        o->tags.boundary_corners = ints[0] == 1 ? CCN_CORNERS_PINNED : CCN_CORNERS_SMOOTH;
+        o->tags.boundary_none = ints[0] == 0;
+    } else if (!strcmp(name, "facevaryinginterpolateboundary")) {
+        if (n[0] != 1 || ints[0] < 0 || ints[0] > 5) { st = bad(err, line, "facevaryinginterpolateboundary needs one integer 0..5"); goto done; }
+        o->tags.fvar_boundary = (int32_t)ints[0];
+    } else { /* creasemethod */
+        if (n[2] != 1 || (strcmp(str, "normal") && strcmp(str, "uniform") && strcmp(str, "chaikin"))) {
+            st = bad(err, line, "creasemethod needs one string: normal (or uniform) or chaikin");
+            goto done;
+        }
+        o->tags.crease_method = strcmp(str, "chaikin") ? CCN_CREASE_UNIFORM : CCN_CREASE_CHAIKIN;
+    }
+done:
+    free(ints);
+    free(fl);
+    return st;
 }
 
 static ccn_status parse_line(ccn_obj *o, cursor *c, long line, ccn_error *err) {
@@ -137,6 +277,7 @@ static ccn_status parse_line(ccn_obj *o, cursor *c, long line, ccn_error *err) {
     if (len < 0) return bad(err, line, "token too long");
     if (strcmp(t, "v") == 0) return parse_v(o, c, line, err);
     if (strcmp(t, "f") == 0) return parse_f(o, c, line, err);
+    if (strcmp(t, "t") == 0) return parse_tag(o, c, line, err);
     return CCN_OK; /* vt, vn, o, g, s, usemtl, ... */
 }
 
@@ -146,6 +287,7 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
     *out = NULL;
     ccn_obj *o = calloc(1, sizeof *o);
     if (!o) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    o->tags.boundary_corners = o->tags.boundary_none = o->tags.crease_method = o->tags.fvar_boundary = -1;
     const char *s = text, *end = text + len;
     long line = 0;
     while (s < end) {
@@ -157,13 +299,29 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
         if (st) { ccn_obj_destroy(o); return st; }
         s = nl ? nl + 1 : end;
     }
+    if (o->nvc > 0) { /* vertex sharpness for every vertex (0 where no corner was given) */
+        if (o->nvc > o->nv) {
+            int32_t nvc = o->nvc, nv = o->nv;
+            ccn_obj_destroy(o);
+            return ccn__fail(err, CCN_ERR_IO, CCN_ELEM_VERTEX, nvc - 1,
+                             "OBJ: a corner names vertex %d, but the file has %d vertices",
+                             (int)nvc, (int)nv);
+        }
+        if (grow((void **)&o->vcrease, &o->cap_vc, o->nv, sizeof(double))) {
+            ccn_obj_destroy(o);
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        }
+        for (int32_t k = o->nvc; k < o->nv; k++) o->vcrease[k] = 0.0;
+        o->nvc = o->nv;
+    }
     *out = o;
     return CCN_OK;
 }
 
 void ccn_obj_destroy(ccn_obj *o) {
     if (!o) return;
-    free(o->pos); free(o->fsz); free(o->fv); free(o->ev); free(o->knot);
+    free(o->pos); free(o->fsz); free(o->fv); free(o->ev); free(o->knot); free(o->crease);
+    free(o->vcrease);
     free(o);
 }
 
@@ -178,5 +336,21 @@ ccn_status ccn_obj_cage(const ccn_obj *o, ccn_cage *c) {
     c->face_verts = o->fv;
     c->edge_verts = o->nk ? o->ev : NULL;
     c->edge_knots = o->nk ? o->knot : NULL;
+    c->edge_creases = o->has_crease ? o->crease : NULL;
+    c->vertex_creases = o->nvc > 0 ? o->vcrease : NULL; /* nvc = nv (ccn_obj_parse) */
     return CCN_OK;
+}
+
+ccn_status ccn_obj_get_tags(const ccn_obj *o, ccn_obj_tags *tags) {
+    if (!o || !tags) return CCN_ERR_ARGUMENT;
+    *tags = o->tags;
+    return CCN_OK;
+}
+
+int32_t ccn_obj_num_warnings(const ccn_obj *o) {
+    return o ? (o->nwarn < OBJ_MAX_WARNINGS ? o->nwarn : OBJ_MAX_WARNINGS) : 0;
+}
+
+const char *ccn_obj_warning(const ccn_obj *o, int32_t i) {
+    return o && i >= 0 && i < ccn_obj_num_warnings(o) ? o->warn[i] : NULL;
 }

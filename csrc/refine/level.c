@@ -12,6 +12,13 @@
  *  - scheme CATMULL_CLARK: all intervals are 1, which makes every rule above Catmull-Clark.
  *  - boundaries: the boundary is a cubic B-spline curve of the boundary polygon; valence-2
  *    corners are smooth, or fixed with CCN_CORNERS_PINNED.
+ *  - creases (rules/crease.h, OpenSubdiv's semantics with the knot-interval rules): an edge of
+ *    sharpness s >= 1 gets the curve edge point H (knot insertion along the crease), 0 < s < 1
+ *    the blend s H + (1-s) (smooth edge point); a vertex's point follows its rule: smooth and
+ *    dart the smooth rule, crease the curve vertex rule along its two sharp edges (as on a
+ *    boundary), corner the vertex itself, blended with OpenSubdiv's fractional weight where the
+ *    rule changes to the next level's. The eigen matrices act only at EVs without sharp edges
+ *    or vertex sharpness; valence-2 vertices always use NURSS / Catmull-Clark rules.
  *
  * New numbering (documented in ccnurbs.h): vertices = face points (face order), edge points
  * (edge order), vertex points (vertex order). Face f's corner j (half-edge h = fstart[f]+j)
@@ -24,6 +31,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "rules/bspline.h"
+#include "rules/crease.h"
 #include "rules/nurss.h"
 #include "topology/knots.h"
 #include "topology/mesh.h"
@@ -44,13 +52,90 @@ static void face_range(void *ctx, int32_t b, int32_t e) {
     }
 }
 
+/* Edge point of a sharp interior edge e (OpenSubdiv's ComputeEdgeVertexMask with the
+ * knot-interval crease point H and smooth point). */
+static void creased_edge_point(const ccn__level *c, int32_t e, const double *fp, double out[3]) {
+    const ccn_mesh *m = c->m;
+    float s = m->esharp[e];
+    const double *H = c->H + 3 * (size_t)e;
+    int crease = s >= 1.0f;
+    if (!crease && c->crease_method == CCN_CREASE_CHAIKIN)
+        crease = ccn__child_edge_sharpness(m, c->crease_method, e, m->everts[2 * e]) > 0.0f &&
+                 ccn__child_edge_sharpness(m, c->crease_method, e, m->everts[2 * e + 1]) > 0.0f;
+    if (crease) {
+        for (int k = 0; k < 3; k++) out[k] = H[k];
+        return;
+    }
+    double sm[3], w = (double)s;
+    ccn__edge_point(m, c->erep[e], c->H, fp, sm);
+    for (int k = 0; k < 3; k++) out[k] = w * H[k] + (1.0 - w) * sm[k];
+}
+
+static void one_edge_point(const ccn__level *c, int32_t e, const double *fp, double *ep) {
+    ccn__curve_edge_point(c->m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+    if (ccn__edge_sharp(c->m, e) && c->m->htwin[c->erep[e]] >= 0) creased_edge_point(c, e, fp, ep);
+    else ccn__edge_point(c->m, c->erep[e], c->H, fp, ep);
+}
+
 static void edge_range(void *ctx, int32_t b, int32_t end) {
     const points_job *j = ctx;
     const ccn__level *c = j->c;
-    for (int32_t e = b; e < end; e++) {
-        ccn__curve_edge_point(c->m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
-        ccn__edge_point(c->m, c->erep[e], c->H, j->fp, j->ep + 3 * (size_t)e);
+    for (int32_t e = b; e < end; e++) one_edge_point(c, e, j->fp, j->ep + 3 * (size_t)e);
+}
+
+#define CREASE_STACK 1024 /* fan sharpness on the stack up to this valence */
+
+/* Curve vertex point along fan edges a and b (OpenSubdiv's crease mask 3/4, 1/8, 1/8 for equal
+ * intervals; the boundary rule when a and b are the boundary edges). */
+static void crease_point(const ccn_mesh *m, int32_t v, const double *H, int32_t a, int32_t b,
+                         double out[3]) {
+    int32_t ea = ccn__fan_edge(m, v, a), eb = ccn__fan_edge(m, v, b);
+    double da = m->eknot[ea], db = m->eknot[eb], s = 1.0 / (2.0 * (da + db));
+    const double *p = m->pos + 3 * (size_t)v, *ha = H + 3 * (size_t)ea, *hb = H + 3 * (size_t)eb;
+    for (int k = 0; k < 3; k++) out[k] = 0.5 * p[k] + s * (db * ha[k] + da * hb[k]);
+}
+
+static void rule_point(const ccn__level *c, int32_t v, int rule, int32_t n, const float *s,
+                       const double *fp, double out[3]) {
+    const ccn_mesh *m = c->m;
+    if (rule == CCN_RULE_CORNER) {
+        for (int k = 0; k < 3; k++) out[k] = m->pos[3 * (size_t)v + k];
+    } else if (rule == CCN_RULE_CREASE) {
+        int32_t ends[2];
+        ccn__sharp_crease_ends(n, s, ends);
+        crease_point(m, v, c->H, ends[0], ends[1], out);
+    } else {
+        ccn__nurss_vertex_point(m, v, c->H, fp, out);
     }
+}
+
+/* Vertex point on a creased mesh (OpenSubdiv's ComputeVertexVertexMask). */
+static void creased_vertex_point(const ccn__level *c, int32_t v, const double *fp, double out[3]) {
+    const ccn_mesh *m = c->m;
+    int32_t n = ccn__valence(m, v);
+    float sbuf[2 * CREASE_STACK], *ps = sbuf;
+    if (n > CREASE_STACK && !(ps = malloc(sizeof(float) * 2 * (size_t)n))) {
+        rule_point(c, v, CCN_RULE_CORNER, 0, NULL, fp, out); /* out of memory: keep the point */
+        return;
+    }
+    float *cs = ps + n;
+    ccn__fan_sharpness(m, v, ps);
+    float pvs = ccn__vertex_sharpness(m, v, c->pinned);
+    int prule = ccn__sharp_rule(pvs, n, ps);
+    if (prule == CCN_RULE_SMOOTH || prule == CCN_RULE_DART) {
+        ccn__nurss_vertex_point(m, v, c->H, fp, out);
+    } else {
+        rule_point(c, v, prule, n, ps, fp, out);
+        float cvs = ccn__sharp_decrement(pvs);
+        ccn__sharp_children(c->crease_method, n, ps, cs);
+        int crule = ccn__sharp_rule(cvs, n, cs);
+        if (crule != prule) {
+            double ch[3], w = (double)ccn__sharp_fraction(c->crease_method, pvs, cvs, n, ps, cs);
+            rule_point(c, v, crule, n, cs, fp, ch);
+            for (int k = 0; k < 3; k++) out[k] = w * out[k] + (1.0 - w) * ch[k];
+        }
+    }
+    if (ps != sbuf) free(ps);
 }
 
 static void vertex_range(void *ctx, int32_t b, int32_t e) {
@@ -61,6 +146,8 @@ static void vertex_range(void *ctx, int32_t b, int32_t e) {
         double *out = j->vp + 3 * (size_t)v;
         if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
             memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        } else if (m->esharp) {
+            creased_vertex_point(c, v, j->fp, out);
         } else if (m->vboundary[v]) {
             ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
         } else {
@@ -219,6 +306,12 @@ static int same_interval(double a, double b) {
  * other EV or n-gon shares a face with v), and each spoke continues beyond its end E_i with the
  * spoke's own interval (e_i = d_i, Fig. 3/5 — what M assumes). See README "Design notes". */
 static int ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
+    if (m->esharp) /* no crease anywhere on v's faces */
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
+                if (ccn__sharp_count(m, m->hvert[h]) > 0 || m->vsharp[m->hvert[h]] > 0.0f) return 0;
+        }
     for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
         int32_t h = m->vfan[k];
         if (ccn__fsize(m, m->hface[h]) != 4) return 0;
@@ -239,7 +332,8 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
     c->nev = 0;
     if (!c->red) return CCN_OK;
     for (int32_t v = 0; v < m->nv; v++) {
-        if (!ccn__is_ev(m, v)) continue;
+        if (!ccn__is_ev(m, v) || ccn__valence(m, v) < 3) continue; /* valence 2: NURSS / CC rules */
+        if (m->esharp && (ccn__sharp_count(m, v) > 0 || m->vsharp[v] > 0.0f)) continue; /* creased */
         if (m->info.level == 0 && !ev_ready_at_level0(m, v)) continue; /* NURSS step */
         if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; continue; }
         c->ev_list[c->nev++] = v;
@@ -254,10 +348,11 @@ void ccn__level_free(ccn__level *c) {
 }
 
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
-                              ccn_error *err) {
+                              int crease_method, ccn_error *err) {
     memset(c, 0, sizeof *c);
     c->m = m;
     c->pinned = pinned;
+    c->crease_method = crease_method;
     c->red = scheme == CCN_SCHEME_EIGEN;
     c->threads = 1;
     c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
@@ -306,8 +401,7 @@ void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t
         int32_t v = verts[i], n = ccn__valence(m, v);
         for (int32_t k = 0; k < n; k++) {
             int32_t e = ccn__fan_edge(m, v, k);
-            ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
-            ccn__edge_point(m, c->erep[e], c->H, fp, ep + 3 * (size_t)e);
+            one_edge_point(c, e, fp, ep + 3 * (size_t)e);
         }
     }
     apply_red(c, 1, fp, ep, vp);
@@ -315,10 +409,28 @@ void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t
         int32_t v = verts[i];
         double *o = vp + 3 * (size_t)v;
         if (m->vfan_start[v + 1] == m->vfan_start[v]) memcpy(o, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        else if (m->esharp) creased_vertex_point(c, v, fp, o);
         else if (m->vboundary[v]) ccn__boundary_vertex_point(m, v, c->H, c->pinned, o);
         else ccn__nurss_vertex_point(m, v, c->H, fp, o);
     }
     apply_red(c, 2, fp, ep, vp);
+}
+
+/* Sharpness of the refined mesh: each half of an edge decays at its end vertex (uniform or
+ * Chaikin), the edges inside faces are smooth, a vertex point's sharpness decays; dropped
+ * again when nothing sharp is left. */
+static ccn_status child_sharpness(const ccn__level *c, ccn_mesh *r, ccn_error *err) {
+    const ccn_mesh *m = c->m;
+    if (!m->esharp) return CCN_OK;
+    if (ccn__mesh_alloc_sharpness(r))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (creases)");
+    for (int32_t e = 0; e < m->ne; e++) {
+        r->esharp[2 * e] = ccn__child_edge_sharpness(m, c->crease_method, e, m->everts[2 * e]);
+        r->esharp[2 * e + 1] = ccn__child_edge_sharpness(m, c->crease_method, e, m->everts[2 * e + 1]);
+    }
+    for (int32_t v = 0; v < m->nv; v++) r->vsharp[m->nf + m->ne + v] = ccn__sharp_decrement(m->vsharp[v]);
+    ccn__mesh_drop_smooth_sharpness(r);
+    return CCN_OK;
 }
 
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err) {
@@ -343,6 +455,7 @@ ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *e
         goto done;
     }
     if ((st = new_intervals(m, r, cand, err))) goto done;
+    if ((st = child_sharpness(c, r, err))) goto done;
     ccn__mesh_update_info(r);
     r->info.num_ring_conflicts = m->info.num_ring_conflicts;
     r->info.num_ignored_edges = m->info.num_ignored_edges;

@@ -12,6 +12,7 @@
 typedef struct {
     const ccn_mesh *m;   /* the level's topology, intervals and (input) positions */
     int pinned, red;     /* red: eigen matrices at the EVs */
+    int crease_method;   /* ccn_crease_method (creased meshes only) */
     int threads;         /* for ccn__level_points (set by the owner; default 1) */
     int32_t *erep;       /* a half-edge per edge */
     int32_t nev, *ev_list;
@@ -21,7 +22,7 @@ typedef struct {
     int32_t fallbacks;
 } ccn__level;
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
-                              ccn_error *err);
+                              int crease_method, ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
 void ccn__level_points(const ccn__level *c, double *out);
 /* Next-level points around the listed vertices only (see refine/level.c). */

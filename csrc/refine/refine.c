@@ -9,10 +9,10 @@
 
 #include <string.h>
 
-static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, int threads,
-                               ccn_mesh **out, ccn_error *err) {
+static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, int crease_method,
+                               int threads, ccn_mesh **out, ccn_error *err) {
     ccn__level c;
-    ccn_status st = ccn__level_prepare(&c, m, scheme, pinned, err);
+    ccn_status st = ccn__level_prepare(&c, m, scheme, pinned, crease_method, err);
     if (st) return st;
     c.threads = threads;
     st = ccn__level_topology(&c, out, err);
@@ -37,6 +37,11 @@ static ccn_mesh *mesh_clone(const ccn_mesh *m) {
     memcpy(r->hfanpos, m->hfanpos, sizeof(int32_t) * (size_t)m->nh);
     memcpy(r->vlast_edge, m->vlast_edge, sizeof(int32_t) * (size_t)m->nv);
     memcpy(r->vboundary, m->vboundary, (size_t)m->nv);
+    if (m->esharp) {
+        if (ccn__mesh_alloc_sharpness(r)) { ccn_mesh_destroy(r); return NULL; }
+        memcpy(r->esharp, m->esharp, sizeof(float) * (size_t)m->ne);
+        memcpy(r->vsharp, m->vsharp, sizeof(float) * (size_t)m->nv);
+    }
     r->knot_scale = m->knot_scale;
     r->info = m->info;
     return r;
@@ -58,6 +63,9 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
     *out = NULL;
     ccn_options o = {0};
     if (opts) o = *opts;
+    if (o.crease_method < CCN_CREASE_UNIFORM || o.crease_method > CCN_CREASE_CHAIKIN)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown crease_method %d",
+                         (int)o.crease_method);
     if (levels < 0 || levels > 16)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "levels must be in [0, 16], got %d", (int)levels);
@@ -76,7 +84,8 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
     ccn__normalize(cur, centre, &scale);
     for (int32_t l = 0; l < levels; l++) {
         ccn_mesh *next = NULL;
-        ccn_status st = refine_level(cur, o.scheme, pinned, ccn__thread_count(o.threads), &next, err);
+        ccn_status st = refine_level(cur, o.scheme, pinned, o.crease_method, ccn__thread_count(o.threads),
+                                     &next, err);
         ccn_mesh_destroy(cur);
         if (st) return st;
         cur = next;

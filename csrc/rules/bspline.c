@@ -11,10 +11,60 @@
  *  - a boundary vertex, edge along the boundary: the other boundary edge (the boundary is a
  *    cubic B-spline curve), or the edge's own interval at a pinned valence-2 corner.
  * Stencils read old control points only.
+ *
+ * Creases (rules/crease.h) split the surface into sectors that refine independently, like
+ * boundaries: the non-uniform spline on each side of an (at this level) sharp edge is the one
+ * that edge's curve bounds. So every look-up treats sharp edges (sharpness >= 1 at this level,
+ * ccn__edge_splits; a fractional edge blends rules that use the smooth look-ups) as boundary
+ * edges: at a vertex
+ * with two sharp edges (a crease) the interval beyond along a smooth edge is that edge's own
+ * (mirror), along a sharp edge the other sharp edge's (the crease curve continues); at a
+ * corner (three or more sharp edges, or vertex sharpness) every edge mirrors; at a dart (one
+ * sharp edge) the look-ups are the smooth ones. The quad face point's interval across a sharp
+ * edge is its own (mirror), as across a boundary.
  */
 #include "rules/bspline.h"
 
+#include "rules/crease.h"
+
+/* Fan edges of v that split the look-ups (boundary edges count). */
+static int32_t split_count(const ccn_mesh *m, int32_t v) {
+    int32_t n = ccn__valence(m, v), k = m->vboundary[v] ? 2 : 0;
+    for (int32_t i = m->vboundary[v] ? 1 : 0; i < (m->vboundary[v] ? n - 1 : n); i++)
+        k += ccn__edge_splits(m, ccn__fan_edge(m, v, i));
+    return k;
+}
+
+/* Crease-aware interval beyond v along fan edge k (see the file comment). */
+static double beyond_creased(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
+    int32_t n = ccn__valence(m, v), e = ccn__fan_edge(m, v, k);
+    int32_t nsharp = split_count(m, v);
+    int bnd_edge = m->vboundary[v] && (k == 0 || k == n - 1);
+    int sharp = bnd_edge || ccn__edge_splits(m, e);
+    int corner = nsharp >= 3 || ccn__vertex_sharpness(m, v, pinned) >= 1.0f;
+    if (sharp) {
+        if (nsharp == 2 && !corner) { /* along the crease: the other sharp edge */
+            for (int32_t j = 0; j < n; j++) {
+                if (j == k) continue;
+                int bj = m->vboundary[v] && (j == 0 || j == n - 1);
+                int32_t ej = ccn__fan_edge(m, v, j);
+                if (bj || ccn__edge_splits(m, ej)) return m->eknot[ej];
+            }
+        }
+        if (corner) return m->eknot[e];
+        /* a dart's sharp edge: the smooth look-up below */
+    } else if (nsharp >= 2 || corner) {
+        return m->eknot[e];
+    }
+    if (m->vboundary[v]) return m->eknot[e];
+    if (n == 4) return m->eknot[ccn__fan_edge(m, v, (k + 2) & 3)];
+    if (n == 2) return m->eknot[ccn__fan_edge(m, v, 1 - k)];
+    return 0.5 * (m->eknot[ccn__fan_edge(m, v, (k + n - 2) % n)] +
+                  m->eknot[ccn__fan_edge(m, v, (k + 2) % n)]);
+}
+
 double ccn__beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
+    if (m->esharp) return beyond_creased(m, v, k, pinned);
     int32_t n = ccn__valence(m, v);
     int32_t e = ccn__fan_edge(m, v, k);
     if (m->vboundary[v]) {
@@ -23,6 +73,7 @@ double ccn__beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
         return m->eknot[ccn__fan_edge(m, v, k == 0 ? n - 1 : 0)];
     }
     if (n == 4) return m->eknot[ccn__fan_edge(m, v, (k + 2) & 3)];
+    if (n == 2) return m->eknot[ccn__fan_edge(m, v, 1 - k)]; /* valence 2: the other edge */
     return 0.5 * (m->eknot[ccn__fan_edge(m, v, (k + n - 2) % n)] +
                   m->eknot[ccn__fan_edge(m, v, (k + 2) % n)]);
 }
@@ -39,6 +90,7 @@ double ccn__transverse(const ccn_mesh *m, int32_t h) {
 }
 
 double ccn__side(const ccn_mesh *m, int32_t h, int pinned) {
+    if (ccn__edge_splits(m, m->hedge[h])) return m->eknot[m->hedge[ccn__next(m, h)]]; /* mirror */
     int32_t v0 = m->hvert[h], v1 = m->hvert[ccn__next(m, h)];
     int ev0 = ccn__is_ev(m, v0), ev1 = ccn__is_ev(m, v1);
     if (ev0 || ev1) {
@@ -103,3 +155,20 @@ void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, i
     double s = 1.0 / (2.0 * (din + dout));
     for (int k = 0; k < 3; k++) out[k] = 0.5 * p[k] + s * (dout * hi[k] + din * ho[k]);
 }
+
+/* 1-D limit at knot t_0 of a cubic B-spline with control points P_-1, P_0, P_1 (blossoms
+ * f(t_-2,t_-1,t_0), f(t_-1,t_0,t_1), f(t_0,t_1,t_2)) and intervals D_-2, D_-1, D_0, D_1:
+ *   A = f(t_-1,t_0,t_0) = P_-1 + a (P_0 - P_-1),  a = (D_-2 + D_-1)/(D_-2 + D_-1 + D_0)
+ *   B = f(t_0,t_0,t_1)  = P_0 + b (P_1 - P_0),    b = D_-1/(D_-1 + D_0 + D_1)
+ *   f(t_0) = A + g (B - A), g = D_-1/(D_-1 + D_0);  f'(t_0) = 3 (B - A)/(D_-1 + D_0). */
+void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
+                                double dw[3]) {
+    double a = (dm2 + dm1) / (dm2 + dm1 + d0), b = dm1 / (dm1 + d0 + d1);
+    double g = dm1 / (dm1 + d0), s = 3.0 / (dm1 + d0);
+    double A[3] = {1 - a, a, 0}, B[3] = {0, 1 - b, b};
+    for (int i = 0; i < 3; i++) {
+        w[i] = A[i] + g * (B[i] - A[i]);
+        dw[i] = s * (B[i] - A[i]);
+    }
+}
+

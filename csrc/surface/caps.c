@@ -8,6 +8,7 @@
 #include "base/vec3.h"
 #include "bi5/bi5.h"
 #include "rules/bspline.h"
+#include "rules/crease.h"
 #include "surface/limit.h"
 #include "surface/patches.h"
 #include "surface/plan_levels.h"
@@ -17,6 +18,17 @@
 #include <string.h>
 
 #define CCN_CAP_MAX_VALENCE 32
+
+/* Sharp edges or vertex sharpness at v (boundary edges not counted)? */
+static int creased(const ccn_mesh *m, int32_t v) {
+    return m->esharp && (ccn__sharp_count(m, v) > (m->vboundary[v] ? 2 : 0) || m->vsharp[v] > 0.0f);
+}
+
+/* An EV the cap is for: interior, smooth (no crease at it), valence >= 3 (valence 2 is refined
+ * to the limit: surface/ring_limit.c). */
+static int cap_ev(const ccn_mesh *m, int32_t v) {
+    return ccn__is_ev(m, v) && ccn__valence(m, v) >= 3 && !creased(m, v);
+}
 
 void ccn__cap_free(ccn__cap *c) {
     free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
@@ -41,7 +53,7 @@ static int cap_isolated(const ccn_mesh *m, int32_t ev, int32_t *stamp, int32_t *
                     int32_t w = m->hvert[h];
                     if (stamp[w] == ev) continue;
                     stamp[w] = ev;
-                    if (m->vboundary[w] || ccn__valence(m, w) != 4) return 0;
+                    if (m->vboundary[w] || ccn__valence(m, w) != 4 || creased(m, w)) return 0;
                     queue[qn++] = w;
                 }
             }
@@ -53,7 +65,7 @@ static int cap_isolated(const ccn_mesh *m, int32_t ev, int32_t *stamp, int32_t *
 
 static int32_t count_evs(const ccn_mesh *m) {
     int32_t n = 0;
-    for (int32_t v = 0; v < m->nv; v++) n += ccn__is_ev(m, v);
+    for (int32_t v = 0; v < m->nv; v++) n += cap_ev(m, v);
     return n;
 }
 
@@ -181,7 +193,7 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
         for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
         int all = 1;
         for (int32_t v = 0; v < m->nv && all; v++)
-            if (ccn__is_ev(m, v) && !cap_isolated(m, v, stamp, q)) all = 0;
+            if (cap_ev(m, v) && !cap_isolated(m, v, stamp, q)) all = 0;
         free(stamp); free(q);
         if (all || K == 4) break;
     }
@@ -193,7 +205,7 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     if (!p->caps || !stamp || !q) { free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
     for (int32_t v = 0; v < m->nv; v++) {
-        if (!ccn__is_ev(m, v)) continue;
+        if (!cap_ev(m, v)) continue;
         if (!cap_isolated(m, v, stamp, q) || !cap_add(p, v, err)) p->sizes.num_cap_fallbacks++;
     }
     free(stamp); free(q);

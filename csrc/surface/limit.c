@@ -8,11 +8,15 @@
  *  - boundary valence 3 and pinned corners: the same with mirrored ghost points
  *    P(i,-1) = 2P(i,0) - P(i,1) (the boundary is the B-spline of the mirror extension,
  *    SPEC [1d]);
- *  - other boundary vertices (smooth corners, boundary EVs): the boundary curve's limit and
- *    tangent (exact: boundary rules read boundary points only); the cross-boundary tangent
- *    is approximated by the direction to the interior neighbours (documented limit);
- *  - interior EVs: left eigenvectors of the refinement matrix M of the 1-ring (stationary
- *    from level 1): eigenvalue 1 gives the limit point, the subdominant pair the tangents.
+ *  - other boundary vertices (smooth corners, boundary EVs), crease, corner and dart
+ *    vertices, interior valence 2, and vertices whose edges still carry semi-sharp values:
+ *    the stationary 1-ring matrix of surface/ring_limit.c (exact position and one exact
+ *    tangent plane per sector between sharp edges); for valences above
+ *    CCN_RING_MAX_VALENCE at a boundary, the boundary curve's limit with the cross-boundary
+ *    tangent approximated by the direction to the interior neighbours;
+ *  - smooth interior EVs: left eigenvectors of the refinement matrix M of the 1-ring
+ *    (stationary from level 1): eigenvalue 1 gives the limit point, the subdominant pair the
+ *    tangents, oriented by the characteristic map (right eigenvectors).
  *
  * 1-D limit at knot t_0 of a cubic B-spline with control points P_-1, P_0, P_1 (blossoms
  * f(t_-2,t_-1,t_0), f(t_-1,t_0,t_1), f(t_0,t_1,t_2)) and intervals D_-2, D_-1, D_0, D_1:
@@ -24,22 +28,11 @@
 
 #include "base/error.h"
 #include "rules/bspline.h"
+#include "rules/crease.h"
 
 #include <lapacke.h>
 #include <math.h>
 #include <string.h>
-
-/* 1-D value (w) and derivative (dw) weights on (P_-1, P_0, P_1). */
-void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
-                                double dw[3]) {
-    double a = (dm2 + dm1) / (dm2 + dm1 + d0), b = dm1 / (dm1 + d0 + d1);
-    double g = dm1 / (dm1 + d0), s = 3.0 / (dm1 + d0);
-    double A[3] = {1 - a, a, 0}, B[3] = {0, 1 - b, b};
-    for (int i = 0; i < 3; i++) {
-        w[i] = A[i] + g * (B[i] - A[i]);
-        dw[i] = s * (B[i] - A[i]);
-    }
-}
 
 static ccn__vpoint vp1(int32_t v) {
     ccn__vpoint p = {{v, 0, 0, 0}, {1, 0, 0, 0}, 1};
@@ -168,7 +161,9 @@ static void boundary_curve_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn
 int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned) {
     if (m->vfan_start[v + 1] == m->vfan_start[v]) return CCN_LIMIT_ISOLATED;
     int32_t n = ccn__valence(m, v);
-    if (!m->vboundary[v]) return n == 4 ? CCN_LIMIT_REGULAR : CCN_LIMIT_EV;
+    if (m->esharp && (ccn__sharp_count(m, v) > (m->vboundary[v] ? 2 : 0) || m->vsharp[v] > 0.0f))
+        return CCN_LIMIT_RING;
+    if (!m->vboundary[v]) return n == 4 ? CCN_LIMIT_REGULAR : n == 2 ? CCN_LIMIT_RING : CCN_LIMIT_EV;
     if (n == 3 || (n == 2 && pinned)) return CCN_LIMIT_REGULAR;
     return CCN_LIMIT_BOUNDARY_CURVE;
 }
@@ -195,17 +190,21 @@ int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring) {
     return 2 * n + 1;
 }
 
-/* Left eigenvectors of M (sz x sz, row-major): l0 for eigenvalue 1 (sum 1), l1/l2 spanning
- * the subdominant pair (real pair or real/imaginary parts of a complex pair). */
+/* Left eigenvectors of M (sz x sz, row-major; ring order F_0..F_{n-1}, E_0..E_{n-1}, V): l0
+ * for eigenvalue 1 (sum 1), l1/l2 spanning the subdominant pair (real pair or real/imaginary
+ * parts of a complex pair), l2's sign chosen so that (l1.P) x (l2.P) is the outward normal:
+ * the ring polygon E_0, F_0, E_1, ... runs counter-clockwise in the characteristic map (the
+ * right eigenvectors r1, r2) and G = [l_i . r_j] has positive determinant (see
+ * surface/ring_limit.c), whatever the geometry of the net. */
 static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *l1, double *l2,
                                ccn_error *err) {
     size_t s2 = (size_t)sz * sz;
-    double *A = malloc(sizeof(double) * (s2 + s2 + 2 * (size_t)sz));
+    double *A = malloc(sizeof(double) * (3 * s2 + 2 * (size_t)sz));
     if (!A) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
-    double *VL = A + s2, *wr = VL + s2, *wi = wr + sz, dummy = 0;
+    double *VL = A + s2, *VR = VL + s2, *wr = VR + s2, *wi = wr + sz;
     memcpy(A, M, sizeof(double) * s2);
-    lapack_int info = LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'V', 'N', sz, A, sz, wr, wi, VL, sz,
-                                    &dummy, 1);
+    lapack_int info = LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'V', 'V', sz, A, sz, wr, wi, VL, sz,
+                                    VR, sz);
     if (info != 0) {
         free(A);
         return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "eigen decomposition failed");
@@ -224,11 +223,21 @@ static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *
     for (int32_t r = 0; r < sz; r++) sum += VL[(size_t)r * sz + i0];
     int cplx = wi[i1] != 0.0;
     if (cplx && wi[i1] < 0) i1 = i1 - 1; /* LAPACK stores a pair as (re, im) columns i, i+1 */
+    int32_t j2 = cplx ? i1 + 1 : i2, n = (sz - 1) / 2;
+    double area = 0, g11 = 0, g12 = 0, g21 = 0, g22 = 0;
     for (int32_t r = 0; r < sz; r++) {
         l0[r] = VL[(size_t)r * sz + i0] / sum;
         l1[r] = VL[(size_t)r * sz + i1];
-        l2[r] = cplx ? VL[(size_t)r * sz + i1 + 1] : VL[(size_t)r * sz + i2];
+        l2[r] = VL[(size_t)r * sz + j2];
+        g11 += l1[r] * VR[(size_t)r * sz + i1]; g12 += l1[r] * VR[(size_t)r * sz + j2];
+        g21 += l2[r] * VR[(size_t)r * sz + i1]; g22 += l2[r] * VR[(size_t)r * sz + j2];
     }
+    for (int32_t k = 0; k < 2 * n; k++) { /* polygon E_0, F_0, E_1, F_1, ... */
+        int32_t a = k & 1 ? k / 2 : n + k / 2, kb = (k + 1) % (2 * n), b = kb & 1 ? kb / 2 : n + kb / 2;
+        area += VR[(size_t)a * sz + i1] * VR[(size_t)b * sz + j2] - VR[(size_t)b * sz + i1] * VR[(size_t)a * sz + j2];
+    }
+    if ((area < 0) != (g11 * g22 - g12 * g21 < 0))
+        for (int32_t r = 0; r < sz; r++) l2[r] = -l2[r];
     free(A);
     if (!(fabs(sum) > 1e-300))
         return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "no eigenvalue 1 in M");
@@ -326,20 +335,22 @@ static void child_boundary_curve(const ccn_mesh *m, int32_t v, ccn__stencil *s) 
 }
 
 ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
-                                    ccn__stencil *s, int32_t orient[3], ccn_error *err) {
+                                    int crease_method, ccn__ring_work *w, ccn__stencil *s,
+                                    ccn__ring_limit *ring, ccn_error *err) {
     int kind = ccn__limit_kind(m, v, pinned);
-    orient[0] = -1;
     s->n = 0;
+    if (ring) ring->nsec = 0;
     if (kind == CCN_LIMIT_REGULAR) child_regular(m, v, s);
-    else if (kind == CCN_LIMIT_BOUNDARY_CURVE) child_boundary_curve(m, v, s);
     else if (kind == CCN_LIMIT_ISOLATED) stencil_add(s, m->nf + m->ne + v, 1, 0, 0);
-    else {
-        ccn_status st = ev_limit_ring(m, v, scheme, 1, s, err);
+    else if (kind == CCN_LIMIT_EV) return ev_limit_ring(m, v, scheme, 1, s, err);
+    else if (ccn__valence(m, v) > CCN_RING_MAX_VALENCE || !w || !ring) {
+        if (kind == CCN_LIMIT_BOUNDARY_CURVE) child_boundary_curve(m, v, s);
+        else stencil_add(s, m->nf + m->ne + v, 1, 0, 0); /* huge creased valence: the point */
+    } else {
+        ccn_status st = ccn__ring_limit_eval(m, v, scheme, pinned, crease_method, w, ring, err);
         if (st) return st;
-        int32_t h = m->vfan[m->vfan_start[v]];
-        orient[0] = m->nf + m->ne + v;
-        orient[1] = m->nf + m->hedge[h];
-        orient[2] = m->nf + m->hedge[m->vfan[m->vfan_start[v] + 1]];
+        for (int32_t i = 0; i < ring->npts; i++) /* sector 0's tangents for the stencil */
+            stencil_add(s, ring->pts[i], ring->wp[i], ring->wu[i], ring->wv[i]);
     }
     return CCN_OK;
 }

@@ -2,6 +2,7 @@
 #ifndef CCN_SURFACE_LIMIT_H
 #define CCN_SURFACE_LIMIT_H
 
+#include "surface/ring_limit.h"
 #include "topology/halfedge.h"
 
 #define CCN_STENCIL_MAX 2049 /* 2n+1 for valence n <= 1024 */
@@ -17,8 +18,10 @@ typedef struct {
 enum {
     CCN_LIMIT_REGULAR = 0,     /* tensor B-spline limit (mirror ghosts on the boundary) */
     CCN_LIMIT_BOUNDARY_CURVE,  /* smooth corner or boundary EV */
-    CCN_LIMIT_EV,              /* interior extraordinary vertex: use ccn__ev_limit */
-    CCN_LIMIT_ISOLATED
+    CCN_LIMIT_EV,              /* smooth interior extraordinary vertex: use ccn__ev_limit */
+    CCN_LIMIT_ISOLATED,
+    CCN_LIMIT_RING             /* sharp spokes or vertex sharpness, interior valence 2:
+                                  surface/ring_limit.c, from the child 1-ring */
 };
 
 /* A virtual grid point: up to 4 real vertices with weights (mirror ghosts). */
@@ -29,9 +32,6 @@ typedef struct { int32_t v[4]; double w[4]; int n; } ccn__vpoint;
  * D_-2, D_-1, D_0, D_1 along u (D_0 between (0,0) and (1,0)); dv likewise. */
 typedef struct { ccn__vpoint p[3][3]; double du[4], dv[4]; } ccn__vgrid;
 void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g);
-/* 1-D limit value (w) and derivative (dw) weights on (P_-1, P_0, P_1) at knot t_0. */
-void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
-                              double dw[3]);
 
 int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
 /* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the
@@ -40,13 +40,14 @@ int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s
 /* 1-ring of an interior vertex in M's order (F_0..F_{n-1}, E_0..E_{n-1}, V); returns 2n+1. */
 int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring);
 /* Limit point and tangent directions of an interior EV from the left eigenvectors of M
- * (scheme's matrix). The tangent pair's orientation is arbitrary: callers orient the
- * normal with the 1-ring. */
+ * (scheme's matrix); wu x wv is the outward normal (oriented by the characteristic map). */
 ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
                          ccn_error *err);
 /* Limit stencil of the vertex point of v one level finer, in level-(l+1) numbering (face
  * point f -> f, edge point e -> nf+e, vertex point v -> nf+ne+v), built from this level's
- * topology. orient: for EVs the (v, a, b) whose (a-v) x (b-v) orients the normal, else -1. */
+ * topology; wu x wv is the outward normal. For BOUNDARY_CURVE and RING vertices (w and ring
+ * given) ring receives every sector's tangent pair (s holds sector 0's). */
 ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
-                                    ccn__stencil *s, int32_t orient[3], ccn_error *err);
+                                    int crease_method, ccn__ring_work *w, ccn__stencil *s,
+                                    ccn__ring_limit *ring, ccn_error *err);
 #endif

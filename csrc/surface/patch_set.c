@@ -142,6 +142,7 @@ void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v) {
     v->pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     memcpy(v->centre, p->centre, sizeof v->centre);
     v->scale = p->scale;
+    v->crease_method = p->opts.crease_method;
 }
 
 /* ---- ccn_plan_patches ------------------------------------------------------------ */

@@ -49,6 +49,7 @@ typedef struct {
     int32_t scheme;            /* ccn_scheme */
     int pinned;                /* boundary_corners == CCN_CORNERS_PINNED */
     double centre[3], scale;
+    int32_t crease_method;     /* ccn_crease_method */
 } ccn__plan_view;
 void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v);
 

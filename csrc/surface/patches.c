@@ -15,6 +15,8 @@
  */
 #include "surface/patches.h"
 
+#include "rules/bspline.h"
+
 #include <string.h>
 
 static void span_to_bezier(const double D[5], double C[4][4]) {

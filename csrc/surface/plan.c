@@ -35,9 +35,10 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t c = 0; c < p->ncap; c++) ccn__cap_free(&p->caps[c]);
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
     free(p->ops); free(p->op_n); free(p->caps); free(p->prep); free(p->lev);
-    free(p->vmapL); free(p->out_fv); free(p->out_origin);
+    free(p->vmapL); free(p->out_vL); free(p->out_fv); free(p->out_origin); free(p->out_eorigin);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
-    free(p->orient); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
+    free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
+    free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
     free(p);
 }
@@ -50,6 +51,9 @@ static ccn_status check_options(const ccn_options *o, ccn_error *err) {
     if (o->boundary_corners < CCN_CORNERS_SMOOTH || o->boundary_corners > CCN_CORNERS_PINNED)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown boundary_corners %d",
                          (int)o->boundary_corners);
+    if (o->crease_method < CCN_CREASE_UNIFORM || o->crease_method > CCN_CREASE_CHAIKIN)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown crease_method %d",
+                         (int)o->crease_method);
     if (o->levels < 0 || o->levels > CCN_MAX_LEVELS)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "levels must be in [0, %d], got %d",
                          CCN_MAX_LEVELS, (int)o->levels);
@@ -64,7 +68,7 @@ static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
     if (p->R > p->L) { p->posS = p->lev[p->L + 1]->pos; return CCN_OK; }
     const ccn_mesh *m = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
-    ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, err);
+    ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, p->opts.crease_method, err);
     if (st) return st;
     p->has_sub = 1;
     p->sub.threads = 1; /* a few points only */
@@ -92,6 +96,9 @@ static void fill_sizes(ccn_plan *p) {
     s->num_ring_conflicts = c->num_ring_conflicts;
     s->num_ignored_verts = c->num_ignored_verts;
     s->num_ignored_edges = c->num_ignored_edges;
+    s->num_sharp_edges = c->num_sharp_edges;
+    s->num_sharp_vertices = c->num_sharp_vertices;
+    s->num_sharp_corners = p->nsv;
 }
 
 ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
@@ -186,17 +193,6 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
         if (!out->normals) continue;
         double *n = out->normals + 3 * (size_t)o;
         ccn__unit_normal(du, dv, n);
-        const int32_t *r = p->orient + 3 * (size_t)o;
-        if (r[0] >= 0) { /* EV: agree with the first face of the 1-ring */
-            double a[3], b[3], c[3];
-            const double *r0 = SPOINT(r[0]), *r1 = SPOINT(r[1]), *r2 = SPOINT(r[2]);
-            for (int i = 0; i < 3; i++) {
-                a[i] = r1[i] - r0[i];
-                b[i] = r2[i] - r0[i];
-            }
-            ccn__cross3(a, b, c);
-            if (c[0] * n[0] + c[1] * n[1] + c[2] * n[2] < 0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
-        }
     }
 }
 
@@ -205,11 +201,45 @@ static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
     ccn__parallel_for(p->threads, p->nout_v, stencil_range, &j);
 }
 
+/* Sharp features: each sector's normal, the vertex normal = their normalised sum. */
+static void eval_sectors(ccn_plan *p, ccn_limit_mesh *out) {
+    const double *PL = p->lev[p->L]->pos, *PS = p->posS;
+    int32_t nvL = p->lev[p->L]->nv;
+    for (int32_t sc = 0; sc < p->nsec; sc++) {
+        double du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+        for (int32_t k = p->sec_start[sc]; k < p->sec_start[sc + 1]; k++) {
+            const double *q = SPOINT(p->sec_v[k]);
+            for (int i = 0; i < 3; i++) { du[i] += p->sec_wu[k] * q[i]; dv[i] += p->sec_wv[k] * q[i]; }
+        }
+        ccn__unit_normal(du, dv, p->sec_nrm + 3 * (size_t)sc);
+    }
+    for (int32_t i = 0; i < p->nsv; i++) {
+        double sum[3] = {0, 0, 0}, *n = out->normals + 3 * (size_t)p->sv_out[i];
+        for (int32_t sc = p->sv_sec[i]; sc < p->sv_sec[i + 1]; sc++)
+            for (int k = 0; k < 3; k++) sum[k] += p->sec_nrm[3 * (size_t)sc + k];
+        double l = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+        if (l > 1e-12) for (int k = 0; k < 3; k++) n[k] = sum[k] / l;
+        else memcpy(n, p->sec_nrm + 3 * (size_t)p->sv_sec[i], sizeof(double) * 3); /* a fold */
+    }
+}
+
+static void eval_corner_normals(const ccn_plan *p, ccn_limit_mesh *out) {
+    for (int32_t f = 0; f < p->nout_f; f++)
+        for (int k = 0; k < 4; k++) {
+            int32_t sc = p->corner_sec ? p->corner_sec[4 * f + k] : -1;
+            const double *src = sc >= 0 ? p->sec_nrm + 3 * (size_t)sc
+                                        : out->normals + 3 * (size_t)p->out_fv[4 * f + k];
+            memcpy(out->corner_normals + 3 * (4 * (size_t)f + k), src, sizeof(double) * 3);
+        }
+}
+
 ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh *out,
                              ccn_error *err) {
     ccn__ok(err);
     if (!p || !out || !out->positions)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "plan, out or out->positions is NULL");
+    if (out->corner_normals && !out->normals)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "corner_normals needs normals too");
     if (positions) {
         ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
         if (st) return st;
@@ -224,11 +254,15 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
     if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
     eval_stencils(p, out);
+    if (out->normals && p->nsec) eval_sectors(p, out);
     ccn_status st = ccn__caps_evaluate(p, out, err);
     if (st) return st;
+    if (out->corner_normals) eval_corner_normals(p, out);
     for (int32_t o = 0; o < p->nout_v; o++)
         for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
     if (out->face_verts) memcpy(out->face_verts, p->out_fv, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
+    if (out->corner_edge_origin)
+        memcpy(out->corner_edge_origin, p->out_eorigin, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
 }

@@ -41,13 +41,22 @@ struct ccn_plan {
     /* output mesh = level L without isolated vertices */
     int32_t nout_v, nout_f;
     int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */
+    int32_t *out_vL;        /* output vertex -> level-L vertex */
     int32_t *out_fv, *out_origin;
+    int32_t *out_eorigin;   /* 4 * nout_f: cage edge under each face corner's outgoing edge */
     /* limit stencils, CSR; index < lev[L]->nv: a level-L vertex, else (index - lev[L]->nv)
      * is a level-(L+1) point (face points, edge points, vertex points) */
     int32_t *st_start, *st_v;
     double *st_wp, *st_wu, *st_wv;
-    int32_t *orient;        /* 3 stencil indices per output vertex (v, a, b) or -1: flip the
-                               normal to agree with (a-v) x (b-v) */
+    /* sharp features: output vertices whose faces see more than one tangent plane (creases,
+     * corners). Their sectors' tangent stencils (indices as st_v), CSR; each output face
+     * corner names its sector (-1: the vertex normal). The vertex normal of such a vertex is
+     * the normalised sum of its sectors' normals. */
+    int32_t nsv, *sv_out, *sv_sec;  /* sv_sec: nsv + 1 offsets into the sectors */
+    int32_t nsec, *sec_start, *sec_v;
+    double *sec_wu, *sec_wv;
+    int32_t *corner_sec;            /* 4 * nout_f, NULL when nsv = 0 */
+    double *sec_nrm;                /* evaluate's scratch: 3 * nsec */
     /* caps */
     int32_t ncap;
     ccn__cap *caps;

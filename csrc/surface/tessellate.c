@@ -15,16 +15,41 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
     if (!p->vmapL || !p->out_fv || !p->out_origin)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    /* output vertices are numbered in the order the output faces first use them (the faces
+     * are in the refinement's quadtree order), so neighbours on the surface get near numbers:
+     * the index arrays of a saved mesh compress like Subdivision Surface's; loose cage vertices
+     * (no face) get none */
     int32_t no = 0;
-    for (int32_t v = 0; v < mL->nv; v++)
-        p->vmapL[v] = mL->vfan_start[v + 1] > mL->vfan_start[v] ? no++ : -1;
+    for (int32_t v = 0; v < mL->nv; v++) p->vmapL[v] = -1;
+    for (int32_t h = 0; h < mL->nh; h++) {
+        int32_t v = mL->hvert[h];
+        if (p->vmapL[v] < 0) p->vmapL[v] = no++;
+        p->out_fv[h] = p->vmapL[v];
+    }
     p->nout_v = no;
     p->nout_f = mL->nf;
-    for (int32_t h = 0; h < mL->nh; h++) p->out_fv[h] = p->vmapL[mL->hvert[h]];
+    p->out_vL = malloc(sizeof(int32_t) * (size_t)(no ? no : 1));
+    if (!p->out_vL) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    for (int32_t v = 0; v < mL->nv; v++)
+        if (p->vmapL[v] >= 0) p->out_vL[p->vmapL[v]] = v;
     for (int32_t f = 0; f < mL->nf; f++) {
         int32_t g = f;
         for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
         p->out_origin[f] = g;
+    }
+    /* the child quad q of level l+1 at corner j of a level-l face is that corner's half-edge
+     * (refine/level.c): its corner 0 -> 1 lies on the parent half-edge q, its corner 3 -> 0 on the
+     * parent's previous half-edge, its corners 1 -> 2 and 2 -> 3 inside the parent face */
+    p->out_eorigin = malloc(sizeof(int32_t) * (size_t)(mL->nh ? mL->nh : 1));
+    if (!p->out_eorigin) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    for (int32_t h = 0; h < mL->nh; h++) {
+        int32_t g = h;
+        for (int32_t l = p->L; l > 0 && g >= 0; l--) {
+            const ccn_mesh *m = p->lev[l], *up = p->lev[l - 1];
+            int32_t q = m->hface[g], k = g - m->fstart[q];
+            g = k == 0 ? q : k == 3 ? ccn__prev(up, q) : -1;
+        }
+        p->out_eorigin[h] = g;
     }
     return CCN_OK;
 }
@@ -70,35 +95,92 @@ static void offset_stencil(ccn__stencil *s, int32_t off) {
     for (int i = 0; i < s->n; i++) s->v[i] += off;
 }
 
+/* Appends the sectors of ring (several tangent planes at output vertex o, level-L vertex v):
+ * their stencils (offset into the level-(L+1) indices) and the sector of each face corner. */
+static int push_sectors(ccn_plan *p, const ccn_mesh *mL, int32_t v, int32_t o,
+                        const ccn__ring_limit *ring, csr_buf *sb, int32_t *cap_sv, int32_t *cap_sec) {
+    if (p->nsv + 1 >= *cap_sv) {
+        int32_t nc = 2 * *cap_sv + 64;
+        int32_t *a = realloc(p->sv_out, sizeof(int32_t) * (size_t)nc);
+        if (a) p->sv_out = a;
+        int32_t *b = realloc(p->sv_sec, sizeof(int32_t) * ((size_t)nc + 1));
+        if (b) p->sv_sec = b;
+        if (!a || !b) return -1;
+        *cap_sv = nc;
+    }
+    if (!p->corner_sec) {
+        p->corner_sec = malloc(sizeof(int32_t) * 4 * (size_t)(p->nout_f ? p->nout_f : 1));
+        if (!p->corner_sec) return -1;
+        for (int32_t i = 0; i < 4 * p->nout_f; i++) p->corner_sec[i] = -1;
+        p->sv_sec[0] = 0;
+    }
+    if (p->nsec + ring->nsec + 1 >= *cap_sec) {
+        int32_t nc = 2 * *cap_sec + ring->nsec + 64;
+        int32_t *a = realloc(p->sec_start, sizeof(int32_t) * ((size_t)nc + 1));
+        if (!a) return -1;
+        p->sec_start = a;
+        if (p->nsec == 0) p->sec_start[0] = 0;
+        *cap_sec = nc;
+    }
+    ccn__stencil *t = malloc(sizeof *t);
+    if (!t) return -1;
+    for (int32_t s = 0; s < ring->nsec; s++) {
+        t->n = 0;
+        for (int32_t i = 0; i < ring->npts; i++) {
+            double wu = ring->wu[(size_t)s * ring->npts + i], wv = ring->wv[(size_t)s * ring->npts + i];
+            if (wu == 0.0 && wv == 0.0) continue;
+            t->v[t->n] = ring->pts[i] + mL->nv; t->wp[t->n] = 0; t->wu[t->n] = wu; t->wv[t->n] = wv;
+            t->n++;
+        }
+        if (csr_push(sb, t)) { free(t); return -1; }
+        int32_t sec = p->nsec++;
+        p->sec_start[sec + 1] = sb->n;
+        for (int32_t j = 0; j < ring->sec_nface[s]; j++) { /* the fan faces of the sector */
+            int32_t k = (ring->sec_face0[s] + j) % ccn__valence(mL, v);
+            int32_t h = mL->vfan[mL->vfan_start[v] + k], f = mL->hface[h];
+            p->corner_sec[4 * f + (h - mL->fstart[f])] = sec;
+        }
+    }
+    free(t);
+    p->sv_out[p->nsv] = o;
+    p->sv_sec[p->nsv + 1] = p->nsec;
+    p->nsv++;
+    return 0;
+}
+
 static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     ccn__stencil *s = malloc(sizeof *s);
-    csr_buf b = {0, 0, NULL, NULL, NULL, NULL};
+    ccn__ring_limit *ring = malloc(sizeof *ring);
+    ccn__ring_work *work = ccn__ring_work_create();
+    csr_buf b = {0, 0, NULL, NULL, NULL, NULL}, sb = {0, 0, NULL, NULL, NULL, NULL};
+    int32_t cap_sv = 0, cap_sec = 0;
     p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
-    p->orient = malloc(sizeof(int32_t) * 3 * (size_t)(p->nout_v ? p->nout_v : 1));
     p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     uint8_t *irr = malloc((size_t)(mL->nv ? mL->nv : 1));
     ccn_status st = CCN_OK;
-    if (!s || !p->st_start || !p->orient || !p->near || !irr) {
+    if (!s || !ring || !work || !p->st_start || !p->near || !irr) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
     p->st_start[0] = 0;
     p->nnear = 0;
     for (int32_t v = 0; v < mL->nv; v++) irr[v] = ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_REGULAR;
-    for (int32_t v = 0; v < mL->nv; v++) {
-        int32_t o = p->vmapL[v];
-        if (o < 0) continue;
-        int32_t *ori = p->orient + 3 * o;
+    for (int32_t o = 0; o < p->nout_v; o++) {
+        int32_t v = p->out_vL[o];
         if (!near_irregular(mL, v, irr)) {
             ccn__limit_stencil(mL, v, pinned, s);
-            ori[0] = -1;
         } else {
             p->near[p->nnear++] = v;
-            if ((st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, s, ori, err))) goto done;
+            st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, p->opts.crease_method, work,
+                                          s, ring, err);
+            if (st) goto done;
             offset_stencil(s, mL->nv);
-            if (ori[0] >= 0) for (int k = 0; k < 3; k++) ori[k] += mL->nv;
+            if (ring->nsec > 1 && push_sectors(p, mL, v, o, ring, &sb, &cap_sv, &cap_sec)) {
+                st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+                goto done;
+            }
         }
         if (csr_push(&b, s)) {
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
@@ -106,9 +188,17 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
         }
         p->st_start[o + 1] = b.n;
     }
+    if (p->nsec) {
+        p->sec_nrm = malloc(sizeof(double) * 3 * (size_t)p->nsec);
+        if (!p->sec_nrm) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+    }
 done:
     p->st_v = b.v; p->st_wp = b.wp; p->st_wu = b.wu; p->st_wv = b.wv;
+    p->sec_v = sb.v; p->sec_wu = sb.wu; p->sec_wv = sb.wv;
+    free(sb.wp);
     free(s);
+    free(ring);
+    ccn__ring_work_destroy(work);
     free(irr);
     return st;
 }

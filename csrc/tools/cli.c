@@ -50,25 +50,37 @@ static int load_cage(const char *path, ccn_obj **obj, ccn_cage *cage) {
     free(text);
     if (st) return ccn_cli_error(path, &err);
     ccn_obj_cage(*obj, cage);
+    for (int32_t i = 0; i < ccn_obj_num_warnings(*obj); i++)
+        fprintf(stderr, "ccnurbs: %s: warning: %s\n", path, ccn_obj_warning(*obj, i));
     return 0;
 }
 
-int ccn_cli_load_mesh(const char *path, ccn_mesh **out) {
+/* Options left unset on the command line (-1) come from the file's tags, else the defaults. */
+static void resolve_options(const ccn_obj *obj, ccn_options *o) {
+    ccn_obj_tags t;
+    ccn_obj_get_tags(obj, &t);
+    if (o->boundary_corners < 0) o->boundary_corners = t.boundary_corners >= 0 ? t.boundary_corners : CCN_CORNERS_SMOOTH;
+    if (o->crease_method < 0) o->crease_method = t.crease_method >= 0 ? t.crease_method : CCN_CREASE_UNIFORM;
+}
+
+int ccn_cli_load_mesh(const char *path, ccn_options *o, ccn_mesh **out) {
     ccn_obj *obj = NULL;
     ccn_cage cage;
     int rc = load_cage(path, &obj, &cage);
     if (rc) return rc;
+    resolve_options(obj, o);
     ccn_error err;
     ccn_status st = ccn_mesh_create(&cage, out, &err);
     ccn_obj_destroy(obj);
     return st ? ccn_cli_error(path, &err) : 0;
 }
 
-int ccn_cli_load_plan(const char *path, const ccn_options *o, ccn_plan **plan) {
+int ccn_cli_load_plan(const char *path, ccn_options *o, ccn_plan **plan) {
     ccn_obj *obj = NULL;
     ccn_cage cage;
     int rc = load_cage(path, &obj, &cage);
     if (rc) return rc;
+    resolve_options(obj, o);
     ccn_error err;
     ccn_status st = ccn_plan_create(&cage, o, plan, &err);
     ccn_obj_destroy(obj);
@@ -83,9 +95,12 @@ static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
     int32_t *fv = malloc(sizeof(int32_t) * (size_t)(in.num_face_verts ? in.num_face_verts : 1));
     int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)(in.num_edges ? in.num_edges : 1));
     double *ek = malloc(sizeof(double) * (size_t)(in.num_edges ? in.num_edges : 1));
+    double *es = malloc(sizeof(double) * (size_t)(in.num_edges ? in.num_edges : 1));
+    double *vs = malloc(sizeof(double) * (size_t)(in.num_verts ? in.num_verts : 1));
     int rc = -1;
-    if (!pos || !fs || !fv || !ev || !ek) goto done;
+    if (!pos || !fs || !fv || !ev || !ek || !es || !vs) goto done;
     ccn_mesh_copy(m, pos, fs, fv, ev, ek);
+    ccn_mesh_creases(m, es, vs);
     if (header) fprintf(f, "%s", header);
     fprintf(f, "# ccnurbs level %d: %d vertices, %d faces, %d edges, %d ring conflicts, "
                "%d EV fallbacks\n", (int)in.level, (int)in.num_verts, (int)in.num_faces,
@@ -99,9 +114,14 @@ static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
     }
     for (int32_t e = 0; e < in.num_edges; e++)
         fprintf(f, "# knot %d %d %.17g\n", (int)ev[2 * e] + 1, (int)ev[2 * e + 1] + 1, ek[e]);
+    for (int32_t e = 0; e < in.num_edges; e++)
+        if (es[e] > 0)
+            fprintf(f, "# crease %d %d %.9g\n", (int)ev[2 * e] + 1, (int)ev[2 * e + 1] + 1, es[e]);
+    for (int32_t v = 0; v < in.num_verts; v++)
+        if (vs[v] > 0) fprintf(f, "# corner %d %.9g\n", (int)v + 1, vs[v]);
     rc = ferror(f) ? -1 : 0;
 done:
-    free(pos); free(fs); free(fv); free(ev); free(ek);
+    free(pos); free(fs); free(fv); free(ev); free(ek); free(es); free(vs);
     return rc;
 }
 
@@ -150,6 +170,8 @@ int ccn_cli_int(const char *s, int lo, int hi, int *out) {
 /* Shared option parser of refine / limit / patches (see cli.h). */
 int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_options *o,
                   const char **in, const char **out) {
+    o->boundary_corners = -1; /* unset: the file's tags decide (resolve_options) */
+    o->crease_method = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(a, "--scheme") == 0 && val) {
@@ -170,6 +192,11 @@ int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_o
             if (strcmp(val, "smooth") == 0) o->boundary_corners = CCN_CORNERS_SMOOTH;
             else if (strcmp(val, "pinned") == 0) o->boundary_corners = CCN_CORNERS_PINNED;
             else { fprintf(stderr, "ccnurbs: bad --corners '%s'\n", val); return 2; }
+            i++;
+        } else if (strcmp(a, "--crease-method") == 0 && val) {
+            if (strcmp(val, "uniform") == 0) o->crease_method = CCN_CREASE_UNIFORM;
+            else if (strcmp(val, "chaikin") == 0) o->crease_method = CCN_CREASE_CHAIKIN;
+            else { fprintf(stderr, "ccnurbs: bad --crease-method '%s'\n", val); return 2; }
             i++;
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);

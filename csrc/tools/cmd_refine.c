@@ -9,7 +9,7 @@ int ccn_cmd_refine(int argc, char **argv) {
     int rc0 = ccn_cli_parse(argc, argv, CCN_CLI_LEVELS, 16, &o, &in, &out);
     if (rc0) return rc0;
     ccn_mesh *cage = NULL, *ref = NULL;
-    int rc = ccn_cli_load_mesh(in, &cage);
+    int rc = ccn_cli_load_mesh(in, &o, &cage);
     if (rc) return rc;
     ccn_error err;
     if (ccn_refine(cage, o.levels, &o, &ref, &err)) rc = ccn_cli_error(in, &err);

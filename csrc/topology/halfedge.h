@@ -31,6 +31,12 @@ struct ccn_mesh {
     int32_t *hfanpos;    /* nh: position of h in its origin vertex's fan */
     int32_t *vlast_edge; /* nv: incoming boundary edge of a boundary vertex, else -1 */
     uint8_t *vboundary;  /* nv */
+    /* Sharpness (OpenSubdiv semantics: > 0 sharp, >= 10 infinite), kept in single precision
+     * as OpenSubdiv keeps it so that fractional blends match it bit for bit. Both NULL when
+     * every edge and vertex is smooth (then every rule is the crease-free one). Boundary
+     * edges are infinitely sharp whatever esharp says. */
+    float *esharp;       /* ne */
+    float *vsharp;       /* nv */
     ccn_mesh_info info;
 };
 
@@ -52,6 +58,18 @@ static inline int32_t ccn__valence(const ccn_mesh *m, int32_t v) {
 static inline int32_t ccn__fan_edge(const ccn_mesh *m, int32_t v, int32_t k) {
     int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v];
     return k < nfan ? m->hedge[m->vfan[m->vfan_start[v] + k]] : m->vlast_edge[v];
+}
+
+/* Is edge e sharp (> 0) at this level (for the vertex rules)? Boundary edges are
+ * (infinitely) sharp whatever this says. */
+static inline int ccn__edge_sharp(const ccn_mesh *m, int32_t e) {
+    return m->esharp && m->esharp[e] > 0.0f;
+}
+/* Does edge e split the knot-interval look-ups like a boundary at this level (sharpness >= 1:
+ * its full crease rule applies)? Below 1 its points blend the crease and the smooth rule, and
+ * the look-ups are the smooth ones, so the smooth part is exactly the smooth rule. */
+static inline int ccn__edge_splits(const ccn_mesh *m, int32_t e) {
+    return m->esharp && m->esharp[e] >= 1.0f;
 }
 
 #define CCN_KNOT_MIN_RATIO 1e-6

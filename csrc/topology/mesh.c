@@ -3,10 +3,12 @@
  * Rejected (CCN_ERR_TOPOLOGY, the message names the element): a face with < 3 vertices or a
  * repeated vertex, an index out of range, an edge shared by more than two faces, two faces
  * using an edge in the same direction (inconsistent orientation), a vertex whose faces form
- * more than one fan (non-manifold vertex), an interior vertex of valence 2. Rejected
- * (CCN_ERR_ARGUMENT): negative counts, NULL arrays, NaN/Inf coordinates or beyond
- * +-CCN_COORD_MAX, no faces. Ignored and counted: isolated vertices, knot
- * values given for vertex pairs that are not edges of any face (loose edges).
+ * more than one fan (non-manifold vertex). Rejected (CCN_ERR_ARGUMENT): negative counts,
+ * NULL arrays, NaN/Inf coordinates or beyond +-CCN_COORD_MAX, no faces, NaN sharpness.
+ * Ignored and counted: isolated vertices, knot or crease values given for vertex pairs that
+ * are not edges of any face (loose edges). Sharpness <= 0 is smooth, >= 10 (and +Inf) is
+ * stored as 10 (infinitely sharp), as OpenSubdiv does. Interior vertices of valence 2 are
+ * accepted (Catmull-Clark / NURSS rules at n = 2, no eigen rules or cap there).
  */
 #include "topology/mesh.h"
 
@@ -47,8 +49,29 @@ void ccn_mesh_destroy(ccn_mesh *m) {
     if (!m) return;
     free(m->pos); free(m->fstart); free(m->hvert); free(m->htwin); free(m->hedge);
     free(m->hface); free(m->everts); free(m->eknot); free(m->vfan_start); free(m->vfan);
-    free(m->hfanpos); free(m->vlast_edge); free(m->vboundary);
+    free(m->hfanpos); free(m->vlast_edge); free(m->vboundary); free(m->esharp); free(m->vsharp);
     free(m);
+}
+
+int ccn__mesh_alloc_sharpness(ccn_mesh *m) {
+    free(m->esharp);
+    free(m->vsharp);
+    m->esharp = calloc((size_t)(m->ne ? m->ne : 1), sizeof(float));
+    m->vsharp = calloc((size_t)(m->nv ? m->nv : 1), sizeof(float));
+    if (m->esharp && m->vsharp) return 0;
+    free(m->esharp); free(m->vsharp);
+    m->esharp = NULL; m->vsharp = NULL;
+    return -1;
+}
+
+void ccn__mesh_drop_smooth_sharpness(ccn_mesh *m) {
+    if (!m->esharp) return;
+    for (int32_t e = 0; e < m->ne; e++)
+        if (m->esharp[e] > 0.0f) return;
+    for (int32_t v = 0; v < m->nv; v++)
+        if (m->vsharp[v] > 0.0f) return;
+    free(m->esharp); free(m->vsharp);
+    m->esharp = NULL; m->vsharp = NULL;
 }
 
 /* ---- fans ----------------------------------------------------------------------- */
@@ -103,6 +126,9 @@ void ccn__mesh_update_info(ccn_mesh *m) {
     in->num_boundary_edges = 0;
     for (int32_t h = 0; h < m->nh; h++) in->num_boundary_edges += m->htwin[h] < 0;
     in->num_extraordinary = 0; in->max_valence = 0; in->num_ignored_verts = 0;
+    in->num_sharp_edges = 0; in->num_sharp_vertices = 0;
+    for (int32_t e = 0; m->esharp && e < m->ne; e++) in->num_sharp_edges += m->esharp[e] > 0.0f;
+    for (int32_t v = 0; m->vsharp && v < m->nv; v++) in->num_sharp_vertices += m->vsharp[v] > 0.0f;
     for (int32_t v = 0; v < m->nv; v++) {
         int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v];
         if (nfan == 0) { in->num_ignored_verts++; continue; }
@@ -147,6 +173,15 @@ static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err)
                 return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
                                  "vertex %d has a coordinate beyond +-%g", (int)v, CCN_COORD_MAX);
         }
+    for (int32_t i = 0; c->edge_creases && i < c->num_edges; i++)
+        if (isnan(c->edge_creases[i]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_EDGE, i,
+                             "edge %d (vertices %d-%d) has a NaN crease sharpness", (int)i,
+                             (int)c->edge_verts[2 * i], (int)c->edge_verts[2 * i + 1]);
+    for (int32_t v = 0; c->vertex_creases && v < c->num_verts; v++)
+        if (isnan(c->vertex_creases[v]))
+            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                             "vertex %d has a NaN crease sharpness", (int)v);
     int64_t nh = 0;
     for (int32_t f = 0; f < c->num_faces; f++) {
         int32_t s = c->face_sizes[f];
@@ -257,7 +292,7 @@ static ccn_status apply_knots(ccn_mesh *m, const ccn_cage *c, hkey *keys, ccn_er
     if (!val) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     for (int32_t e = 0; e < m->ne; e++) val[e] = 0.0;
     m->info.num_ignored_edges = 0;
-    if (c->edge_knots && c->edge_verts) {
+    if ((c->edge_knots || c->edge_creases) && c->edge_verts) {
         /* keys must be sorted by (a,b): rebuild them (pair_edges reused .a as a map) */
         for (int32_t h = 0; h < m->nh; h++) {
             int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
@@ -269,12 +304,43 @@ static ccn_status apply_knots(ccn_mesh *m, const ccn_cage *c, hkey *keys, ccn_er
             int32_t e = (a >= 0 && b >= 0 && a < m->nv && b < m->nv) ? find_edge(m, keys, a, b)
                                                                       : -1;
             if (e < 0) { m->info.num_ignored_edges++; continue; }
-            val[e] = c->edge_knots[i];
+            if (!c->edge_knots) continue;
+            double x = c->edge_knots[i];
+            if (isfinite(x) && x > 0.0) val[e] = x; /* an unset value does not replace a set one */
         }
     }
     ccn_status st = ccn__resolve_rings(m, val, NULL, err);
     free(val);
     return st;
+}
+
+/* Sharpness as OpenSubdiv stores it: float, clamped to [0, 10]. */
+static float sharpness_value(double s) {
+    if (!(s > 0.0)) return 0.0f;
+    if (s >= CCN_SHARPNESS_INFINITE) return (float)CCN_SHARPNESS_INFINITE;
+    return (float)s;
+}
+
+/* Edge sharpness from edge_creases (keys sorted by apply_knots), vertex sharpness. */
+static ccn_status apply_creases(ccn_mesh *m, const ccn_cage *c, const hkey *keys, ccn_error *err) {
+    int any = 0;
+    for (int32_t i = 0; c->edge_creases && c->edge_verts && i < c->num_edges && !any; i++)
+        any = c->edge_creases[i] > 0.0;
+    for (int32_t v = 0; c->vertex_creases && v < c->num_verts && !any; v++)
+        any = c->vertex_creases[v] > 0.0;
+    if (!any) return CCN_OK;
+    if (ccn__mesh_alloc_sharpness(m))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (creases)");
+    for (int32_t i = 0; c->edge_creases && c->edge_verts && i < c->num_edges; i++) {
+        int32_t a = c->edge_verts[2 * i], b = c->edge_verts[2 * i + 1];
+        int32_t e = (a >= 0 && b >= 0 && a < m->nv && b < m->nv) ? find_edge(m, keys, a, b) : -1;
+        if (e < 0) continue; /* counted in apply_knots */
+        float s = sharpness_value(c->edge_creases[i]);
+        if (s > 0.0f) m->esharp[e] = s; /* a smooth value does not replace a sharp one */
+    }
+    for (int32_t v = 0; c->vertex_creases && v < c->num_verts; v++)
+        m->vsharp[v] = sharpness_value(c->vertex_creases[v]);
+    return CCN_OK;
 }
 
 ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err) {
@@ -302,14 +368,8 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
                        (int)(bad - 1));
         goto done;
     }
-    for (int32_t v = 0; v < m->nv; v++)
-        if (!m->vboundary[v] && m->vfan_start[v + 1] - m->vfan_start[v] == 2) {
-            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
-                           "vertex %d is an interior vertex with only 2 edges (two faces share "
-                           "two consecutive edges): not supported", (int)v);
-            goto done;
-        }
     if ((st = apply_knots(m, cage, keys, err))) goto done;
+    if ((st = apply_creases(m, cage, keys, err))) goto done;
     ccn__mesh_update_info(m);
     m->info.level = 0;
     *out = m;
@@ -337,6 +397,15 @@ ccn_status ccn_mesh_copy(const ccn_mesh *m, double *positions, int32_t *face_siz
     if (edge_verts) memcpy(edge_verts, m->everts, sizeof(int32_t) * 2 * (size_t)m->ne);
     if (edge_knots)
         for (int32_t e = 0; e < m->ne; e++) edge_knots[e] = m->eknot[e] * m->knot_scale;
+    return CCN_OK;
+}
+
+ccn_status ccn_mesh_creases(const ccn_mesh *m, double *edge_sharpness, double *vertex_sharpness) {
+    if (!m) return CCN_ERR_ARGUMENT;
+    for (int32_t e = 0; edge_sharpness && e < m->ne; e++)
+        edge_sharpness[e] = m->esharp ? m->esharp[e] : 0.0;
+    for (int32_t v = 0; vertex_sharpness && v < m->nv; v++)
+        vertex_sharpness[v] = m->vsharp ? m->vsharp[v] : 0.0;
     return CCN_OK;
 }
 

@@ -10,6 +10,10 @@ ccn_mesh *ccn__mesh_alloc(int32_t nv, int32_t nf, int32_t nh, int32_t ne);
  * success, or the index + 1 of a vertex whose faces form more than one fan (non-manifold). */
 int32_t ccn__mesh_build_fans(ccn_mesh *m);
 void ccn__mesh_update_info(ccn_mesh *m);
+/* Allocates esharp and vsharp (all 0); 0 on success. */
+int ccn__mesh_alloc_sharpness(ccn_mesh *m);
+/* Frees esharp and vsharp if every value is 0 (the crease-free rules then apply). */
+void ccn__mesh_drop_smooth_sharpness(ccn_mesh *m);
 /* Affine normalisation of positions to a unit box (the rules are affine-invariant). */
 void ccn__normalize(ccn_mesh *m, double centre[3], double *scale);
 void ccn__denormalize(ccn_mesh *m, const double centre[3], double scale);

@@ -41,7 +41,7 @@ int main(int argc, char **argv) {
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), tev = 1e30;
-    ccn_limit_mesh lm = {pos, NULL, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = pos};
     for (int r = 0; r < reps; r++) {
         double t0 = now();
         if (ccn_plan_evaluate(plan, NULL, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }

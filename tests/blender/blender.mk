@@ -6,8 +6,16 @@ BLENDER_SAVED_GOAL := $(.DEFAULT_GOAL)
 APT_PKGS  += blender zip
 ADDON_SRC  = $(sort $(wildcard addon/*.py)) blender_manifest.toml
 
-.PHONY: package
+.PHONY: package deps-bpy
 package: $(B)/ccnurbs.zip
+
+# `make deps` also makes the Blender 4.5 / 5.x environments (PyPI `bpy` wheels, cached outside
+# build/; see tests/blender/deps_bpy.sh). Skipped in a second run; a failure is reported by
+# run_blender.sh as a failed suite line, not here.
+deps: deps-bpy
+deps-bpy:
+	@./tests/deps.sh python3 python3-venv
+	@./tests/blender/deps_bpy.sh
 
 # The shipped library finds its LAPACK/BLAS/gfortran dependencies next to itself (DT_RPATH
 # $$ORIGIN also serves their own dependencies), so the add-on needs nothing installed.

@@ -103,6 +103,7 @@ def cage_object(name, x, scheme, V, F, K):
     bpy.ops.object.ccnurbs_add()
     s = ob.ccnurbs
     s.scheme, s.levels, s.render_levels = scheme, 3, 5
+    s.store_render_mesh = True  # demo.blend opens and renders without the add-on
     ob.color = SURFACE
     # cage edges: long intervals red, 1 grey; the spokes to the lifted centre are left out
     # (they would hide the bump)
@@ -166,9 +167,9 @@ def main():
     sh.show_specular_highlight = False
 
     ccn = sys.modules[[m for m in sys.modules if m.rpartition(".")[2] == "ccnurbs"][0]]
-    ccn.sync.sync_render()
+    bpy.context.view_layer.update()
     for ob, title in ((nurss, "NURSS (1998)"), (eigen, "Eigen (Li et al. 2016)")):
-        n = len(local_maxima(ob.ccnurbs.render_proxy.data))
+        n = len(local_maxima(ccn.modifier.proxy(ob, 'RENDER').data))
         label("%s: %d maxim%s" % (title, n, "um" if n == 1 else "a"), ob.location.x, -5.6)
         print("demo: %-6s %d local maxima at render levels %d" % (ob.name, n,
                                                                  ob.ccnurbs.render_levels))

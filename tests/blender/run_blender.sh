@@ -1,45 +1,76 @@
 #!/bin/sh
-# Headless Blender tests of the add-on (picked up by tests/run_tests.sh).
-# Installs build/ccnurbs.zip into a throw-away user scripts dir and runs test_addon.py with
-# `blender --background --factory-startup --python-exit-code 1`. Last line: "N passed, N failed".
+# Headless Blender tests of the add-on (picked up by tests/run_tests.sh), on every Blender:
+#   3.4  Debian's `blender`:  blender --background --factory-startup --python-exit-code 1 --python
+#   4.5, 5.x  PyPI's `bpy` module in the venvs of tests/blender/deps_bpy.sh:  python test_addon.py
+# Each run installs build/ccnurbs.zip (3.x: legacy add-on; 4.2+: extension API) into throw-away
+# user dirs. One line per test, then "== Blender X.Y.Z (how): N passed, N failed" per version;
+# a version that is not installed counts as a failure. Last line: "N passed, N failed" in total.
 cd "$(dirname "$0")/../.." || exit 2
 ZIP=${CCN_ZIP:-build/ccnurbs.zip}
 CLI=${CCN_CLI:-build/ccnurbs}
-if ! command -v blender >/dev/null 2>&1; then
-  echo "run_blender: blender is not installed (make deps installs Debian's blender)"
-  echo "0 passed, 1 failed"; exit 1
-fi
+CACHE=${CCN_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/ccnurbs}
+LINES=${CCN_BPY_LINES:-"4.5 5"}
+TIMEOUT=${CCN_BLENDER_TIMEOUT:-300}
 for f in "$ZIP" "$CLI"; do
   [ -f "$f" ] || { echo "run_blender: $f missing (make package build)"; echo "0 passed, 1 failed"; exit 1; }
 done
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/ccnurbs_blender.XXXXXX") || exit 2
 trap 'rm -rf "$tmp"' EXIT INT TERM
-# Keep the user's Blender configuration untouched: install into a temporary user dir.
-BLENDER_USER_SCRIPTS="$tmp/scripts" BLENDER_USER_CONFIG="$tmp/config" \
-  timeout 600 blender --background --factory-startup --python-exit-code 1 \
-  --python tests/blender/test_addon.py -- "$ZIP" "$CLI" "$tmp" >"$tmp/log" 2>&1
-rc=$?
-# One line per test (failures with their traceback); Blender's own output left out.
-sed -n '/^== CCNURBS blender tests ==$/,$p' "$tmp/log" | sed '1d' \
-  | grep -Ev '^[0-9]+ passed, [0-9]+ failed$|^Blender quit$|^$' | sed 's/^/  /'
-summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed$' "$tmp/log" | tail -n 1)
-# A Python traceback printed by Blender or by a handler (which must never raise) is a failure.
-tb=$(sed '/^== CCNURBS blender tests ==$/,$d' "$tmp/log" | grep -c '^Traceback')
-if [ "$tb" -ne 0 ]; then
-  echo "run_blender: $tb Python traceback(s) in Blender's output:"
-  sed '/^== CCNURBS blender tests ==$/,$d' "$tmp/log" | grep -A 12 '^Traceback' | sed 's/^/  /'
-  rc=1
-  summary="${summary:-0 passed, 1 failed}"
-  case "$summary" in *" 0 failed") p=${summary%% *}; summary="$p passed, 1 failed" ;; esac
-fi
-if [ -z "$summary" ] || [ $rc -ne 0 ]; then
+total_p=0; total_f=0; versions=""
+
+# run LABEL CMD...: runs test_addon.py with a fresh user dir, prints its lines, adds its counts.
+run() {
+  label=$1; shift
+  d="$tmp/$label"; mkdir -p "$d/work"
+  start=$(date +%s)
+  BLENDER_USER_SCRIPTS="$d/scripts" BLENDER_USER_CONFIG="$d/config" \
+  BLENDER_USER_EXTENSIONS="$d/extensions" BLENDER_USER_DATAFILES="$d/datafiles" \
+    timeout "$TIMEOUT" "$@" "$ZIP" "$CLI" "$d/work" >"$d/log" 2>&1
+  rc=$?
+  sed -n '/^== CCNURBS blender tests ==$/,$p' "$d/log" | sed '1d' \
+    | grep -Ev '^[0-9]+ passed, [0-9]+ failed$|^Blender quit$|^$|^Freeing memory after|^Error: Not freed memory|^(bench|measure) ' \
+    | sed 's/^/  /'
+  grep -E '^(bench|measure) ' "$d/log" | sed 's/^/  /'
+  summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed$' "$d/log" | tail -n 1)
+  ver=$(grep -E '^== CCNURBS blender tests ==' -B1000 "$d/log" | grep -oE '^CCNURBS test Blender [0-9.]+' | tail -n 1 | awk '{print $4}')
+  # A Python traceback printed by Blender or by a handler (which must never raise) is a failure.
+  tb=$(sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -c '^Traceback')
+  if [ "$tb" -ne 0 ]; then
+    echo "  run_blender: $tb Python traceback(s) in Blender's output:"
+    sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -A 16 "^Traceback" | sed 's/^/    /'
+  fi
   if [ -z "$summary" ]; then
-    echo "run_blender: blender exited with $rc before the tests finished; last output:"
-    tail -n 40 "$tmp/log" | sed 's/^/  /'
+    echo "  run_blender: exited with $rc before the tests finished; last output:"
+    tail -n 40 "$d/log" | sed 's/^/    /'
     summary="0 passed, 1 failed"
   fi
-  echo "$summary"
-  exit 1
+  p=${summary%% passed*}; f=${summary#*passed, }; f=${f%% failed*}
+  if [ "$f" -eq 0 ] && { [ "$tb" -ne 0 ] || [ $rc -ne 0 ]; }; then f=1; fi
+  total_p=$((total_p + p)); total_f=$((total_f + f))
+  versions="$versions ${ver:-?}"
+  echo "== Blender ${ver:-$label} ($label): $p passed, $f failed ($(( $(date +%s) - start ))s)"
+}
+
+missing() {
+  echo "== Blender $1: not available: $2"
+  total_f=$((total_f + 1)); versions="$versions $1(missing)"
+}
+
+if command -v blender >/dev/null 2>&1; then
+  run "debian-blender" blender --background --factory-startup --python-exit-code 1 \
+    --python tests/blender/test_addon.py --
+else
+  missing "3.4 (Debian blender)" "blender is not installed (make deps installs it)"
 fi
-echo "$summary"
-case "$summary" in *" 0 failed") exit 0 ;; *) exit 1 ;; esac
+for line in $LINES; do
+  env="$CACHE/venv-bpy-$line"
+  if [ -f "$env/.ok" ] && [ -x "$env/bin/python" ]; then
+    run "bpy-$line" "$env/bin/python" tests/blender/test_addon.py
+  else
+    why=$(cat "$env.failed" 2>/dev/null | tr '\n' ' ')
+    missing "$line (bpy wheel)" "${why:-no venv at $env (make deps creates it)}"
+  fi
+done
+echo "run_blender: Blender versions tested:$versions"
+echo "$total_p passed, $total_f failed"
+[ "$total_f" -eq 0 ]

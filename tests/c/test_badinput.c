@@ -155,6 +155,61 @@ static void interval_row(double value, double want_ratio) {
     soup_free(&s);
 }
 
+/* One interior edge of a 3x3 grid gets sharpness `value`: accepted (refined finite), the
+ * stored sharpness is `want` (<= 0 smooth, >= 10 and +Inf infinitely sharp: 10). */
+static void crease_row(double value, double want) {
+    soup s = grid(3, 3);
+    ccn_cage c = soup_cage(&s);
+    int32_t ev[2] = {5, 6};
+    double cr[1] = {value};
+    c.num_edges = 1; c.edge_verts = ev; c.edge_creases = cr;
+    ccn_mesh *m = accept_and_refine(&c);
+    if (m) {
+        ccn_mesh_info in;
+        ccn_mesh_info_get(m, &in);
+        int32_t *e2 = malloc(sizeof(int32_t) * 2 * (size_t)in.num_edges);
+        double *sh = malloc(sizeof(double) * (size_t)in.num_edges), got = -1;
+        ccn_mesh_copy(m, NULL, NULL, NULL, e2, NULL);
+        ccn_mesh_creases(m, sh, NULL);
+        for (int32_t e = 0; e < in.num_edges; e++)
+            if ((e2[2 * e] == 5 && e2[2 * e + 1] == 6) || (e2[2 * e] == 6 && e2[2 * e + 1] == 5)) got = sh[e];
+        CHECK(got == want, "sharpness %g stored as %g, expected %g", value, got, want);
+        CHECK(in.num_sharp_edges == (want > 0), "sharp edges %d", in.num_sharp_edges);
+        free(e2); free(sh);
+        ccn_mesh_destroy(m);
+    }
+    soup_free(&s);
+}
+
+static void row_crease_negative(void) { crease_row(-3.0, 0.0); } /* smooth, as OpenSubdiv */
+static void row_crease_fraction(void) { crease_row(0.25, 0.25); }
+static void row_crease_inf(void) { crease_row(INFINITY, 10.0); }
+static void row_crease_huge(void) { crease_row(1e300, 10.0); }
+
+static void row_crease_nan(void) {
+    soup s = grid(3, 3);
+    ccn_cage c = soup_cage(&s);
+    int32_t ev[4] = {1, 2, 5, 6};
+    double cr[2] = {1.0, NAN};
+    c.num_edges = 2; c.edge_verts = ev; c.edge_creases = cr;
+    expect_err(&c, CCN_ERR_ARGUMENT, CCN_ELEM_EDGE, 1, "edge 1 (vertices 5-6) has a NaN crease sharpness");
+    double vc[16] = {0};
+    vc[9] = NAN;
+    c.num_edges = 0; c.edge_creases = NULL; c.vertex_creases = vc;
+    expect_err(&c, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, 9, "vertex 9 has a NaN crease sharpness");
+    soup_free(&s);
+}
+
+/* Interior valence 2 (two quads sharing two consecutive edges, inside a grid): accepted. */
+static void row_interior_valence2(void) {
+    /* a quad pillow: the same quad twice, reversed: four interior vertices of valence 2 */
+    int32_t fs[2] = {4, 4}, fv[8] = {0, 1, 2, 3, 3, 2, 1, 0};
+    static const double q[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0.2, 0, 1, 0.5};
+    ccn_cage c = cage_of(4, 2, q, fs, fv);
+    ccn_mesh *m = accept_and_refine(&c);
+    ccn_mesh_destroy(m);
+}
+
 static void row_interval_negative(void) { interval_row(-2.0, 1.0); } /* unset -> 1 */
 static void row_interval_zero(void) { interval_row(0.0, 1.0); }
 static void row_interval_nan(void) { interval_row(NAN, 1.0); }
@@ -214,7 +269,8 @@ static void row_two_gon(void) {
 }
 
 /* The same face twice (same orientation): its edges are used twice in one direction. A
- * reversed duplicate is a closed two-face "pillow": a topology error, see test_fixed_bugs.c (KB1). */
+ * reversed duplicate is a closed two-face "pillow" of interior valence-2 vertices: accepted
+ * (row_interior_valence2, test_fixed_bugs.c KB1). */
 static void row_duplicate_faces(void) {
     int32_t fs[2] = {4, 4}, fv[8] = {0, 1, 2, 3, 0, 1, 2, 3};
     ccn_cage c = cage_of(4, 2, SQ, fs, fv);
@@ -506,6 +562,12 @@ int main(void) {
     RUN(row_interval_negative);
     RUN(row_interval_zero);
     RUN(row_interval_nan);
+    RUN(row_crease_negative);
+    RUN(row_crease_fraction);
+    RUN(row_crease_inf);
+    RUN(row_crease_huge);
+    RUN(row_crease_nan);
+    RUN(row_interior_valence2);
     RUN(row_interval_inf);
     RUN(row_interval_1e_300);
     RUN(row_interval_1e300);

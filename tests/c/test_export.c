@@ -189,7 +189,7 @@ static int against_limit(ccn_plan *p, const ccn_cage *cage, const faces *F, doub
     int L = sz.levels;
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)sz.num_faces);
-    ccn_limit_mesh lm = {pos, NULL, fv, NULL};
+    ccn_limit_mesh lm = {.positions = pos, .face_verts = fv};
     ccn_error err;
     int touched = 0;
     *worst = *fill_worst = 0;

@@ -56,5 +56,25 @@ if "$CLI" refine --scheme eigen --levels 2 "$T/quad.obj" "$T/out.obj" 2> "$T/std
   else bad "refine output: $nv verts, $nf faces, knots '$k'"; fi
 else bad "refine of a quad failed: $(cat "$T/stderr")"; fi
 
+# Creases in and out: '# crease i j s' / '# corner i s' read, refined sharpness written back
+# (uniform: minus 1 per level), OpenSubdiv's 't' tags read (0-based), unknown tags warned.
+printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\n# crease 2 5 2.5\n# corner 1 3\n' > "$T/crease.obj"
+if "$CLI" refine --levels 1 "$T/crease.obj" "$T/out.obj" 2> "$T/stderr"; then
+  c=$(awk '/^# crease/ {print $5}' "$T/out.obj" | sort -u | tr '\n' ' '); n=$(grep -c '^# crease' "$T/out.obj")
+  k=$(awk '/^# corner/ {print $4}' "$T/out.obj" | tr '\n' ' ')
+  if [ "$c" = "1.5 " ] && [ "$n" = 2 ] && [ "$k" = "2 " ]; then ok "refine writes decayed creases and corners"
+  else bad "refine creases: '$c' ($n lines), corners '$k'"; fi
+else bad "refine of a creased cage failed: $(cat "$T/stderr")"; fi
+printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\nt crease 2/1/0 1 4 2.5\nt corner 1/1/0 0 3\nt hole 1/0/0 0\n' > "$T/tags.obj"
+if "$CLI" refine --levels 1 "$T/tags.obj" "$T/out2.obj" 2> "$T/stderr" && grep -q "unsupported tag 'hole' ignored" "$T/stderr" &&
+   [ "$(grep -v '^# ccnurbs' "$T/out.obj" | md5sum)" = "$(grep -v '^# ccnurbs' "$T/out2.obj" | md5sum)" ]; then
+  ok "t crease / t corner tags = # crease / # corner; unknown tag warned"
+else bad "t tags: $(cat "$T/stderr")"; fi
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n# crease 1 2 nan\n' > "$T/nancrease.obj"
+expect_error "NaN crease"         "NaN crease sharpness"          refine --levels 1 "$T/nancrease.obj" "$T/out.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n# corner 9 2\n' > "$T/farcorner.obj"
+expect_error "corner beyond vertices" "corner names vertex 9"   refine --levels 1 "$T/farcorner.obj" "$T/out.obj"
+expect_error "bad crease method"  "bad --crease-method"           refine --crease-method foo tests/data/cube.obj "$T/out.obj"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

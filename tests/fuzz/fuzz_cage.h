@@ -34,7 +34,20 @@ typedef struct {
     double pos[3 * MAXV];
     int32_t fs[MAXF], fv[MAXFV], ev[2 * MAXE];
     double kn[MAXE];
+    double cr[MAXE];   /* edge sharpness (issue 12) */
+    double vc[MAXV];   /* vertex sharpness */
 } soup;
+
+/* Sharpness from a byte: mostly 0, else semi-sharp 0..12, a few specials (NaN, Inf, -1). */
+static inline double next_crease(rd *r) {
+    uint8_t b = next(r);
+    if (b < 160) return 0.0;
+    if (b == 250) return NAN;
+    if (b == 251) return INFINITY;
+    if (b == 252) return -1.0;
+    if (b == 253) return 10.0;
+    return (double)(b - 160) * (12.0 / 90.0);
+}
 
 static inline void perturb(rd *r, soup *s) {
     for (int32_t v = 0; v < s->nv; v++) {
@@ -137,7 +150,9 @@ static inline void fz_add_edges(rd *r, soup *s) {
             s->ev[2 * i + 1] = s->fv[st + (j + 1) % n];
         }
         s->kn[i] = next_knot(r);
+        s->cr[i] = next_crease(r);
     }
+    for (int32_t v = 0; v < s->nv && v < MAXV; v++) s->vc[v] = next(r) < 240 ? 0.0 : next_crease(r);
 }
 
 /* Builds s from the input: flags & 3 picks the generator, flags & 4 raw doubles. */

@@ -51,6 +51,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     c.positions = s.pos; c.face_sizes = s.fs; c.face_verts = s.fv;
     c.edge_verts = s.ne ? s.ev : NULL;
     c.edge_knots = s.ne && (next(&r) & 1) ? s.kn : NULL;
+    uint8_t cb = next(&r);
+    if ((cb & 1) && s.ne) c.edge_creases = s.cr;
+    if (cb & 2) c.vertex_creases = s.vc;
     if (flags & 8) {
         uint8_t b = next(&r);
         if (b & 1) c.num_verts = -1 - b;
@@ -76,6 +79,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                 ccn_options o = {0};
                 o.scheme = (ccn_scheme)sc;
                 o.boundary_corners = corners;
+                o.crease_method = (corners + sc) & 1;
                 fz_refine_check(m, 1, &o);
                 if (sc == sel % 3 && corners == ((sel >> 2) & 1)) fz_refine_check(m, 2, &o);
             }

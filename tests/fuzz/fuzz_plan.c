@@ -54,6 +54,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     c.positions = s.pos; c.face_sizes = s.fs; c.face_verts = s.fv;
     c.edge_verts = s.ne ? s.ev : NULL;
     c.edge_knots = s.ne ? s.kn : NULL;
+    uint8_t cb = next(&r);
+    if ((cb & 1) && s.ne) c.edge_creases = s.cr;
+    if (cb & 2) c.vertex_creases = s.vc;
     if ((flags & 16) && s.ne) c.edge_verts = NULL;
 
     ccn_options o = {0};
@@ -63,6 +66,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     o.levels = lb == 255 ? 1000 : lb == 254 ? INT32_MIN : (int32_t)(lb % 5) - 1; /* -1..3 */
     o.boundary_corners = next(&r) % 3;         /* 2: invalid */
     o.threads = next(&r) % 3;
+    o.crease_method = next(&r) % 2;
     int opts_bad = o.scheme > CCN_SCHEME_CATMULL_CLARK || o.cap > CCN_CAP_REFINE ||
                    o.levels < 0 || o.boundary_corners > CCN_CORNERS_PINNED;
     int levels_huge = o.levels == 1000; /* must be refused: CCN_ERR_ARGUMENT or _MEMORY */
@@ -117,7 +121,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FZ_CHECK(pos && nrm && fv && fo && fv2 && fo2, "harness out of memory");
 
     /* 1: the cage's own positions, every output */
-    ccn_limit_mesh out = {pos, nrm, fv, fo};
+    ccn_limit_mesh out = {.positions = pos, .normals = nrm, .face_verts = fv, .face_origin = fo};
     fz_err_init(&e);
     st = ccn_plan_evaluate(plan, NULL, &out, &e);
     fz_check_status(st, &e, "ccn_plan_evaluate");
@@ -146,7 +150,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     double maxabs2 = 0;
     for (int32_t k = 0; k < 3 * c.num_verts; k++) maxabs2 = fmax(maxabs2, fabs(p2[k]));
     int strict2 = fz_known_bugs() || maxabs2 <= FZ_HUGE; /* KB2b */
-    ccn_limit_mesh out2 = {pos, NULL, fv2, fo2};
+    ccn_limit_mesh out2 = {.positions = pos, .face_verts = fv2, .face_origin = fo2};
     fz_err_init(&e);
     ccn_status st2 = ccn_plan_evaluate(plan, p2, &out2, &e);
     fz_check_status(st2, &e, "ccn_plan_evaluate(positions)");
@@ -166,7 +170,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
      * of the previous call instead (KB3, fixed: strict). */
     double *pos3 = malloc(sizeof(double) * nv3);
     FZ_CHECK(pos3 != NULL, "harness out of memory");
-    ccn_limit_mesh out3 = {pos3, NULL, NULL, NULL};
+    ccn_limit_mesh out3 = {.positions = pos3};
     fz_err_init(&e);
     ccn_status st3 = ccn_plan_evaluate(plan, NULL, &out3, &e);
     fz_check_status(st3, &e, "ccn_plan_evaluate(positions only)");
@@ -176,7 +180,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         FZ_CHECK(memcmp(pos1, pos3, sizeof(double) * nv3) == 0,
                  "KB3: evaluate(NULL) after evaluate(positions) does not use the cage's own");
     free(pos3);
-    ccn_limit_mesh out4 = {NULL, nrm, NULL, NULL};
+    ccn_limit_mesh out4 = {.normals = nrm};
     fz_err_init(&e);
     st = ccn_plan_evaluate(plan, NULL, &out4, &e);
     fz_check_status(st, &e, "ccn_plan_evaluate(NULL positions)");

@@ -16,4 +16,5 @@ $(B)/objdiff: tests/oracle/objdiff.c
 	$(CC) $(ORACLE_CFLAGS) $< -o $@ -lm
 
 TEST_DEPS += $(B)/osd_refine $(B)/objdiff
+DEPS_SCRIPTS += tests/oracle/osd_shapes_deps.sh
 .DEFAULT_GOAL := $(ORACLE_SAVED_GOAL)

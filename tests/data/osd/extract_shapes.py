@@ -4,6 +4,9 @@
     extract_shapes.py SRC OUTDIR        write OUTDIR/catmark_*.obj (+ LICENSE.txt)
     extract_shapes.py --table SRC       print the README table (markdown) to stdout
     extract_shapes.py --scope SRC       print the in-scope shape names, one a line
+    extract_shapes.py --nonmanifold SRC print the shapes ccnurbs must refuse as non-manifold
+                                        (topology problems other than unused vertices only,
+                                        which ccnurbs accepts and counts as isolated)
 
 SRC is either OpenSubdiv's regression/shapes directory (catmark_*.h, each a C/C++ string
 literal holding the OBJ text, possibly split into std::string(...) + std::string(...)
@@ -222,7 +225,7 @@ def tag_summary(tags):
 
 def main(argv):
     mode = "write"
-    if argv and argv[0] in ("--table", "--scope"):
+    if argv and argv[0] in ("--table", "--scope", "--nonmanifold"):
         mode = argv.pop(0)
     if (mode == "write" and len(argv) != 2) or (mode != "write" and len(argv) != 1):
         sys.stderr.write(__doc__)
@@ -251,6 +254,13 @@ def main(argv):
     if mode == "--scope":
         for name, r in rows.items():
             if not r["reasons"]:
+                print(name)
+        return 0
+    if mode == "--nonmanifold":
+        for name, text in shapes.items():
+            nv, nvt, faces, forms, tags = parse(text)
+            probs = [p for p in topology_problems(nv, faces) if "used by no face" not in p]
+            if probs:
                 print(name)
         return 0
     print("| shape | verts | faces | face sizes | `f` forms | vt | interior val-2 | tags | in scope |")

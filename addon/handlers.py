@@ -1,0 +1,279 @@
+"""Persistent app handlers: when to read the taps, sync, clean up. Handlers never raise.
+
+* depsgraph_update_post: the cages whose geometry changed → their taps in this depsgraph →
+  viewport proxies (Blender re-evaluates at once after our write, before drawing). Also the cheap
+  hygiene triggers (hygiene.suspicious, object/group counts).
+* frame_change_post: frame_set, playback and every frame of a render. Viewport depsgraph: the
+  viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
+  them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
+  then `depsgraph.update()` so the engine renders them (headless included).
+* render_complete / render_cancel: render proxies emptied and render plans freed (unless the
+  cage stores its render mesh in the file).
+* save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write; nothing is
+  evaluated or rebuilt.
+* load_post, undo_post, redo_post: hygiene, then every cage re-read.
+"""
+import traceback
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import hygiene, modifier, overlay, proxies, sync, tap
+
+_busy = [False]
+_counts = [None]
+_saving = [False]  # between save_pre and save_post: the proxies are swapped out, read nothing
+_echo = set()      # cages whose proxies the save swapped back: their next update is our echo
+_refresh = [False]  # enabled while bpy.data was restricted: refresh at the first chance
+
+
+def _guarded(fn, *args):
+    if _busy[0]:
+        return None
+    _busy[0] = True
+    try:
+        return fn(*args)
+    except Exception:
+        sync.stats["internal_errors"] += 1
+        traceback.print_exc()
+    finally:
+        _busy[0] = False
+    return None
+
+
+def run_collect():
+    renamed, fresh, _ = hygiene.collect()
+    for old, new in renamed:
+        sync.rename(old, new)
+    _counts[0] = hygiene.counts()
+    return fresh
+
+
+def _shown(obj, depsgraph):
+    mod = modifier.get_modifier(obj)
+    if mod is None:
+        return False
+    if depsgraph.mode == 'RENDER':
+        return mod.show_render
+    if obj.mode == 'EDIT' and not mod.show_in_editmode:
+        return False
+    return mod.show_viewport
+
+
+def sync_cages(depsgraph, objs, kind='VIEW', force=False):
+    """Reads the taps of `objs` from `depsgraph` and syncs their `kind` proxies. Returns the
+    number of proxies written."""
+    objs = [o for o in objs if modifier.is_cage(o) and o.library is None and _shown(o, depsgraph)]
+    taps = tap.read(depsgraph, objs)
+    written = 0
+    for obj in objs:
+        cage = taps.get(obj.name_full)
+        if cage is None:
+            sync.missing_tap(obj, kind)
+            continue
+        before = sync.stats["syncs"]
+        sync.sync_object(obj, kind, cage, force=force)
+        written += sync.stats["syncs"] - before
+        if kind == 'VIEW' and obj.ccnurbs.store_render_mesh and bpy.app.background:
+            sync.sync_object(obj, 'RENDER', cage)  # farm files from scripts: no idle timer here
+        elif kind == 'VIEW' and obj.ccnurbs.store_render_mesh:
+            _render_dirty.add(obj.name_full)
+    if _render_dirty and not bpy.app.background:
+        if bpy.app.timers.is_registered(_render_timer):
+            bpy.app.timers.unregister(_render_timer)
+        bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
+    return written
+
+
+RENDER_DELAY = 1.0  # seconds of quiet before stored render meshes are refreshed (UI only)
+_render_dirty = set()
+
+
+def _render_timer():
+    if _busy[0]:
+        return 0.2
+    names = set(_render_dirty)
+    _render_dirty.clear()
+    objs = [o for o in bpy.data.objects if o.name_full in names]
+
+    def run():
+        dg = bpy.context.evaluated_depsgraph_get()
+        sync_cages(dg, [o for o in objs if o.ccnurbs.store_render_mesh], 'RENDER')
+    _guarded(run)
+    return None
+
+
+def sync_all(depsgraph=None, force=False):
+    dg = depsgraph or bpy.context.evaluated_depsgraph_get()
+    return sync_cages(dg, modifier.cages(), 'VIEW', force)
+
+
+def _updated(depsgraph):
+    objs, meshes, geometry = set(), set(), set()
+    for u in depsgraph.updates:
+        idd = u.id.original if u.id.original is not None else u.id
+        if isinstance(idd, bpy.types.Object):
+            objs.add(idd)
+            if u.is_updated_geometry:
+                geometry.add(idd)
+        elif isinstance(idd, bpy.types.Mesh) and u.is_updated_geometry:
+            meshes.add(idd)
+    if meshes:
+        extra = {o for o in bpy.data.objects if o.data in meshes}
+        objs |= extra
+        geometry |= extra
+    return objs, geometry
+
+
+def _is_echo(objs, geometry, depsgraph):
+    """The update only re-evaluated cages because the save swapped their proxies back."""
+    if not _echo:
+        return False
+    names = {o.name_full for o in objs}
+    cages = {n for n in names if n in _echo}
+    others = {o for o in objs if o.name_full not in cages and o.ccnurbs.role
+              not in hygiene.PROXY_ROLES}
+    meshes = [u for u in depsgraph.updates if isinstance(u.id, bpy.types.Mesh)
+              and not u.id.name.startswith(".CCNURBS")]
+    _echo.clear()
+    return not others and not meshes
+
+
+def _on_update(depsgraph):
+    if _refresh[0]:
+        _refresh[0] = False
+        run_collect()
+        sync_all(depsgraph)
+    objs, geometry = _updated(depsgraph)
+    if _is_echo(objs, geometry, depsgraph):
+        return
+    fresh = []
+    if _counts[0] != hygiene.counts() or any(hygiene.suspicious(o) for o in objs):
+        fresh = run_collect()
+    sync_cages(depsgraph, [o for o in geometry if o.type == 'MESH' and o not in fresh], 'VIEW')
+    if fresh:  # new groups (copies): evaluate them now, then read their taps
+        depsgraph.update()
+        sync_cages(depsgraph, fresh, 'VIEW')
+    overlay.on_objects_updated(geometry)
+
+
+@persistent
+def on_depsgraph_update_post(scene, depsgraph=None):
+    sync.stats["handler_calls"] += 1
+    if _saving[0]:
+        return
+    _guarded(_on_update, depsgraph or bpy.context.evaluated_depsgraph_get())
+
+
+def _on_frame(depsgraph):
+    if depsgraph is None:
+        return
+    if depsgraph.mode == 'RENDER':
+        cages = modifier.cages(depsgraph.scene.objects)
+        if sync_cages(depsgraph, cages, 'RENDER'):
+            sync.stats["render_frames"] += 1
+            depsgraph.update()
+        return
+    if sync_cages(depsgraph, modifier.cages(depsgraph.scene.objects), 'VIEW'):
+        depsgraph.update()
+
+
+@persistent
+def on_frame_change_post(scene, depsgraph=None):
+    _guarded(_on_frame, depsgraph)
+
+
+def _after_render():
+    for obj in modifier.cages():
+        if not obj.ccnurbs.store_render_mesh and obj.library is None:
+            proxies.clear(modifier.proxy(obj, 'RENDER'))
+    sync.free_render_plans()
+
+
+@persistent
+def on_render_done(*args):
+    _guarded(_after_render)
+
+
+def _before_save():
+    run_collect()
+    proxies.detach_for_save([modifier.proxy(o, 'VIEW') for o in modifier.cages()])
+    _saving[0] = True
+
+
+def _after_save():
+    _saving[0] = False
+    if proxies.reattach_after_save():
+        _echo.update(o.name_full for o in modifier.cages())
+
+
+@persistent
+def on_save_pre(*args):
+    _guarded(_before_save)
+
+
+@persistent
+def on_save_post(*args):
+    _guarded(_after_save)
+
+
+def _reload(forget):
+    _saving[0] = False  # a save that failed between save_pre and save_post ends here
+    if forget:
+        sync.forget_all()
+    run_collect()
+    sync_all()
+
+
+@persistent
+def on_load_post(*args):
+    _guarded(_reload, True)
+
+
+@persistent
+def on_undo_redo(*args):
+    _guarded(_reload, False)
+
+
+HANDLERS = (("depsgraph_update_post", on_depsgraph_update_post),
+            ("frame_change_post", on_frame_change_post), ("load_post", on_load_post),
+            ("undo_post", on_undo_redo), ("redo_post", on_undo_redo),
+            ("render_complete", on_render_done), ("render_cancel", on_render_done),
+            ("save_pre", on_save_pre), ("save_post", on_save_post)) + \
+    ((("save_post_fail", on_save_post),) if hasattr(bpy.app.handlers, "save_post_fail") else ())
+
+
+def _is_ours(fn, name):
+    """A handler of this module, also one left by an earlier load of it (same module name)."""
+    return getattr(fn, "__name__", None) == name and getattr(fn, "__module__", None) == __name__
+
+
+def refresh_after_enable():
+    """Every surface re-read after the add-on is enabled (a timer: add-ons register while
+    bpy.data is restricted; headless, where no timer fires, the first update does it)."""
+    if _refresh[0]:
+        _refresh[0] = False
+        _guarded(_reload, False)
+    return None
+
+
+def register():
+    for event, fn in HANDLERS:
+        lst = getattr(bpy.app.handlers, event)
+        for h in [h for h in lst if _is_ours(h, fn.__name__)]:
+            lst.remove(h)
+        lst.append(fn)
+    _refresh[0] = True
+    bpy.app.timers.register(refresh_after_enable, first_interval=0.0)
+
+
+def unregister():
+    for event, fn in HANDLERS:
+        lst = getattr(bpy.app.handlers, event)
+        for h in [h for h in lst if h is fn or _is_ours(h, fn.__name__)]:
+            lst.remove(h)
+    for t in (_render_timer, refresh_after_enable):
+        if bpy.app.timers.is_registered(t):
+            bpy.app.timers.unregister(t)
+    _render_dirty.clear()
+    sync.forget_all()

@@ -1,0 +1,156 @@
+"""File hygiene: which groups and proxies belong to which live cage; everything else goes.
+
+A *live* cage is a local mesh object in some scene with a CCNURBS modifier using one of our
+groups. One pass over bpy.data (`collect`, O(objects + groups), run on save, load, undo, and
+after updates that change the object or group count or touch a cage whose ownership is off):
+
+* a group used by several live objects (Shift+D, Alt+D, Copy Modifiers, Copy to Selected) stays
+  with its owner (`group["ccnurbs_owner"]`); every other user gets its own group and proxies
+  (and the owner's settings if it had none);
+* a group whose owner name is gone but which one live object uses was renamed with it (rename,
+  append with a new name): the group, its proxies and their names follow;
+* two live groups naming the same proxy (a duplicated node tree): the proxy stays with the
+  group whose owner it records; the other cage gets new proxies;
+* a cage whose modifier is gone (Apply, X) stops being a cage; an applied limit loses its
+  marker attribute (and, 4.4+, the custom normals: the mesh Subsurf's Apply would give);
+* groups no live cage uses, proxies no live group names, and our empty/scratch meshes are
+  deleted, so a saved file holds only what its scenes use.
+"""
+import bpy
+import numpy as np
+
+from . import compat, modifier, proxies
+
+SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "normals",
+            "use_creases", "store_render_mesh")
+PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
+
+
+def is_live(obj):
+    return obj.library is None and obj.users > 0 and len(obj.users_scene) > 0
+
+
+def suspicious(obj):
+    """Cheap per-object test the update handler runs on updated objects: does this need a
+    collect()? (copied modifier, shared group, renamed cage, applied modifier)."""
+    if obj.type != 'MESH' or obj.library is not None:
+        return False
+    mod = modifier.get_modifier(obj)
+    if mod is None:
+        return obj.ccnurbs.role == 'CAGE'
+    group = mod.node_group
+    return (obj.ccnurbs.role != 'CAGE' or not modifier.is_group(group) or group.users > 1
+            or modifier.owner_of(group) != obj.name_full)
+
+
+def _copy_settings(src, dst):
+    for name in SETTINGS:
+        setattr(dst.ccnurbs, name, getattr(src.ccnurbs, name))
+
+
+def _adopt(group, obj):
+    """obj (renamed, or appended under a new name) keeps its group and proxies."""
+    group[modifier.OWNER_PROP] = obj.name_full
+    group.name = "CCNURBS " + obj.name_full
+    for role, p in zip(PROXY_ROLES, modifier.group_proxies(group)):
+        if p is not None and p.library is None:
+            p.ccnurbs.owner_name = obj.name_full
+            p.name = modifier.proxy_name(role, obj.name_full)
+            if p.data is not None and p.data.users == 1 and p.data.library is None:
+                p.data.name = p.name
+
+
+def _applied(me):
+    """An applied limit (it carries the limit marker) keeps positions and faces like Subsurf's
+    Apply: the marker goes, and so do the custom normals where Python can remove them (4.4+),
+    so the mesh is what Subsurf's Apply would store (README: file size)."""
+    if me is None or me.library is not None:
+        return
+    a = me.attributes.get(proxies.LIMIT_ATTR)
+    if a is None:
+        return
+    me.attributes.remove(a)
+    if compat.drop_custom_normals(me):  # and the all-False sharp_edge custom normals made
+        e = me.attributes.get("sharp_edge")
+        if e is not None and e.domain == 'EDGE' and e.data_type == 'BOOLEAN':
+            v = np.empty(len(e.data), bool)
+            e.data.foreach_get("value", v)
+            if not v.any():
+                me.attributes.remove(e)
+
+
+def collect():
+    """One hygiene pass. Returns (renamed [(old, new)], fresh [objects], removed count)."""
+    users = {}
+    for o in bpy.data.objects:
+        if o.type != 'MESH' or o.library is not None:
+            continue
+        mod = modifier.get_modifier(o)
+        if mod is None:
+            if o.ccnurbs.role == 'CAGE':
+                o.ccnurbs.role = 'NONE'  # applied or removed by hand
+                _applied(o.data)
+            continue
+        if is_live(o) and modifier.is_group(mod.node_group):
+            users.setdefault(mod.node_group, []).append(o)
+    renamed, fresh, keepers = [], [], {}
+    for group, objs in users.items():
+        owner = modifier.owner_of(group)
+        keeper = next((o for o in objs if o.name_full == owner), None)
+        if keeper is None:
+            keeper = min(objs, key=lambda o: o.name_full)
+            renamed.append((owner, keeper.name_full))
+            _adopt(group, keeper)
+        keepers[group] = keeper
+        fresh += [(o, keeper) for o in objs if o is not keeper]
+    claimed = {}
+    for group, keeper in keepers.items():  # a proxy named by two live groups
+        for p in modifier.group_proxies(group):
+            if p is None:
+                continue
+            other = claimed.get(p)
+            if other is None:
+                claimed[p] = keeper
+            elif p.ccnurbs.owner_name == keeper.name_full:
+                claimed[p] = keeper
+                fresh.append((other, other))
+            else:
+                fresh.append((keeper, keeper))
+    made = []
+    for obj, src in fresh:
+        if obj in made:
+            continue
+        if obj.ccnurbs.role != 'CAGE' and src is not obj:
+            _copy_settings(src, obj)
+        modifier.ensure(obj, fresh=True)
+        made.append(obj)
+    return renamed, made, _remove_unused()
+
+
+def _remove_unused():
+    live_groups, named = set(), set()
+    for o in bpy.data.objects:
+        if o.type == 'MESH' and o.library is None and is_live(o):
+            mod = modifier.get_modifier(o)
+            if mod is not None and modifier.is_group(mod.node_group):
+                live_groups.add(mod.node_group)
+                named.update(p for p in modifier.group_proxies(mod.node_group) if p)
+    removed = 0
+    for g in [g for g in bpy.data.node_groups if modifier.is_group(g)]:
+        if g.library is None and g not in live_groups:
+            bpy.data.node_groups.remove(g)
+            removed += 1
+    for p in [o for o in bpy.data.objects if o.ccnurbs.role in PROXY_ROLES]:
+        if p.library is None and p not in named:
+            modifier.remove_proxy(p)
+            removed += 1
+    for name in (proxies.EMPTY_NAME, ".ccnurbs_scratch"):
+        me = bpy.data.meshes.get(name)
+        if me is not None and me.users == 0 and me.library is None:
+            bpy.data.meshes.remove(me)
+    return removed
+
+
+def counts():
+    """What the update handler compares to notice deletions, appends and links cheaply."""
+    return len(bpy.data.objects), len(bpy.data.node_groups), len(bpy.data.meshes)

@@ -1,0 +1,155 @@
+"""Writing the limit into a proxy mesh, and keeping proxy meshes out of saved files.
+
+All bulk data goes through foreach_set. A proxy's mesh is its own (never the shared empty mesh
+used while saving). Saving: a viewport proxy shows what the add-on computes again on load, so
+its mesh is swapped for an empty one during the write (`save_pre` / `save_post`: O(1) per cage,
+the mesh itself is untouched); a render proxy is empty outside renders unless the cage's
+*Store Render Mesh in File* is on, and is then written as it is (never rebuilt by saving).
+"""
+import bpy
+import numpy as np
+
+from . import compat
+
+EMPTY_NAME = ".CCNURBS empty"
+KEY_PROP = "ccnurbs_key"
+LIMIT_ATTR = "ccn_limit"  # FACE bool on every limit face: tells an applied limit from a cage
+TOPO_PROP = "ccnurbs_topology"
+
+_detached = []  # (proxy name, mesh name) swapped out for a save
+
+
+def own_mesh(p):
+    """The proxy's mesh, replaced by a new one if it is shared (the empty mesh of a save)."""
+    me = p.data
+    if me is None or me.users > 1 or me.name.startswith(EMPTY_NAME) or me.library is not None:
+        me = bpy.data.meshes.new(p.name)
+        p.data = me
+    return me
+
+
+def write_normals(me, res, exact):
+    """Exact: the library's normals as custom split normals, per face corner where the surface
+    has creases or corners (each side its own), else per vertex. Fast: Blender's own."""
+    if not exact:
+        compat.use_plain_normals(me)
+    elif "corner_normals" in res:
+        compat.set_corner_normals(me, res["corner_normals"].astype(np.float32))
+    else:
+        compat.set_vertex_normals(me, res["normals"].astype(np.float32))
+
+
+def write_creases(me, res, cage):
+    """The cage's edge creases on the limit mesh's edges that lie on creased cage edges
+    (corner_edge_origin), so a crease survives Apply as on Subdivision Surface's result."""
+    if cage.edge_creases is None or not np.any(cage.edge_creases > 0) or "corner_edge_origin" not in res:
+        return
+    fs = np.asarray(cage.face_sizes, np.int64)
+    fv = np.asarray(cage.face_verts, np.int64)
+    start = np.repeat(np.cumsum(fs) - fs, fs)
+    nxt = np.arange(len(fv)) + 1
+    nxt = np.where(nxt - start >= np.repeat(fs, fs), start, nxt)  # the face's next corner
+    a, b = np.minimum(fv, fv[nxt]), np.maximum(fv, fv[nxt])
+    ev = np.asarray(cage.edge_verts, np.int64).reshape(-1, 2)
+    nvk = int(max(fv.max(), ev.max())) + 1
+    ekey = np.minimum(ev[:, 0], ev[:, 1]) * nvk + np.maximum(ev[:, 0], ev[:, 1])
+    order = np.argsort(ekey)
+    pos = np.searchsorted(ekey[order], a * nvk + b).clip(0, len(ekey) - 1)
+    corner_crease = np.where(ekey[order][pos] == a * nvk + b, cage.edge_creases[order][pos], 0.0)
+    origin = res["corner_edge_origin"].ravel()
+    loop_edge = np.empty(len(me.loops), np.int32)
+    me.loops.foreach_get("edge_index", loop_edge)
+    out = np.zeros(len(me.edges), np.float32)
+    on = origin >= 0
+    np.maximum.at(out, loop_edge[on], corner_crease[origin[on]].astype(np.float32))
+    compat.set_edge_creases(me, out)
+
+
+def write_topology(me, res, cage, exact=True):
+    pos = res["positions"].astype(np.float32).ravel()
+    fv = res["face_verts"].ravel()
+    nv, nf = len(res["positions"]), len(res["face_verts"])
+    me.clear_geometry()
+    me.vertices.add(nv)
+    me.loops.add(4 * nf)
+    me.polygons.add(nf)
+    me.vertices.foreach_set("co", pos)
+    me.loops.foreach_set("vertex_index", fv)
+    compat.set_face_loops(me, np.arange(0, 4 * nf, 4, dtype=np.int32), np.full(nf, 4, np.int32))
+    me.polygons.foreach_set("use_smooth", np.ones(nf, bool))
+    if cage.material_index is not None and cage.material_index.any():  # all 0: no attribute
+        origin = np.clip(res["face_origin"], 0, len(cage.material_index) - 1)
+        me.polygons.foreach_set("material_index", cage.material_index[origin])
+    me.attributes.new(LIMIT_ATTR, 'BOOLEAN', 'FACE').data.foreach_set("value", np.ones(nf, bool))
+    me.update(calc_edges=True)
+    write_creases(me, res, cage)
+    write_normals(me, res, exact)
+
+
+def write_positions(me, res, exact=True):
+    me.vertices.foreach_set("co", res["positions"].astype(np.float32).ravel())
+    me.update()
+    write_normals(me, res, exact)
+
+
+def clear(p):
+    """Empties a proxy (the modifier then shows its input, or the viewport proxy in renders)."""
+    if p is None or p.data is None or not len(p.data.vertices) and KEY_PROP not in p.data:
+        return False
+    me = own_mesh(p)
+    me.clear_geometry()
+    for k in (KEY_PROP, TOPO_PROP):
+        if k in me:
+            del me[k]
+    return True
+
+
+def sync_materials(src_mesh, p):
+    src, dst = src_mesh.materials, p.data.materials
+    if [m for m in src] != [m for m in dst]:
+        dst.clear()
+        for m in src:
+            dst.append(m)
+
+
+def size_bytes(me):
+    """What a mesh adds to a .blend (positions, edges, corners, faces, custom normals), roughly."""
+    if me is None:
+        return 0
+    nv, ne, nl, nf = len(me.vertices), len(me.edges), len(me.loops), len(me.polygons)
+    normals = 4 * nl if compat.has_custom_normals(me) else 0
+    return 12 * nv + 8 * ne + 8 * nl + 8 * nf + nf + normals
+
+
+def _empty_mesh():
+    me = bpy.data.meshes.get(EMPTY_NAME)
+    if me is None or me.library is not None or len(me.vertices):
+        me = bpy.data.meshes.new(EMPTY_NAME)
+    return me
+
+
+def detach_for_save(view_proxies):
+    """Swaps each non-empty viewport proxy's mesh for one empty mesh; the limit mesh keeps no
+    user during the write, so it is not saved."""
+    _detached.clear()
+    empty = None
+    for p in view_proxies:
+        if p is None or p.library is not None or p.data is None or not len(p.data.vertices):
+            continue
+        empty = empty or _empty_mesh()
+        _detached.append((p.name, p.data.name))
+        p.data = empty
+
+
+def reattach_after_save():
+    """Gives the viewport proxies their meshes back; returns whether any was swapped."""
+    swapped = bool(_detached)
+    for pname, mname in _detached:
+        p, me = bpy.data.objects.get(pname), bpy.data.meshes.get(mname)
+        if p is not None and me is not None:
+            p.data = me
+    _detached.clear()
+    me = bpy.data.meshes.get(EMPTY_NAME)
+    if me is not None and me.users == 0:
+        bpy.data.meshes.remove(me)
+    return swapped

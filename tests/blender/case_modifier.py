@@ -1,0 +1,327 @@
+"""The modifier on a plain cage: equals `ccnurbs limit`, live updates, render levels, errors,
+save/reload without the add-on, panels, remove."""
+from bltest import *  # noqa: F401,F403
+
+
+class TestModifier(AddonTestCase):
+    def test_matches_cli_settings(self):
+        cases = [dict(scheme='EIGEN', cap='GUIDED_BI5', boundary_smooth='ALL', levels=2),
+                 dict(scheme='NURSS', cap='REFINE', boundary_smooth='PRESERVE_CORNERS', levels=3),
+                 dict(scheme='CATMULL_CLARK', cap='GUIDED_BI5', boundary_smooth='ALL', levels=1)]
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob)
+        for c in cases:
+            with self.subTest(**c):
+                for k, v in c.items():
+                    setattr(ob.ccnurbs, k, v)
+                self.assertMatchesCLI(ob)
+
+    def test_structure(self):
+        ob = load_cage("Fan5", os.path.join(DATA, "fan5.obj"))
+        mats = [bpy.data.materials.new("A"), bpy.data.materials.new("B")]
+        for m in mats:
+            ob.data.materials.append(m)
+        mi = np.zeros(len(ob.data.polygons), np.int32)
+        mi[:5] = 1
+        ob.data.polygons.foreach_set("material_index", mi)
+        add_modifier(ob)
+        ev = ob.evaluated_get(update()).data
+        self.assertEqual([m.original for m in ev.materials], mats, "materials on the limit")
+        emi = np.empty(len(ev.polygons), np.int32)
+        ev.polygons.foreach_get("material_index", emi)
+        self.assertEqual(int((emi == 1).sum()), 5 * 16, "each cage quad → 16 faces at level 2")
+        mod = ob.modifiers["CCNURBS"]
+        self.assertEqual(mod.type, 'NODES')
+        self.assertEqual(ob.modifiers[0], mod)
+        s = ob.ccnurbs
+        self.assertEqual((s.levels, s.render_levels, s.scheme, s.cap, s.boundary_smooth),
+                         (2, 3, 'EIGEN', 'GUIDED_BI5', 'ALL'))
+        for p in ccn.modifier.proxies(ob):
+            self.assertEqual(len(p.users_collection), 0, "proxy must not be in a scene")
+        self.assertNotIn(ccn.modifier.proxy(ob, 'VIEW'), list(bpy.context.scene.objects))
+
+    def test_closed_cage_with_ngons(self):
+        ob = add_modifier(load_cage("Prism", os.path.join(DATA, "ngon_prism.obj")), levels=2)
+        self.assertMatchesCLI(ob)
+
+    def test_live_updates(self):
+        ob = load_cage("Fan5", os.path.join(DATA, "fan5.obj"))
+        me = ob.data
+        cagelib.set_knots(me, {k: 1.0 for k in cagelib.edge_keys(me)})
+        add_modifier(ob)
+        self.assertMatchesCLI(ob)
+        proxy_me = ccn.modifier.proxy(ob, 'VIEW').data
+        loops_before = np.empty(len(proxy_me.loops), np.int32)
+        proxy_me.loops.foreach_get("vertex_index", loops_before)
+        st = dict(ccn.sync.stats)
+
+        # move a vertex: one position update, same proxy topology, bounded handler calls
+        me.vertices[0].co.z += 0.7
+        me.update()
+        self.assertMatchesCLI(ob)
+        d = {k: ccn.sync.stats[k] - st[k] for k in st}
+        self.assertEqual(d["position_updates"], 1, d)
+        self.assertEqual(d["rebuilds"], 0, d)
+        self.assertLessEqual(d["handler_calls"], 3, d)
+        loops_after = np.empty(len(proxy_me.loops), np.int32)
+        ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
+        self.assertIs(ccn.modifier.proxy(ob, 'VIEW').data, proxy_me)
+        np.testing.assert_array_equal(loops_before, loops_after)
+
+        # nothing changed: further updates do nothing (no loop)
+        st = dict(ccn.sync.stats)
+        for _ in range(3):
+            update()
+        self.assertEqual(ccn.sync.stats["syncs"], st["syncs"])
+        # what a proxy write looks like to the depsgraph (the cage is re-evaluated because its
+        # modifier reads the proxy): the handler runs, sees the same content key, writes nothing
+        st = dict(ccn.sync.stats)
+        ccn.modifier.proxy(ob, 'VIEW').data.update()
+        ccn.modifier.proxy(ob, 'RENDER').data.update()
+        update()
+        d = {k: ccn.sync.stats[k] - st[k] for k in st}
+        self.assertGreaterEqual(d["handler_calls"], 1, d)
+        self.assertGreaterEqual(d["skipped"], 1, d)
+        self.assertEqual(d["syncs"], 0, d)
+
+        # change an interval (ring of the first spoke) → rebuild with the new intervals
+        st = dict(ccn.sync.stats)
+        k = cagelib.get_knots(me)
+        k[0] = 6.0
+        me.attributes["knot_interval"].data.foreach_set("value", k)
+        me.update()
+        self.assertMatchesCLI(ob)
+        self.assertEqual(ccn.sync.stats["syncs"] - st["syncs"], 1)
+
+        # levels → new vertex count
+        n2 = len(evaluated_positions(ob))
+        ob.ccnurbs.levels = 3
+        self.assertGreater(len(self.assertMatchesCLI(ob)), n2)
+
+    def test_edit_mode_updates(self):
+        ob = add_modifier(grid(4))
+        bpy.ops.object.mode_set(mode='EDIT')
+        bm = bmesh.from_edit_mesh(ob.data)
+        bm.verts.ensure_lookup_table()
+        bm.verts[12].co.z = 1.5
+        bmesh.update_edit_mesh(ob.data)
+        P = evaluated_positions(ob)  # still in edit mode
+        self.assertGreater(P[:, 2].max(), 0.5, "edit-mode move did not update the limit")
+        edit_select_edges(ob, [0])
+        bpy.ops.mesh.ccnurbs_set_knot_interval(value=5.0)
+        P2 = evaluated_positions(ob)
+        self.assertGreater(np.abs(P2 - P).max(), 1e-4, "edit-mode interval did not update")
+        bpy.ops.object.mode_set(mode='OBJECT')
+        R, _ = reference(ob)
+        np.testing.assert_allclose(P2, R, atol=POS_TOL)
+
+    def test_render_uses_render_levels(self):
+        ob = add_modifier(load_cage("Fan5", os.path.join(DATA, "fan5.obj")), levels=1,
+                          render_levels=3)
+        n_view = len(evaluated_positions(ob))
+        seen = {}
+
+        class ProbeEngine(bpy.types.RenderEngine):
+            bl_idname = "CCNURBS_TEST_PROBE"
+            bl_label = "probe"
+
+            def render(self, depsgraph):
+                for inst in depsgraph.object_instances:
+                    if inst.object.original.name == ob.name and not inst.is_instance:
+                        seen["verts"] = len(inst.object.data.vertices)
+                        seen["positions"] = cagelib.mesh_positions(inst.object.data)
+                r = self.begin_result(0, 0, 4, 4)
+                self.end_result(r)
+
+        bpy.utils.register_class(ProbeEngine)
+        try:
+            scene = bpy.context.scene
+            cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+            scene.collection.objects.link(cam)
+            scene.camera = cam
+            scene.render.engine = ProbeEngine.bl_idname
+            scene.render.resolution_x = scene.render.resolution_y = 4
+            bpy.ops.render.render()
+        finally:
+            bpy.utils.unregister_class(ProbeEngine)
+        R, _ = reference(ob, levels=3)
+        self.assertIn("verts", seen, "render did not see the cage")
+        self.assertEqual(seen["verts"], len(R))
+        np.testing.assert_allclose(seen["positions"], R, atol=POS_TOL)
+        self.assertEqual(len(evaluated_positions(ob)), n_view, "viewport result not restored")
+        self.assertMatchesCLI(ob, normals=False)
+
+    def _reload_without_addon(self, path):
+        """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender
+        without the add-on."""
+        out = os.path.join(TMP, "reload.npy")
+        script = os.path.join(TMP, "reload_check.py")
+        with open(script, "w") as fh:
+            fh.write(
+                "import bpy, numpy as np, sys\n"
+                "assert not hasattr(bpy.types.Object, 'ccnurbs')\n"
+                "ob = bpy.data.objects['Fig16']\n"
+                "dg = bpy.context.evaluated_depsgraph_get()\n"
+                "me = ob.evaluated_get(dg).data\n"
+                "co = np.empty(3 * len(me.vertices), np.float32)\n"
+                "me.vertices.foreach_get('co', co)\n"
+                "n = [len(o.data.vertices) for p in ('.CCNURBS view', '.CCNURBS render')\n"
+                "     for o in bpy.data.objects if o.name.startswith(p)]\n"
+                "np.save(%r, co.reshape(-1, 3))\n"
+                "np.save(%r, np.array(n))\n" % (out, out + ".n.npy"))
+        r = subprocess.run(blender_command(script, path), capture_output=True, text=True,
+                           timeout=120)
+        self.assertEqual(r.returncode, 0, r.stdout[-2000:] + r.stderr[-2000:])
+        return np.load(out).astype(np.float64), list(np.load(out + ".n.npy"))
+
+    def test_save_reload_without_addon(self):
+        """Default: the file holds the cage and empty proxies; without the add-on it shows the
+        cage (as a file with Subsurf shows what Blender computes, here nothing to compute)."""
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob, scheme='NURSS', levels=2, render_levels=3)
+        ob.data.vertices[0].co.z = 1.3
+        ob.data.update()
+        update()
+        path = os.path.join(TMP, "reload.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        self.assertMatchesCLI(ob)  # the session keeps its limit across the save
+        P, counts = self._reload_without_addon(path)
+        np.testing.assert_array_equal(P, cagelib.mesh_positions(ob.data))
+        self.assertEqual(counts, [0, 0], "proxy meshes were saved")
+
+    def test_store_render_mesh_in_file(self):
+        """Store Render Mesh in File: the render-levels limit is in the file and shows (viewport
+        and render) where the add-on is not installed; the panel states its size."""
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob, scheme='NURSS', levels=2, render_levels=3)
+        ob.ccnurbs.store_render_mesh = True
+        ob.data.vertices[0].co.z = 1.3
+        ob.data.update()
+        update()
+        R3, _ = reference(ob, levels=3)
+        bpy.context.view_layer.objects.active = ob
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertRegex(shown, r"Render mesh in file: %d vertices, [0-9.]+ MB" % len(R3))
+        path = os.path.join(TMP, "reload_store.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        P, counts = self._reload_without_addon(path)
+        self.assertEqual(counts, [0, len(R3)])
+        self.assertEqual(P.shape, R3.shape)
+        self.assertLessEqual(np.abs(P - R3).max(), POS_TOL)
+        ob.ccnurbs.store_render_mesh = False
+        update()
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertIn("Render mesh: computed per frame when rendering, not saved", shown)
+        self.assertEqual(len(ccn.modifier.proxy(ob, 'RENDER').data.vertices), 0)
+
+    def test_non_manifold_cage(self):
+        ob = add_modifier(grid(2))
+        good = evaluated_positions(ob)
+        me = ob.data
+        # a third face on the interior edge (1,4): non-manifold edge
+        bm = bmesh.new()
+        bm.from_mesh(me)
+        bm.verts.ensure_lookup_table()
+        a, b = bm.verts[1], bm.verts[4]
+        bm.faces.new((a, b, bm.verts.new((1.0, 0.5, 1.0))))
+        bm.to_mesh(me)
+        bm.free()
+        me.update()
+        P = evaluated_positions(ob)  # must not raise
+        lines = ccn.ui.status_lines(ob)
+        self.assertGreater(len(lines), 0, "no status lines")
+        self.assertIn("error", lines[0].lower(), lines)
+        # the panel shows exactly the library's message
+        c = ccn.cage.read(ob)
+        with self.assertRaises(ccn.native.CCNError) as cm:
+            ccn.native.Plan(c.positions, c.face_sizes, c.face_verts, c.edge_verts, c.knots,
+                            levels=2)
+        self.assertEqual(lines[1], str(cm.exception))
+        self.assertIn("non-manifold", str(cm.exception))
+        bpy.context.view_layer.objects.active = ob
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertIn(" ".join(str(cm.exception).split()), shown)
+        np.testing.assert_array_equal(P, good)  # the previous limit stays
+        self.assertIsNotNone(ccn.sync.status(ob).error)
+        # non-manifold from the start: no limit yet, the modifier shows the cage itself
+        ob2 = grid(1, "Bad")
+        bm = bmesh.new()
+        bm.from_mesh(ob2.data)
+        bm.verts.ensure_lookup_table()
+        a, b = bm.verts[0], bm.verts[1]
+        bm.faces.new((b, a, bm.verts.new((0.5, -0.5, 1.0))))
+        bm.faces.new((a, b, bm.verts.new((0.5, 0.5, -1.0))))
+        bm.to_mesh(ob2.data)
+        bm.free()
+        add_modifier(ob2)
+        st = ccn.sync.status(ob2)
+        self.assertIsNotNone(st, "no status for the non-manifold cage")
+        self.assertIn("non-manifold", (st.error or "").lower(), "no error reported")
+        np.testing.assert_array_equal(evaluated_positions(ob2),
+                                      cagelib.mesh_positions(ob2.data))
+
+    def test_duplicate_gets_own_proxies(self):
+        ob = add_modifier(grid(2, "Orig"))
+        before = evaluated_positions(ob)
+        bpy.ops.object.select_all(action='DESELECT')
+        ob.select_set(True)
+        bpy.context.view_layer.objects.active = ob
+        bpy.ops.object.duplicate()
+        dup = bpy.context.object
+        self.assertIsNot(dup, ob)
+        update()
+        self.assertIsNot(ccn.modifier.proxy(dup, 'VIEW'), ccn.modifier.proxy(ob, 'VIEW'))
+        dup.data.vertices[4].co.z = 2.0
+        dup.data.update()
+        update()
+        np.testing.assert_array_equal(evaluated_positions(ob), before)
+        self.assertGreater(evaluated_positions(dup)[:, 2].max(), 0.5)
+
+    def test_add_is_undoable(self):
+        ob = grid(2, "UndoMe")
+        bpy.ops.ed.undo_push(message="before add")
+        add_modifier(ob)
+        self.assertIsNotNone(bpy.data.objects["UndoMe"].modifiers.get("CCNURBS"))
+        bpy.ops.ed.undo()
+        self.assertIsNone(bpy.data.objects["UndoMe"].modifiers.get("CCNURBS"))
+        bpy.ops.ed.redo()
+        ob = bpy.data.objects["UndoMe"]
+        self.assertIsNotNone(ob.modifiers.get("CCNURBS"))
+        self.assertMatchesCLI(ob)
+
+    def test_panels(self):
+        ob = grid(2, "Panel")
+        bpy.context.view_layer.objects.active = ob
+        self.assertIn(("operator", "object.ccnurbs_add"),
+                      draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        add_modifier(ob)
+        log = draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)
+        for p in ("levels", "render_levels", "scheme", "cap", "boundary_smooth"):
+            self.assertIn(("prop", p), log)
+        self.assertIn("Limit: 81 vertices, 64 faces", labels(log))
+        self.assertIn(("operator", "object.ccnurbs_remove"), log)
+        edit_select_edges(ob, [0])
+        bpy.ops.mesh.ccnurbs_set_knot_interval(value=2.5)
+        log = draw_panel(ccn.ui.VIEW3D_PT_ccnurbs_knots)
+        for op in ("mesh.ccnurbs_set_knot_interval", "mesh.ccnurbs_select_ring",
+                   "mesh.ccnurbs_clear_knot_interval"):
+            self.assertIn(("operator", op), log)
+        self.assertIn(("prop", "show_overlay"), log)
+        self.assertIn("Active edge: 2.5", labels(log))
+        bpy.ops.object.mode_set(mode='OBJECT')
+
+    def test_remove(self):
+        ob = add_modifier(grid(2, "Rm"))
+        proxy_name = ccn.modifier.proxy(ob, 'VIEW').name
+        bpy.context.view_layer.objects.active = ob
+        bpy.ops.ed.undo_push(message="before remove")
+        self.assertEqual(bpy.ops.object.ccnurbs_remove(*UNDO), {'FINISHED'})
+        self.assertIsNone(ob.modifiers.get("CCNURBS"))
+        self.assertNotIn(proxy_name, bpy.data.objects)
+        self.assertEqual(len(evaluated_positions(ob)), 9)
+        bpy.ops.ed.undo()
+        ob = bpy.data.objects["Rm"]
+        self.assertIsNotNone(ob.modifiers.get("CCNURBS"))
+        self.assertEqual(len(evaluated_positions(ob)), 81)
+
+
