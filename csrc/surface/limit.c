@@ -94,9 +94,64 @@ static int32_t slot_edge(const ccn_mesh *m, int32_t v, int32_t k0, int s) {
     return k >= 0 && k < n ? k : -1;
 }
 
+/* Does fan edge k of v bound a sector (a boundary edge, or sharp enough to split the look-ups,
+ * rules/bspline.c)? */
+static int sector_edge(const ccn_mesh *m, int32_t v, int32_t k) {
+    int32_t n = ccn__valence(m, v);
+    if (m->vboundary[v] && (k == 0 || k == n - 1)) return 1;
+    return ccn__edge_splits(m, ccn__fan_edge(m, v, k));
+}
+
+void ccn__fan_sector(const ccn_mesh *m, int32_t v, int32_t k, int32_t *first, int32_t *count) {
+    int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v], n = ccn__valence(m, v), splits = 0;
+    for (int32_t j = 0; m->esharp && j < n; j++) splits += sector_edge(m, v, j);
+    if (m->vboundary[v] ? splits <= 2 : splits < 2) { /* the whole fan */
+        *first = 0;
+        *count = nfan;
+        return;
+    }
+    int32_t a = k, b = k + 1; /* fan faces a .. b-1; walk to the bounding edges a and b */
+    while (!sector_edge(m, v, (a % n + n) % n)) a--;
+    while (!sector_edge(m, v, b % n)) b++;
+    *first = (a % n + n) % n;
+    *count = b - a;
+}
+
+int ccn__sector_regular(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
+    int kind = ccn__limit_kind(m, v, pinned);
+    if (kind == CCN_LIMIT_REGULAR) return 1;
+    if (kind != CCN_LIMIT_RING || !m->esharp) return 0;
+    int32_t n = ccn__valence(m, v), ns = 0;
+    float vs = ccn__vertex_sharpness(m, v, pinned);
+    if (vs > 0.0f && vs < CCN_SHARP_INF) return 0; /* semi-sharp: its rule still changes */
+    for (int32_t j = 0; j < n; j++) {
+        int bnd = m->vboundary[v] && (j == 0 || j == n - 1);
+        float s = bnd ? CCN_SHARP_INF : m->esharp[ccn__fan_edge(m, v, j)];
+        if (s > 0.0f && s < CCN_SHARP_INF) return 0;
+        ns += s >= CCN_SHARP_INF;
+    }
+    if (ns < 2) return 0; /* a dart, or a cone (vertex sharpness only) */
+    int32_t first, count;
+    ccn__fan_sector(m, v, k, &first, &count);
+    /* a corner's one-face sector is a pinned corner, a crease's two-face sector a boundary
+     * vertex of valence 3: both refine by knot insertion with mirrored ghosts */
+    return ns >= 3 || vs >= CCN_SHARP_INF ? count == 1 : count == 2;
+}
+
 void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g) {
     int32_t sl[4];
     for (int s = 0; s < 4; s++) sl[s] = slot_edge(m, v, k0, s);
+    int32_t first = 0, count = 0;
+    if (m->esharp) ccn__fan_sector(m, v, k0, &first, &count);
+    if (m->esharp && count < m->vfan_start[v + 1] - m->vfan_start[v]) {
+        /* the sector of fan face k0 between sharp edges, as if those edges were the boundary:
+         * its edges first .. first+count are the fan of a boundary vertex */
+        int32_t n = ccn__valence(m, v), rel = ((k0 - first) % n + n) % n;
+        for (int s = 0; s < 4; s++) {
+            int32_t k = s == 3 ? rel - 1 : rel + s;
+            sl[s] = k >= 0 && k <= count ? (first + k) % n : -1;
+        }
+    }
     /* fan face k lies between fan edges k and k+1: quadrant (+u,+v) is face sl[0],
      * (-u,+v) face sl[1], (-u,-v) face sl[2], (+u,-v) face sl[3] */
     ccn__vpoint (*p)[3] = g->p;

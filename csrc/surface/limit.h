@@ -32,6 +32,16 @@ typedef struct { int32_t v[4]; double w[4]; int n; } ccn__vpoint;
  * D_-2, D_-1, D_0, D_1 along u (D_0 between (0,0) and (1,0)); dv likewise. */
 typedef struct { ccn__vpoint p[3][3]; double du[4], dv[4]; } ccn__vgrid;
 void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn__vgrid *g);
+/* Creases: the fan faces first .. first+count-1 (mod the fan size) of v's sector that holds
+ * fan face k, between the edges that split the look-ups (sharpness >= 1) or the boundary; the
+ * whole fan when v has fewer than two such edges. ccn__vertex_grid builds the grid of fan face
+ * k0's sector, mirrored across its sharp edges as across a boundary. */
+void ccn__fan_sector(const ccn_mesh *m, int32_t v, int32_t k, int32_t *first, int32_t *count);
+/* Is the limit of v's sector holding fan face k the tensor spline of that sector's grid, as at
+ * a regular vertex? REGULAR vertices, and on creased meshes (no semi-sharp value at v) a
+ * crease vertex's two-face sector (a boundary vertex of valence 3: the crease curve is the
+ * B-spline boundary on each side) and a corner's one-face sector (a pinned corner). */
+int ccn__sector_regular(const ccn_mesh *m, int32_t v, int32_t k, int pinned);
 
 int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
 /* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the

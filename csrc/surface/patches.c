@@ -7,6 +7,14 @@
  * the 3x3 grids of the four corners (limit.c); the intervals D_-2..D_2 of each direction
  * come from the ring intervals (D_0 = the face's own).
  *
+ * Creases: sharp edges (sharpness >= 1) split the surface into sectors that refine
+ * independently, like boundaries (rules/bspline.c). A corner's grid is that of its sector
+ * holding the face, mirrored across the sector's sharp edges (ccn__vertex_grid), and a vertex
+ * counts as regular for the faces of one sector (ccn__sector_regular): a crease vertex's
+ * two-face sector and a corner's one-face sector are, so a face beside an infinitely sharp
+ * crease through valence-4 vertices is the bicubic patch whose boundary is the crease curve.
+ * Semi-sharp values (still decaying) at a vertex make it irregular.
+ *
  * 1-D conversion of the span [t_0, t_1] from P_-1..P_2 (blossoming):
  *   b_0 = f(t_0,t_0,t_0)   limit at t_0 (limit.c)
  *   b_1 = f(t_0,t_0,t_1) = (1-a) P_0 + a P_1,  a = D_-1 / (D_-1 + D_0 + D_1)
@@ -37,12 +45,29 @@ static int vpoint_regular(const ccn_mesh *m, const ccn__vpoint *p, int pinned) {
     return 1;
 }
 
+/* Creases: every vertex of every face of the corners' sectors that hold f (the faces the net
+ * is made of; each one's vertices are its real points) regular in that face's sector. */
+static int sectors_strict(const ccn_mesh *m, int32_t f, int pinned) {
+    for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+        int32_t v = m->hvert[h], first, count, nfan = m->vfan_start[v + 1] - m->vfan_start[v];
+        ccn__fan_sector(m, v, m->hfanpos[h], &first, &count);
+        for (int32_t i = 0; i < count; i++) {
+            int32_t g = m->hface[m->vfan[m->vfan_start[v] + (first + i) % nfan]];
+            if (ccn__fsize(m, g) != 4) return 0;
+            for (int32_t x = m->fstart[g]; x < m->fstart[g + 1]; x++)
+                if (!ccn__sector_regular(m, m->hvert[x], m->hfanpos[x], pinned)) return 0;
+        }
+    }
+    return 1;
+}
+
 int ccn__bicubic_net(const ccn_mesh *m, int32_t f, int pinned, int strict, ccn__vpoint net[4][4],
                      double Cu[4][4], double Cv[4][4]) {
     if (ccn__fsize(m, f) != 4) return 0;
     int32_t h0 = m->fstart[f];
     for (int k = 0; k < 4; k++)
-        if (ccn__limit_kind(m, m->hvert[h0 + k], pinned) != CCN_LIMIT_REGULAR) return 0;
+        if (!ccn__sector_regular(m, m->hvert[h0 + k], m->hfanpos[h0 + k], pinned)) return 0;
+    if (strict && m->esharp && !sectors_strict(m, f, pinned)) return 0;
     ccn__vgrid g[4];
     for (int k = 0; k < 4; k++)
         ccn__vertex_grid(m, m->hvert[h0 + k], m->hfanpos[h0 + k], pinned, &g[k]);
@@ -54,7 +79,7 @@ int ccn__bicubic_net(const ccn_mesh *m, int32_t f, int pinned, int strict, ccn__
         }
     net[3][0] = g[1].p[0][0]; /* v1 at (1,0): local (a,b) -> (1-b, a) */
     net[0][3] = g[3].p[0][0]; /* v3 at (0,1): local (a,b) -> (b, 1-a) */
-    for (int i = 0; strict && i < 4; i++)
+    for (int i = 0; strict && !m->esharp && i < 4; i++)
         for (int j = 0; j < 4; j++)
             if (!vpoint_regular(m, &net[i][j], pinned)) return 0;
     double Du[5] = {g[0].du[0], g[0].du[1], g[0].du[2], g[0].du[3], g[2].du[0]};
