@@ -297,10 +297,15 @@ typedef struct {
     int32_t fill_level;      /* mesh level of the fill faces (-1: none) */
     int32_t num_edges, num_vertices, num_shells, num_boundary_edges;
     int32_t closed;          /* every edge shared by two face sides: a closed shell (solid) */
-    double max_g1_deviation;      /* rad: largest normal angle across shared edges, fills excluded */
+    double max_g1_deviation;      /* rad: largest normal angle across shared edges, fills and
+                                     creases excluded */
     double max_fill_g1_deviation; /* rad: the same across edges of fill faces (0 without fills) */
     double size;             /* bounding-box diagonal of the poles */
     int64_t bytes;           /* written */
+    /* creases: edges on infinitely sharp cage edges, where faces meet C0 (shared edge, normals
+     * differ); they are not in max_g1_deviation / max_fill_g1_deviation */
+    int32_t num_crease_edges;
+    double min_crease_angle, max_crease_angle; /* rad: normal angle across them (0 without) */
 } ccn_export_info;
 
 /* Evaluates the plan at positions (3 * num_cage_verts, NULL = the cage's own, as

@@ -6,7 +6,8 @@
  *   3. the plan's other patches (bicubic around caps, bi-5 rings and caps) one face each;
  *   4. holes (faces the plan has no patch for): refined deeper and closed (fill.c);
  *   5. topology from the places (export_topo.c); G1 deviation measured on the model: the
- *      normals of both faces at 8 inner points of every shared segment;
+ *      normals of both faces at 8 inner points of every shared segment (segments on infinitely
+ *      sharp cage edges, C0 by design, counted apart with their smallest and largest angle);
  *   6. the STEP or IGES writer through the caller's callback.
  */
 #include "io/export_model.h"
@@ -142,7 +143,8 @@ static double normal_angle(const ccn__cad_surface *A, double ua, double va, cons
 typedef struct { int32_t face; int side; int32_t k; } seg_of;
 
 static void g1_deviation(const ccn__cad_model *m, const ccn__xmodel *xm, const seg_of *so,
-                         int32_t ns, double *all, double *fill) {
+                         const uint8_t *crease, int32_t ns, ccn_export_info *inf) {
+    double *all = &inf->max_g1_deviation, *fill = &inf->max_fill_g1_deviation;
     *all = *fill = 0;
     for (int32_t j = 0; j < ns; j++) {
         int32_t q = m->adjacency[j];
@@ -158,6 +160,18 @@ static void g1_deviation(const ccn__cad_model *m, const ccn__xmodel *xm, const s
             side_uv(B, so[q].side, b1 + w * (b0 - b1), &ub, &vb);
             double ang = normal_angle(A, ua, va, B, ub, vb);
             if (!(ang <= mx)) mx = ang; /* NaN (a degenerate normal) counts as the worst */
+        }
+        if (crease[j]) { /* a C0 edge: its angle, apart */
+            double mn = INFINITY;
+            for (int i = 0; i < 8; i++) {
+                double w = (i + 0.5) / 8, ua, va, ub, vb;
+                side_uv(A, so[j].side, a0 + w * (a1 - a0), &ua, &va);
+                side_uv(B, so[q].side, b1 + w * (b0 - b1), &ub, &vb);
+                mn = fmin(mn, normal_angle(A, ua, va, B, ub, vb));
+            }
+            if (!inf->num_crease_edges++ || mn < inf->min_crease_angle) inf->min_crease_angle = mn;
+            if (!(mx <= inf->max_crease_angle)) inf->max_crease_angle = mx;
+            continue;
         }
         int isfill = xm->faces[so[j].face].kind == CCN_EXPORT_FACE_FILL ||
                      xm->faces[so[q].face].kind == CCN_EXPORT_FACE_FILL;
@@ -362,6 +376,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     memset(&xm, 0, sizeof xm);
     int32_t *bs = NULL, *adj = NULL;
     double *br = NULL;
+    uint8_t *crease = NULL;
     seg_of *so = NULL;
     int32_t *uf = NULL;
     ccn__cad_topo topo;
@@ -378,7 +393,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         goto done;
     }
     if (o.face_fn) face_map(&o, &xm);
-    if ((st = ccn__xtopo_build(&xm, v.lev[0], &bs, &br, &adj, err))) goto done;
+    if ((st = ccn__xtopo_build(&xm, v.lev[0], &bs, &br, &adj, &crease, err))) goto done;
     progress(&o, 0.6);
     ccn__cad_surface *faces = malloc(sizeof *faces * (size_t)xm.num_faces);
     if (!faces) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)"); goto done; }
@@ -411,7 +426,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         if (a != b) uf[a < b ? b : a] = a < b ? a : b;
     }
     for (int32_t f = 0; f < xm.num_faces; f++) inf.num_shells += uf_find(uf, f) == f;
-    g1_deviation(&m, &xm, so, ns, &inf.max_g1_deviation, &inf.max_fill_g1_deviation);
+    g1_deviation(&m, &xm, so, crease, ns, &inf);
     inf.num_faces = xm.num_faces;
     inf.num_edges = topo.num_edges;
     inf.num_vertices = topo.num_verts;
@@ -427,7 +442,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
 done:
     ccn__cad_topo_free(&topo);
     ccn__xm_free(&xm);
-    free(rl.r); free(rl.pts); free(bs); free(br); free(adj); free(so); free(uf);
+    free(rl.r); free(rl.pts); free(bs); free(br); free(adj); free(crease); free(so); free(uf);
     if (info) *info = inf;
     return st;
 }

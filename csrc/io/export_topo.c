@@ -9,10 +9,12 @@
  * breaks is covered by one face side (boundary) or by two running in opposite directions
  * (an edge; anything else is an internal error). Consecutive elementary segments of a side
  * whose partners are consecutive on one other side (or which are both boundary) are merged,
- * so an edge runs as far as the same two faces meet (a torus pack: two seam edges). */
+ * so an edge runs as far as the same two faces meet (a torus pack: two seam edges), and not
+ * from an infinitely sharp cage edge (a crease: C0) onto a smooth line or back. */
 #include "io/export_topo.h"
 
 #include "base/error.h"
+#include "rules/crease.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +29,7 @@ typedef struct {
     double x0, x1;  /* line parameter at the piece's start and end (running order) */
     double r0, r1;  /* the face side's parameter there */
     int32_t face, side, order; /* order: running index of the piece on its side */
+    int crease;     /* on an infinitely sharp cage edge */
 } piece;
 
 static int key_cmp(const line_key *a, const line_key *b) {
@@ -107,10 +110,11 @@ typedef struct {
     int32_t partner;     /* elementary segment index, -1 */
     int32_t pos;         /* running index on its side */
     int dir;             /* 1: along the line's parameter */
+    int crease;
 } eseg;
 
 ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t **breaks_start,
-                            double **breaks, int32_t **adjacency, ccn_error *err) {
+                            double **breaks, int32_t **adjacency, uint8_t **crease, ccn_error *err) {
     ccn_status st = CCN_OK;
     int32_t F = xm->num_faces;
     size_t np = 0;
@@ -121,7 +125,8 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
     eseg *es = NULL;
     int32_t *group = NULL, *bstart = NULL, *adj = NULL;
     double *br = NULL;
-    *breaks_start = NULL; *breaks = NULL; *adjacency = NULL;
+    uint8_t *cr = NULL;
+    *breaks_start = NULL; *breaks = NULL; *adjacency = NULL; *crease = NULL;
     if (!pc || !xs || !side_first) goto oom;
     size_t n = 0;
     for (int32_t f = 0; f < F; f++) {
@@ -150,6 +155,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
                 p->face = f;
                 p->side = s;
                 p->order = q;
+                p->crease = p->k.type == 0 && cage->esharp && cage->esharp[p->k.a] >= CCN_SHARP_INF;
             }
         }
     }
@@ -204,6 +210,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
                 e->r1 = xb == p->x1 ? p->r1 : p->r0 + (xb - p->x0) / (p->x1 - p->x0) * (p->r1 - p->r0);
                 e->partner = -1;
                 e->dir = fwd;
+                e->crease = p->crease;
                 int32_t *cv = &cover[2 * (base + kk)];
                 if (cv[0] < 0) cv[0] = (int32_t)m;
                 else if (cv[1] < 0) cv[1] = (int32_t)m;
@@ -279,7 +286,8 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
             int merge = 0;
             if (i > s0) {
                 const eseg *A = &es[perm[i - 1]], *B = &es[perm[i]];
-                if (A->partner < 0 && B->partner < 0) merge = 1;
+                if (A->crease != B->crease) merge = 0;
+                else if (A->partner < 0 && B->partner < 0) merge = 1;
                 else if (A->partner >= 0 && B->partner >= 0) {
                     int32_t pa = inv[A->partner], pb = inv[B->partner];
                     merge = pb + 1 == pa && es[A->partner].face == es[B->partner].face &&
@@ -296,21 +304,24 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
     }
     if (st) { free(perm); free(inv); goto done; }
     adj = malloc(sizeof(int32_t) * (ng ? ng : 1));
-    if (!adj) { free(perm); free(inv); goto oom; }
+    cr = malloc((size_t)(ng ? ng : 1));
+    if (!adj || !cr) { free(perm); free(inv); goto oom; }
     for (int32_t i = 0; i < ng; i++) adj[i] = -1;
     for (size_t i = 0; i < m; i++) {
         const eseg *e = &es[perm[i]];
         if (e->partner >= 0) adj[group[i]] = group[inv[e->partner]];
+        cr[group[i]] = (uint8_t)e->crease;
     }
     free(perm);
     free(inv);
     *breaks_start = bstart; bstart = NULL;
     *breaks = br; br = NULL;
     *adjacency = adj; adj = NULL;
+    *crease = cr; cr = NULL;
     goto done;
 oom:
     st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export topology)");
 done:
-    free(pc); free(xs); free(side_first); free(es); free(group); free(bstart); free(br); free(adj);
+    free(pc); free(xs); free(side_first); free(es); free(group); free(bstart); free(br); free(adj); free(cr);
     return st;
 }

@@ -7,7 +7,7 @@
  * face order: grow along +u from the first free packable face (meeting the start again:
  * periodic in u), then add rows along +v while every cell of the next row is packable, free,
  * distinct and consistent (reaching the first row again: periodic in v). A regular torus is
- * one pack, periodic both ways.
+ * one pack, periodic both ways. Packs end at sharp edges (creases are C0 edges between faces).
  *
  * Knots: D_k = the ring interval of column k (side 0 of its cells; rows: side 3), the two
  * beyond each end from the corner vertex grids (mirrored at a boundary), cumulated from 0:
@@ -26,12 +26,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Steps never cross a sharp edge: a crease is a C0 edge between two packs (each side's
+ * nets are mirrored across it, so no net spans it). */
 static int32_t step_u(const ccn_mesh *m, int32_t b) {
-    int32_t t = m->htwin[ccn__next(m, b)];
-    return t < 0 ? -1 : ccn__next(m, t);
+    int32_t x = ccn__next(m, b), t = m->htwin[x];
+    return t < 0 || ccn__edge_sharp(m, m->hedge[x]) ? -1 : ccn__next(m, t);
 }
 static int32_t step_v(const ccn_mesh *m, int32_t b) {
-    return m->htwin[ccn__next(m, ccn__next(m, b))];
+    int32_t x = ccn__next(m, ccn__next(m, b));
+    return ccn__edge_sharp(m, m->hedge[x]) ? -1 : m->htwin[x];
 }
 
 int ccn__packable(const ccn_mesh *m, int32_t f, int pinned) {

@@ -107,11 +107,12 @@ int ccn_cmd_export(int argc, char **argv) {
     for (int k = 0; k < 5; k++) printf("%s: %d\n", KIND[k], (int)by[k]);
     printf("packed_cage_faces: %d\nfills: %d\nfill_level: %d\nedges: %d\nvertices: %d\nshells: %d\n"
            "boundary_edges: %d\nclosed: %d\nmax_g1_deviation: %.3e\nmax_fill_g1_deviation: %.3e\n"
-           "size: %.17g\nbytes: %lld\n",
+           "size: %.17g\nbytes: %lld\ncrease_edges: %d\nmin_crease_angle: %.3e\nmax_crease_angle: %.3e\n",
            (int)info.num_packed_cage_faces, (int)info.num_fills, (int)info.fill_level,
            (int)info.num_edges, (int)info.num_vertices, (int)info.num_shells,
            (int)info.num_boundary_edges, (int)info.closed, info.max_g1_deviation,
-           info.max_fill_g1_deviation, info.size, (long long)info.bytes);
+           info.max_fill_g1_deviation, info.size, (long long)info.bytes, (int)info.num_crease_edges,
+           info.min_crease_angle, info.max_crease_angle);
 done:
     if (f) fclose(f);
     if (fm) fclose(fm);
