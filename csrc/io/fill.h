@@ -12,9 +12,10 @@ typedef struct {
 } ccn__fill_opts;
 
 /* The holes faces[0..n-1] of plan level `level` (the plan has no patch there): refined
- * o->levels levels deeper around them, the exact bicubic pieces of every level (strict
- * faces: CCN_EXPORT_FACE_REFINED), then at the last level one fill face per sector of every
- * irregular vertex over the 2x2 faces there (CCN_EXPORT_FACE_FILL). */
+ * o->levels levels deeper around them (below the level where the last semi-sharp value
+ * decayed, if any), the exact bicubic pieces of every level (strict faces:
+ * CCN_EXPORT_FACE_REFINED), then at the last level one fill face per fan face in the irregular
+ * sectors of every irregular vertex, over the 2x2 faces there (CCN_EXPORT_FACE_FILL). */
 ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t level,
                            const int32_t *faces, int32_t n, ccn__fill_opts *o, ccn_error *err);
 
