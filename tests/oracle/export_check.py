@@ -15,7 +15,14 @@ For every limit vertex, every place (cage face, sub-quad, s, t) it has; the face
 containing it give the face and its (u, v); OpenCASCADE evaluates those (occt_read --eval)
 and the distance to the limit sample is taken, apart for fill faces (counted fallbacks).
 Patch faces (the plan's own bicubic / bi-5 patches) are also evaluated on a 4x4 grid against
-the Bernstein form of `ccnurbs patches`' control points. Prints "key: value" per file.
+the Bernstein form of `ccnurbs patches`' control points.
+
+Creases: every edge OpenCASCADE has with two faces (occt_read --edges: the uv of its middle on
+each face and its normal angles) is located on the cage through the face map; an edge lying on
+a cage edge that the cage file makes infinitely sharp (`# crease i j s` or OpenSubdiv's
+`t crease`, s >= 10) is a crease: C0 by design, its angles reported apart (smallest, largest),
+not as G1 deviations. smooth_angle_max covers the other edges except those of fill faces,
+fill_angle_max the fill faces' (per side of a crease). Prints "key: value" per file.
 """
 import argparse
 import os
@@ -35,6 +42,96 @@ def read_cage_sizes(path):
         if line.startswith("f "):
             sizes.append(len(line.split()) - 1)
     return sizes
+
+
+def read_cage_creases(path):
+    """Face vertex lists (0-based) and the infinitely sharp edges {(a, b)} of an OBJ cage."""
+    faces, sharp, nv = [], set(), 0
+
+    def num(x):
+        return float("inf") if x.lower() in ("inf", "+inf") else float(x)
+    for line in open(path):
+        w = line.split()
+        if not w:
+            continue
+        if w[0] == "v":
+            nv += 1
+        elif w[0] == "f":
+            idx = [int(t.split("/")[0]) for t in w[1:]]
+            faces.append([i - 1 if i > 0 else nv + i for i in idx])
+        elif w[0] == "#" and len(w) >= 5 and w[1] == "crease" and w[2].lstrip("-").isdigit():
+            if num(w[4]) >= 10:
+                a, b = int(w[2]) - 1, int(w[3]) - 1
+                sharp.add((min(a, b), max(a, b)))
+        elif w[0] == "t" and len(w) >= 3 and w[1] == "crease":
+            ni, nf = [int(x) for x in w[2].split("/")[:2]]
+            ints, vals = [int(x) for x in w[3:3 + ni]], [num(x) for x in w[3 + ni:3 + ni + nf]]
+            for k in range(ni // 2):
+                if (vals[k] if nf > 1 else vals[0]) >= 10:
+                    a, b = ints[2 * k], ints[2 * k + 1]
+                    sharp.add((min(a, b), max(a, b)))
+    return faces, sharp
+
+
+def cage_edge_at(faces, c, sub, st, tol=1e-6):
+    """The cage edge (a, b) that the local point st of place (c, sub) lies on, or None."""
+    f, n = faces[c], len(faces[c])
+    s, t = st
+    if sub < 0:  # quad: t=0 side 0, s=1 side 1, t=1 side 2, s=0 side 3
+        side = 0 if abs(t) < tol else 1 if abs(s - 1) < tol else 2 if abs(t - 1) < tol else 3 if abs(s) < tol else -1
+    elif abs(t) < tol:  # corner 0 (the cage vertex) to 1: half-edge sub
+        side = sub
+    elif abs(s) < tol:  # corner 3 to 0: the previous half-edge
+        side = (sub + n - 1) % n
+    else:
+        side = -1
+    if side < 0:
+        return None
+    a, b = f[side], f[(side + 1) % n]
+    return (min(a, b), max(a, b))
+
+
+def place_in_face(face, u, v, tol=1e-6):
+    """(cage face, sub, local st) of parameter (u, v) of a mapped export face: the cell that
+    contains it, or is nearest to it within tol x the cell's size (OpenCASCADE's pcurves of
+    edges lie within its tolerance of the face's parameter range: measured 2.6e-9 outside)."""
+    best, bd = None, float("inf")
+    for (c, sub, uv, st) in face["cells"]:
+        x = (u - uv[0]) / (uv[1] - uv[0])
+        y = (v - uv[2]) / (uv[3] - uv[2])
+        d = max(0.0, -x, x - 1, -y, y - 1)
+        if d < bd:
+            best, bd = (c, sub, st, min(max(x, 0.0), 1.0), min(max(y, 0.0), 1.0)), d
+    if best is None or bd > tol:
+        return None
+    c, sub, st, x, y = best
+    return c, sub, st[0] + x * (st[1] - st[0]) + y * (st[2] - st[0])
+
+
+def edge_report(tag, path, faces, cage_faces, sharp, kind):
+    """Crease edges and normal angles from occt_read --edges."""
+    byidx = {f["index"]: f for f in faces}
+    n_crease, cmin, cmax, smooth, fill, bad = 0, float("inf"), 0.0, 0.0, 0.0, 0
+    for line in open(path):
+        w = line.split()
+        fa, fb = int(w[0]), int(w[1])
+        ua, va, ub, vb, amax, amin = [float(x) for x in w[2:8]]
+        on = []
+        for (fi, u, v) in ((fa, ua, va), (fb, ub, vb)):
+            p = place_in_face(byidx[fi], u, v) if fi in byidx else None
+            on.append(cage_edge_at(cage_faces, p[0], p[1], p[2]) if p else None)
+        if on[0] != on[1]:
+            bad += 1
+        if on[0] is not None and on[0] in sharp:
+            n_crease += 1
+            cmin, cmax = min(cmin, amin), max(cmax, amax)
+        elif kind.get(fa) == FILL or kind.get(fb) == FILL:
+            fill = max(fill, amax)
+        else:
+            smooth = max(smooth, amax)
+    print("%s_crease_edges: %d\n%s_crease_angle_min: %.6e\n%s_crease_angle_max: %.6e\n"
+          "%s_smooth_angle_max: %.6e\n%s_fill_angle_max: %.6e\n%s_edges_located_apart: %d" % (
+              tag, n_crease, tag, cmin if n_crease else 0.0, tag, cmax, tag, smooth, tag, fill, tag, bad))
 
 
 def read_limit(path):
@@ -148,6 +245,7 @@ def main():
     ap.add_argument("files", nargs="+")
     a = ap.parse_args()
     sizes = read_cage_sizes(a.cage)
+    cage_faces, sharp = read_cage_creases(a.cage)
     level, V, N, F = read_limit(a.limit)
     places = limit_places(sizes, level, F)
     faces = read_map(a.map)
@@ -170,13 +268,16 @@ def main():
                 o.write("%d %.17g %.17g\n" % (r[0], r[1], r[2]))
         for path in a.files:
             rs = os.path.join(T, "res")
-            cmd = [a.occt] + (["--fallback", a.fallback] if a.fallback else []) + ["--eval", rq, "--out", rs, path]
+            ed = os.path.join(T, "edges")
+            cmd = [a.occt] + (["--fallback", a.fallback] if a.fallback else []) + ["--eval", rq, "--out", rs,
+                                                                                    "--edges", ed, path]
             with open(path + ".rep", "w") as rep:
                 p = subprocess.run(cmd, stdout=rep, stderr=subprocess.DEVNULL)
             tag = "iges" if path.endswith((".igs", ".iges")) else "step"
             if p.returncode != 0:
                 print("%s_eval: failed" % tag)
                 continue
+            edge_report(tag, ed, faces, cage_faces, sharp, kind)
             R = np.loadtxt(rs, ndmin=2)
             n = len(req)
             X = R[:n, 3:6]

@@ -2,7 +2,7 @@
 // OpenCASCADE and reports what a CAD system would see, as "key: value" lines on stdout.
 //
 //   occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]
-//             [--fallback FACES] model.step|model.igs
+//             [--fallback FACES] [--edges FILE] model.step|model.igs
 //   occt_read --build SURF.txt --grid N --points FILE
 //
 // Report: reader status, counts of solids/shells/faces/wires/edges/vertices, whether
@@ -21,6 +21,11 @@
 // its surface); RES gets "face u v x y z nx ny nz" (the oriented normal, 0 0 0 if undefined).
 // --fallback FACES: face indices (whitespace separated) whose edges are reported apart:
 // normal_angle_max covers the edges with no such face, normal_angle_fallback_max the others.
+// --edges FILE: one line per edge with two face uses, "fa fb ua va ub vb max min": the two
+// faces (TopExp order), the uv on each (from the pcurves) of the edge's point at 0.4142 of its
+// range (irrational: never at a vertex of the cage's hierarchy) and the largest
+// and smallest normal angle of its samples; for a caller that knows where the edges lie (e.g.
+// which are creases, whose angles are not G1 deviations).
 //
 // --no-heal: no shape healing after the translation (the reader's ShapeFix sequence is
 // replaced by an undefined one), so a wrongly oriented edge use or a gap the writer left
@@ -93,7 +98,7 @@
 
 static int usage() {
     std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]\n"
-                         "                 [--fallback FACES] FILE.step|FILE.igs\n"
+                         "                 [--fallback FACES] [--edges FILE] FILE.step|FILE.igs\n"
                          "       occt_read --build SURF.txt --grid N --points FILE\n");
     return 2;
 }
@@ -276,6 +281,8 @@ static bool eval_requests(const TopoDS_Shape &shape, const char *req, const char
 }
 
 // Normal angles across edges used twice (two faces, or a seam of one face).
+static FILE *edges_out; // --edges
+
 static void edge_angles(const TopoDS_Shape &shape, int K, const std::vector<char> &fallback) {
     TopTools_IndexedDataMapOfShapeListOfShape ef;
     TopExp::MapShapesAndAncestors(shape, TopAbs_EDGE, TopAbs_FACE, ef);
@@ -317,6 +324,7 @@ static void edge_angles(const TopoDS_Shape &shape, int K, const std::vector<char
         Handle(Geom2d_Curve) ca = BRep_Tool::CurveOnSurface(ea, fa, fa0, la0);
         Handle(Geom2d_Curve) cb = BRep_Tool::CurveOnSurface(eb, fb, fb0, lb0);
         if (ca.IsNull() || cb.IsNull()) { undefined++; continue; }
+        double emax = 0, emin = HUGE_VAL;
         for (int k = 0; k < K; k++) {
             double t = f0 + (l0 - f0) * (k + 0.5) / K; // inner samples: corners may be EVs
             gp_Pnt2d pa = ca->Value(t), pb = cb->Value(t);
@@ -328,10 +336,18 @@ static void edge_angles(const TopoDS_Shape &shape, int K, const std::vector<char
             }
             gp_Vec a(Na), b(Nb);
             double ang = std::atan2(a.Crossed(b).Magnitude(), a.Dot(b));
+            emax = std::max(emax, ang);
+            emin = std::min(emin, ang);
             if (fb_edge) { fbmax = std::max(fbmax, ang); continue; }
             if (ang > amax) { amax = ang; worst = e; }
             asum += ang;
             count++;
+        }
+        if (edges_out) { // a point at an irrational fraction: never at a vertex of the cage
+            double t = f0 + (l0 - f0) * 0.41421356237309515;
+            gp_Pnt2d pa = ca->Value(t), pb = cb->Value(t);
+            std::fprintf(edges_out, "%d %d %.17g %.17g %.17g %.17g %.6e %.6e\n", ia, ib, pa.X(), pa.Y(), pb.X(),
+                         pb.Y(), emax, emin);
         }
     }
     std::printf("edge_pairs: %ld\nnormal_samples: %ld\nnormal_undefined: %ld\n", pairs, count, undefined);
@@ -440,6 +456,7 @@ static Handle(Geom_BSplineSurface) build_surface(const char *path) {
 int main(int argc, char **argv) {
     int N = 0, K = 8, heal = 1;
     const char *points = nullptr, *build = nullptr, *file = nullptr, *req = nullptr, *res = nullptr;
+    const char *edges = nullptr;
     std::vector<char> fallback;
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--grid") && i + 1 < argc) N = std::atoi(argv[++i]);
@@ -449,6 +466,7 @@ int main(int argc, char **argv) {
         else if (!std::strcmp(argv[i], "--no-heal")) heal = 0;
         else if (!std::strcmp(argv[i], "--eval") && i + 1 < argc) req = argv[++i];
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) res = argv[++i];
+        else if (!std::strcmp(argv[i], "--edges") && i + 1 < argc) edges = argv[++i];
         else if (!std::strcmp(argv[i], "--fallback") && i + 1 < argc) {
             std::ifstream fin(argv[++i]);
             int x;
@@ -513,7 +531,9 @@ int main(int argc, char **argv) {
         return 1;
     }
     std::printf("shape_type: %s\n", TopAbs::ShapeTypeToString(shape.ShapeType()));
+    if (edges && !(edges_out = std::fopen(edges, "w"))) { std::perror(edges); return 1; }
     report(shape, K, fallback);
+    if (edges_out && std::fclose(edges_out) != 0) { std::perror(edges); return 1; }
     if (req && !eval_requests(shape, req, res)) { std::fprintf(stderr, "occt_read: --eval failed\n"); return 1; }
     if (points) {
         FILE *out = std::fopen(points, "w");

@@ -3,13 +3,20 @@
 # cages: cube, torus, the Fig. 16-18 star cages (non-uniform intervals), the tear box
 # (make_tearbox.py), n-gons (ngon_prism), boundaries (lshape, mixed_boundary),
 # the 2.5k-face production-like cage (tests/bench/make_bench_cages.py), the cube with
-# --cap refine (every EV a fill). For each, STEP and IGES:
+# --cap refine (every EV a fill); creased cages: the cube with all edges infinitely sharp (6
+# flat faces meeting C0), sharpness 1.5, a box with darts, a corner and a cone point
+# (make_creased.py), and six of OpenSubdiv's creased regression shapes (single-component ones:
+# OpenCASCADE orders the faces of several shells its own way; from the cache `make deps` fills,
+# tests/oracle/osd_shapes_deps.sh). For each, STEP and IGES:
 #   - read with no load or transfer failure, the loops as written closed and every edge used at
 #     most once each way, BRepCheck valid, one shell, no edge with more than two face uses, as
 #     many free edges as the export reports boundary edges (closed cages: a closed shell with
 #     positive volume), no sewing;
 #   - normals across every shared edge <= 1e-8 rad except edges of fill faces (the counted
-#     fallbacks, listed to occt_read --fallback), whose largest angle is printed;
+#     fallbacks, listed to occt_read --fallback), whose largest angle is printed, and crease
+#     edges: OpenCASCADE's edges located on the cage through the face map (export_check.py)
+#     that lie on an infinitely sharp cage edge of the file; as many as the export reports,
+#     their angles printed;
 #   - every sample of `ccnurbs limit` (same options) lies in a face (by the face map) and
 #     OpenCASCADE's evaluation of that face there equals it <= 1e-9 x size (fills apart:
 #     printed); every face that is one of the plan's patches equals `ccnurbs patches` on a 4x4
@@ -21,10 +28,13 @@
 cd "$(dirname "$0")/../.." || exit 2
 T=$(mktemp -d) || exit 2
 trap 'rm -rf "$T"' EXIT
-pass=0; fail=0
+pass=0; fail=0; expect=""
 val() { sed -n "s/^$1: //p" "$2" | head -n 1; }
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
 python3 tests/oracle/make_tearbox.py "$T/tearbox.obj" || exit 2
+python3 tests/oracle/make_creased.py "$T" || exit 2
+OSD_DIR=$(sh tests/oracle/osd_shapes_deps.sh 2>/dev/null) && python3 tests/data/osd/extract_shapes.py "$OSD_DIR" "$T/osd" > /dev/null ||
+  OSD_DIR="" 
 python3 tests/bench/make_bench_cages.py "$T" > /dev/null || exit 2
 
 check() { # name obj limit-level [options]
@@ -51,28 +61,43 @@ check() { # name obj limit-level [options]
       k=${kv%%=*} want=${kv#*=}
       [ "$(val "$k" "$r")" = "$want" ] || e="$e $ext:$k=$(val "$k" "$r")(want $want)"
     done
-    le "$(val normal_angle_max "$r")" 1e-8 || e="$e $ext:normal_angle_max=$(val normal_angle_max "$r")"
     if [ "$closed" = 1 ] && ! awk -v v="$(val volume "$r")" 'BEGIN { exit !(v > 0) }'; then e="$e $ext:volume"; fi
   done
   for k in faces edges vertices closed_shells free_edges normal_angle_max normal_angle_fallback_max; do
     [ "$(val $k "$T/$name.step.rep")" = "$(val $k "$T/$name.igs.rep")" ] ||
       e="$e iges-differs:$k=$(val $k "$T/$name.step.rep")/$(val $k "$T/$name.igs.rep")"
   done
-  for k in faces packs bicubic bi5 refined fill_faces fills edges vertices closed max_g1_deviation max_fill_g1_deviation; do
+  for k in crease_edges crease_angle_min crease_angle_max smooth_angle_max fill_angle_max; do
+    [ "$(val step_$k "$T/$name.chk")" = "$(val iges_$k "$T/$name.chk")" ] ||
+      e="$e iges-differs:$k=$(val step_$k "$T/$name.chk")/$(val iges_$k "$T/$name.chk")"
+  done
+  for k in faces packs bicubic bi5 refined fill_faces fills edges vertices closed max_g1_deviation max_fill_g1_deviation \
+           crease_edges min_crease_angle max_crease_angle; do
     [ "$(val $k "$T/$name.info.step")" = "$(val $k "$T/$name.info.iges")" ] || e="$e iges-info-differs:$k"
   done
   c="$T/$name.chk"
   [ "$(val unmatched_vertices "$c")" = 0 ] || e="$e unmatched_limit_samples=$(val unmatched_vertices "$c")"
   for ext in step iges; do
+    le "$(val ${ext}_smooth_angle_max "$c")" 1e-8 || e="$e $ext:normal_angle_max=$(val ${ext}_smooth_angle_max "$c")"
+    [ "$(val ${ext}_crease_edges "$c")" = "$(val crease_edges "$T/$name.info.step")" ] ||
+      e="$e $ext:crease_edges=$(val ${ext}_crease_edges "$c")(export $(val crease_edges "$T/$name.info.step"))"
+    [ "$(val ${ext}_edges_located_apart "$c")" = 0 ] || e="$e $ext:edges_located_apart=$(val ${ext}_edges_located_apart "$c")"
     le "$(val ${ext}_max_rel_dist "$c")" 1e-9 || e="$e $ext:limit_dist=$(val ${ext}_max_rel_dist "$c")"
     if [ -n "$(val faces_patch_checked "$c")" ] && [ "$(val faces_patch_checked "$c")" != 0 ]; then
       le "$(val ${ext}_patch_max_rel_dist "$c")" 1e-9 || e="$e $ext:patch_dist=$(val ${ext}_patch_max_rel_dist "$c")"
     fi
   done
   i="$T/$name.info.step"
+  for kv in $expect; do # expectations of this cage
+    k=${kv%%=*} w=${kv#*=}
+    [ "$(val "$k" "$i")" = "$w" ] || e="$e $k=$(val "$k" "$i")(want $w)"
+  done
+  crease=""
+  [ "$(val crease_edges "$i")" = 0 ] ||
+    crease=" creases: $(val crease_edges "$i") C0 edges, angles $(val step_crease_angle_min "$c")..$(val step_crease_angle_max "$c") rad;"
   if [ -z "$e" ]; then
     pass=$((pass+1))
-    echo "ok   $name: $(val faces "$i") faces ($(val packs "$i") packs, $(val bicubic "$i") bicubic, $(val bi5 "$i") bi-5, $(val refined "$i") refined, $(val fill_faces "$i") fill), closed=$closed, $(val bytes "$i") B; vs limit L$L: $(val step_samples "$c") samples $(val step_max_rel_dist "$c") x size, patches $(val step_patch_max_rel_dist "$c"); normals $(val normal_angle_max "$T/$name.step.rep") rad; fills: $(val fills "$i") (level $(val fill_level "$i")) G1 $(val normal_angle_fallback_max "$T/$name.step.rep") rad, dist $(val step_fill_max_rel_dist "$c") x size; STEP = IGES"
+    echo "ok   $name: $(val faces "$i") faces ($(val packs "$i") packs, $(val bicubic "$i") bicubic, $(val bi5 "$i") bi-5, $(val refined "$i") refined, $(val fill_faces "$i") fill), closed=$closed, $(val bytes "$i") B; vs limit L$L: $(val step_samples "$c") samples $(val step_max_rel_dist "$c") x size, patches $(val step_patch_max_rel_dist "$c"); normals $(val step_smooth_angle_max "$c") rad;$crease fills: $(val fills "$i") (level $(val fill_level "$i")) G1 $(val step_fill_angle_max "$c") rad, dist $(val step_fill_max_rel_dist "$c") x size; STEP = IGES"
   else
     fail=$((fail+1)); echo "FAIL $name:$e"
   fi
@@ -89,6 +114,24 @@ check ngon_prism tests/data/ngon_prism.obj 3
 check lshape tests/data/lshape.obj 3
 check mixed_boundary tests/data/mixed_boundary.obj 3
 check carlike_2.5k "$T/carlike.obj" 1
+expect="faces=6 packs=6 edges=12 vertices=8 closed=1 crease_edges=12 min_crease_angle=1.571e+00 max_crease_angle=1.571e+00"
+check cube_sharp "$T/cube_sharp.obj" 3
+expect=""
+for ext in step igs; do # the unit cube's six flat faces bound volume 1
+  v=$(val volume "$T/cube_sharp.$ext.rep")
+  if awk -v v="$v" 'BEGIN { d = v - 1; exit !(v != "" && d < 1e-9 && d > -1e-9) }'; then
+    pass=$((pass+1)); echo "ok   cube_sharp .$ext: OpenCASCADE's volume $v"
+  else fail=$((fail+1)); echo "FAIL cube_sharp .$ext: volume $v, expected 1"; fi
+done
+check cube_semi "$T/cube_semi.obj" 3
+check dart_corner "$T/dart_corner.obj" 3
+if [ -n "$OSD_DIR" ]; then
+  for s in inf_crease0 cube_creases2 single_crease torus_creases1 dart_edgecorner fvar_project0; do
+    check "osd_$s" "$T/osd/catmark_$s.obj" 3
+  done
+else
+  fail=$((fail+1)); echo "FAIL OpenSubdiv's creased shapes: not available (tests/oracle/osd_shapes_deps.sh)"
+fi
 
 # The CLI contract: errors print a message, exit 2 and leave no output file (nor a temporary).
 printf 'v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n' > "$T/nan.obj"
