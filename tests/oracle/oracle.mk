@@ -7,7 +7,7 @@ ORACLE_SAVED_GOAL := $(.DEFAULT_GOAL)
 ORACLE_CFLAGS      = -std=c11 -O2 -Wall -Wextra -Werror
 ORACLE_CXXFLAGS    = -std=c++14 -O2 -Wall -Wextra -Werror
 
-OSD_REFINE_SRC = tests/oracle/osd_refine.cpp tests/oracle/osd_obj.cpp
+OSD_REFINE_SRC = tests/oracle/osd_refine.cpp tests/oracle/osd_obj.cpp tests/oracle/osd_patch.cpp
 $(B)/osd_refine: $(OSD_REFINE_SRC) tests/oracle/osd_oracle.h
 	@mkdir -p $(@D)
 	$(CXX) $(ORACLE_CXXFLAGS) $(OSD_REFINE_SRC) -o $@ -losdCPU

@@ -1,5 +1,7 @@
 // Shared declarations of the osd_refine test oracle: osd_refine.cpp (main, refinement, exact
-// limit) and osd_obj.cpp (the OBJ reader with its sharpness and option tags).
+// limit), osd_obj.cpp (the OBJ reader with its sharpness and option tags) and osd_patch.cpp
+// (--patch-limit: OpenSubdiv's adaptive patch table evaluated as Blender's Subdivision
+// Surface does).
 #ifndef CCNURBS_OSD_ORACLE_H
 #define CCNURBS_OSD_ORACLE_H
 
@@ -45,6 +47,29 @@ bool readObj(const char *path, Mesh &m, std::string &msg);
 
 // Errors reported by OpenSubdiv's callback so far (osd_refine.cpp).
 extern int g_osdErrors;
+
+// --patch-limit settings (osd_patch.cpp). Defaults are Blender's.
+struct PatchOptions {
+    int isolation = 10;         // Subdivision Surface's Quality
+    bool infSharpPatch = true;  // Blender: always
+    bool singleCreasePatch = false;
+    bool bsplineEndCaps = false;  // false: ENDCAP_GREGORY_BASIS (Blender), true: BSPLINE_BASIS
+};
+
+// What the patch table held, for the output's comment line.
+struct PatchStats {
+    int maxLevel = 0;
+    int regular = 0, gregoryBasis = 0, other = 0;
+    int localPoints = 0;
+};
+
+// Positions of the vertices of level `levels` of `uniform` (uniformly refined to that level,
+// any vertex order) evaluated on the patch table of `adaptive` (an unrefined refiner of the
+// same cage) at their ptex coordinates; basePos are the cage positions.
+std::vector<Vertex3> patchLimit(OpenSubdiv::Far::TopologyRefiner const &uniform, int levels,
+                                OpenSubdiv::Far::TopologyRefiner &adaptive,
+                                std::vector<Vertex3> const &basePos, PatchOptions const &opts,
+                                PatchStats &stats);
 
 }  // namespace osd_oracle
 

@@ -1,7 +1,8 @@
 // osd_refine: reference Catmull-Clark refinement with OpenSubdiv (test oracle).
 //
-//   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd]
-//              in.obj out.obj
+//   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd |
+//              --patch-limit [--isolation N] [--inf-sharp-patch 0|1] [--single-crease-patch 0|1]
+//              [--endcap gregory|bspline]] in.obj out.obj
 //
 // Input: OBJ with OpenSubdiv shape tags or CCNURBS sharpness comments (osd_obj.cpp).
 // Options. Boundary interpolation is EDGE_ONLY (--corners smooth, the default) or
@@ -40,6 +41,12 @@
 //     vertices under interpolateboundary 0.
 //   --limit-osd: plain PrimvarRefiner::Limit at level K (OpenSubdiv's own approximation
 //     described above), for comparison.
+//   --patch-limit: the level-K vertices evaluated on OpenSubdiv's adaptive patch table
+//     (Far::PatchTableFactory, Far::PatchMap, PatchTable::EvaluateBasis at each vertex's
+//     ptex face (u, v)) as Blender's Subdivision Surface does with Use Limit Surface; the
+//     defaults are Blender's (isolation 10 = Quality 10, infinitely sharp patches, no
+//     single-crease patches, Gregory basis end caps). Not the exact limit near irregular
+//     features: see osd_patch.cpp.
 // Level-K vertex order: OpenSubdiv "orderVerticesFromFacesFirst" (at each level face
 // points, then edge points, then vertex points). Errors: message on stderr, exit 2.
 #include "osd_oracle.h"
@@ -56,6 +63,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
@@ -92,7 +100,9 @@ void osdWarning(const char *msg) {
 
 void usage() {
     die("usage: osd_refine [--levels K] [--corners smooth|pinned] "
-        "[--limit | --limit-normals | --limit-osd] in.obj out.obj");
+        "[--limit | --limit-normals | --limit-osd | --patch-limit [--isolation N] "
+        "[--inf-sharp-patch 0|1] [--single-crease-patch 0|1] [--endcap gregory|bspline]] "
+        "in.obj out.obj");
 }
 
 typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
@@ -316,11 +326,37 @@ const char *boundaryName(Sdc::Options::VtxBoundaryInterpolation b) {
 
 int main(int argc, char **argv) {
     int levels = 1;
-    bool pinned = false, limit = false, normals = false, limitOsd = false;
+    bool pinned = false, limit = false, normals = false, limitOsd = false, patch = false;
+    bool patchOpt = false;  // a --patch-limit setting was given
+    PatchOptions po;
     const char *inPath = nullptr, *outPath = nullptr;
+    auto flag = [&](const char *name, const char *v) {
+        const std::string s = v;
+        if (s != "0" && s != "1") die(std::string(name) + " must be 0 or 1");
+        patchOpt = true;
+        return s == "1";
+    };
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        if (a == "--levels" && i + 1 < argc) {
+        if (a == "--isolation" && i + 1 < argc) {
+            char *end = nullptr;
+            long k = std::strtol(argv[++i], &end, 10);
+            if (*argv[i] == '\0' || *end != '\0' || k < 1 || k > 10)
+                die("--isolation must be 1..10");
+            po.isolation = (int)k;
+            patchOpt = true;
+        } else if (a == "--inf-sharp-patch" && i + 1 < argc) {
+            po.infSharpPatch = flag("--inf-sharp-patch", argv[++i]);
+        } else if (a == "--single-crease-patch" && i + 1 < argc) {
+            po.singleCreasePatch = flag("--single-crease-patch", argv[++i]);
+        } else if (a == "--endcap" && i + 1 < argc) {
+            const std::string c = argv[++i];
+            if (c != "gregory" && c != "bspline") die("--endcap must be gregory or bspline");
+            po.bsplineEndCaps = c == "bspline";
+            patchOpt = true;
+        } else if (a == "--patch-limit") {
+            patch = true;
+        } else if (a == "--levels" && i + 1 < argc) {
             char *end = nullptr;
             long k = std::strtol(argv[++i], &end, 10);
             if (*argv[i] == '\0' || *end != '\0' || k < 0 || k > 10) die("--levels must be 0..10");
@@ -348,6 +384,9 @@ int main(int argc, char **argv) {
     }
     if (!inPath || !outPath) usage();
     if (limitOsd && normals) die("--limit-osd and --limit-normals exclude each other");
+    if (patch && limit) die("--patch-limit excludes --limit, --limit-normals and --limit-osd");
+    if (patchOpt && !patch) die("--isolation, --inf-sharp-patch, --single-crease-patch and "
+                                "--endcap need --patch-limit");
 
     if (const char *e = std::getenv("OSD_REFINE_SETTLE")) g_settle = std::atof(e);
     Far::SetErrorCallback(osdError);
@@ -444,6 +483,12 @@ int main(int argc, char **argv) {
         }
         cur.swap(pos);
     }
+    PatchStats ps;
+    if (patch) {
+        std::unique_ptr<Far::TopologyRefiner> adaptive(createRefiner(base, sdcOpts));
+        if (!adaptive || g_osdErrors) die("OpenSubdiv rejected the topology");
+        cur = patchLimit(*refiner, levels, *adaptive, m.verts, po, ps);
+    }
     if (g_osdErrors) die("OpenSubdiv interpolation failed");
 
     FILE *out = std::fopen(outPath, "w");
@@ -460,6 +505,15 @@ int main(int argc, char **argv) {
     if (limitOsd) std::fprintf(out, ", PrimvarRefiner::Limit positions");
     else if (limit) std::fprintf(out, ", limit positions (%d by one-ring refinement)", nLocal);
     if (normals) std::fprintf(out, ", normals (%d undefined: 0 0 0)", nNoNormal);
+    if (patch)
+        std::fprintf(out,
+                     ", patch-table limit (isolation %d, inf-sharp patches %s, single-crease "
+                     "patches %s, %s end caps; %d levels, %d regular, %d Gregory basis, %d other "
+                     "patches, %d local points)",
+                     po.isolation, po.infSharpPatch ? "on" : "off",
+                     po.singleCreasePatch ? "on" : "off",
+                     po.bsplineEndCaps ? "B-spline basis" : "Gregory basis", ps.maxLevel,
+                     ps.regular, ps.gregoryBasis, ps.other, ps.localPoints);
     std::fputc('\n', out);
     for (size_t i = 0; i < cur.size(); i++)
         std::fprintf(out, "v %.17g %.17g %.17g\n", cur[i].p[0], cur[i].p[1], cur[i].p[2]);
