@@ -151,7 +151,7 @@ static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
         cap_cnet(m, ev, n, c->cnet);
         ccn__ev_ring(m, ev, c->ring);
         for (int32_t k = 0; k < n; k++) c->knots[k] = m->eknot[ccn__fan_edge(m, ev, k)];
-        ok = ccn__ev_limit(m, ev, p->opts.scheme, s, &e2) == CCN_OK;
+        ok = ccn__ev_limit(m, ev, p->opts.scheme, p->opts.ev_polyhedron, p->ev_cache, s, &e2) == CCN_OK;
         for (int32_t j = 0; ok && j < 2 * n + 1; j++) c->l0[j] = s->wp[j];
         int nu = 0; /* some kappa_s = d_{s+1}/d_{s-1} != 1: taus, once (they need no positions) */
         for (int32_t k = 0; k < n; k++)
