@@ -140,10 +140,10 @@ typedef struct {
 /* Eigen polyhedra (scheme EIGEN; the list with reasons: csrc/rules/eigen_shape.h):
  * CCN_POLY_PAPER = Li 2016 section 5's spoke lengths; 2..11 = l_i^(1-e) d_i^e with
  * e = 0.1, 0.2, -0.1, 0.05, -0.05, 0.15, -0.2, 0.3, -0.3, 0.4; 12 = lengths in the ratio of the
- * transverse Greville abscissae (least squares); 13, 14 = interval-dependent angles. */
+ * transverse Greville abscissae (least squares); 13..28 = interval-dependent sector angles. */
 #define CCN_POLY_SELECT 0
 #define CCN_POLY_PAPER 1
-#define CCN_POLY_COUNT 22
+#define CCN_POLY_COUNT 28
 
 /* M ((2n+1) x (2n+1), row-major; rows F_0..F_{n-1}, E_0..E_{n-1}, V) for valence n >= 3
  * and spoke intervals d[0..n-1] > 0. info may be NULL. Scheme EIGEN: the per-vertex choice of

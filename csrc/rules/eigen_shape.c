@@ -7,16 +7,18 @@
 #define SHAPE_PI 3.14159265358979323846
 
 static const ccn__poly_design DESIGNS[CCN__POLY_COUNT] = {
-    {CCN__LEN_PAPER, 0, 0},
-    {CCN__LEN_EXPONENT, 0.1, 0},  {CCN__LEN_EXPONENT, 0.2, 0},   {CCN__LEN_EXPONENT, -0.1, 0},
-    {CCN__LEN_EXPONENT, 0.05, 0}, {CCN__LEN_EXPONENT, -0.05, 0}, {CCN__LEN_EXPONENT, 0.15, 0},
-    {CCN__LEN_EXPONENT, -0.2, 0}, {CCN__LEN_EXPONENT, 0.3, 0},   {CCN__LEN_EXPONENT, -0.3, 0},
-    {CCN__LEN_EXPONENT, 0.4, 0},
-    {CCN__LEN_GREVILLE, 0, 0},
-    {CCN__LEN_GREVILLE, 0, -0.08}, {CCN__LEN_GREVILLE, 0, -0.12}, {CCN__LEN_PAPER, 0, -0.08},
-    {CCN__LEN_GREVILLE, 0, -0.05}, {CCN__LEN_EXPONENT, 0.1, -0.12}, {CCN__LEN_GREVILLE, 0, -0.2},
-    {CCN__LEN_PAPER, 0, -0.12},    {CCN__LEN_GREVILLE, 0, -0.03}, {CCN__LEN_EXPONENT, 0.1, -0.08},
-    {CCN__LEN_GREVILLE, 0, -0.15},
+    {CCN__LEN_PAPER, 0, 0, 0},
+    {CCN__LEN_EXPONENT, 0.1, 0, 0},  {CCN__LEN_EXPONENT, 0.2, 0, 0},   {CCN__LEN_EXPONENT, -0.1, 0, 0},
+    {CCN__LEN_EXPONENT, 0.05, 0, 0}, {CCN__LEN_EXPONENT, -0.05, 0, 0}, {CCN__LEN_EXPONENT, 0.15, 0, 0},
+    {CCN__LEN_EXPONENT, -0.2, 0, 0}, {CCN__LEN_EXPONENT, 0.3, 0, 0},   {CCN__LEN_EXPONENT, -0.3, 0, 0},
+    {CCN__LEN_EXPONENT, 0.4, 0, 0},
+    {CCN__LEN_GREVILLE, 0, 0, 0},
+    {CCN__LEN_GREVILLE, 0, -0.08, 0}, {CCN__LEN_GREVILLE, 0, -0.12, 0}, {CCN__LEN_PAPER, 0, -0.08, 0},
+    {CCN__LEN_GREVILLE, 0, -0.05, 0}, {CCN__LEN_EXPONENT, 0.1, -0.12, 0}, {CCN__LEN_GREVILLE, 0, -0.2, 0},
+    {CCN__LEN_PAPER, 0, -0.12, 0},    {CCN__LEN_GREVILLE, 0, -0.03, 0}, {CCN__LEN_EXPONENT, 0.1, -0.08, 0},
+    {CCN__LEN_GREVILLE, 0, -0.15, 0},
+    {CCN__LEN_GREVILLE, -0.1, -0.1, 3}, {CCN__LEN_GREVILLE, 0.1, -0.06, 0}, {CCN__LEN_GREVILLE, 0.1, -0.2, 0},
+    {CCN__LEN_GREVILLE, 0.1, -0.03, 0}, {CCN__LEN_GREVILLE, -0.1, -0.06, 0}, {CCN__LEN_PAPER, 0, -0.15, 1},
 };
 
 const ccn__poly_design *ccn__poly_design_of(int32_t poly) {
@@ -66,18 +68,27 @@ static int greville_lengths(int32_t n, const double *d, double *l) {
     return 0;
 }
 
+static double sector_weight(const ccn__poly_design *des, double a, double b) {
+    double x = des->angle_fn == 1 ? a + b : des->angle_fn == 2 ? fmin(a, b) : des->angle_fn == 3 ? fmax(a, b) : a * b;
+    return pow(x, des->a);
+}
+
 int ccn__poly_apply(const ccn__poly_design *des, int32_t n, const double *d, double *l,
                     double *c, double *s) {
     if (des->lengths == CCN__LEN_EXPONENT)
         for (int32_t i = 0; i < n; i++) l[i] = pow(l[i], 1.0 - des->e) * pow(d[i], des->e);
-    if (des->lengths == CCN__LEN_GREVILLE && greville_lengths(n, d, l)) return -1;
+    if (des->lengths == CCN__LEN_GREVILLE) {
+        if (greville_lengths(n, d, l)) return -1;
+        if (des->e != 0)
+            for (int32_t i = 0; i < n; i++) l[i] = pow(l[i], 1.0 - des->e) * pow(d[i], des->e);
+    }
     if (des->a != 0) {
         double sum = 0, phi = 0;
-        for (int32_t i = 0; i < n; i++) sum += pow(d[i] * d[md(i + 1, n)], des->a);
+        for (int32_t i = 0; i < n; i++) sum += sector_weight(des, d[i], d[md(i + 1, n)]);
         for (int32_t i = 0; i < n; i++) {
             c[i] = cos(phi);
             s[i] = sin(phi);
-            phi += 2 * SHAPE_PI * pow(d[i] * d[md(i + 1, n)], des->a) / sum;
+            phi += 2 * SHAPE_PI * sector_weight(des, d[i], d[md(i + 1, n)]) / sum;
         }
     }
     return 0;

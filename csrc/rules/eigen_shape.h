@@ -14,10 +14,15 @@
  *            of the transverse Greville abscissae, l_{s+1} / l_{s-1} = (2 d_{s+1} + d_{s-1}) /
  *            (2 d_{s-1} + d_{s+1}) (least squares where the n equations have no exact
  *            solution). At n = 4 the paper's lengths solve them, so it is the paper's there;
- *   13, 14   interval-dependent angles (the idea of the "modified eigen-polyhedron", Visual
- *            Computing for Industry, Biomedicine and Art 5:18, 2022, whose formulas we could not
- *            read): the paper's lengths, sector s (between spokes s and s+1) gets the angle
- *            2 pi w_s / sum w, w_s = (d_s d_{s+1})^a, a = 0.1 (13) and 0.25 (14).
+ *   13..28   interval-dependent sector angles (the idea of the "modified eigen-polyhedron",
+ *            Visual Computing for Industry, Biomedicine and Art 5:18, 2022, whose formulas we
+ *            could not read): sector s (between spokes s and s+1) gets the angle
+ *            2 pi w_s / sum w with w_s = (d_s d_{s+1})^a (or (d_s + d_{s+1})^a, max(d_s,
+ *            d_{s+1})^a), on the paper's, Greville or Greville^(1-e) d^e lengths; the 16
+ *            (lengths, e, a, w) of DESIGNS in eigen_shape.c were chosen by a greedy set cover
+ *            of the cases no earlier candidate passes (log-uniform [1e-3, 1] and [1e-6, 1],
+ *            seed 1, cases 0-1499; measured on cases 4000-5999, README "Eigen rules").
+ *            Negative a (wider sectors between short spokes) is what helps.
  * Every candidate is equivariant under rotation and reflection of the spoke order and equals
  * the paper's polyhedron for equal intervals (all l_i equal, equal angles). */
 #ifndef CCN_RULES_EIGEN_SHAPE_H
@@ -26,7 +31,7 @@
 #include <stdint.h>
 
 #define CCN__POLY_PAPER 1
-#define CCN__POLY_COUNT 22 /* candidates 1..CCN__POLY_COUNT */
+#define CCN__POLY_COUNT 28 /* candidates 1..CCN__POLY_COUNT */
 
 typedef enum { CCN__LEN_PAPER = 0, CCN__LEN_EXPONENT, CCN__LEN_GREVILLE } ccn__len_rule;
 
@@ -36,6 +41,7 @@ typedef enum { CCN__LEN_PAPER = 0, CCN__LEN_EXPONENT, CCN__LEN_GREVILLE } ccn__l
 typedef struct {
     ccn__len_rule lengths;
     double e, a;
+    int angle_fn; /* research: 0 w_s = (d_s d_{s+1})^a, 1 (d_s + d_{s+1})^a, 2 min^a, 3 max^a */
 } ccn__poly_design;
 
 /* The design of candidate poly (1..CCN__POLY_COUNT), NULL for any other number. */

@@ -522,13 +522,22 @@ static void test_large_valence(void) {
 /* ---- candidate polyhedra and the per-vertex choice (issue 14) ------------------------------ */
 
 /* The candidate list as documented (ccnurbs.h CCN_POLY_*, rules/eigen_shape.h): lengths rule
- * (0 paper, 1 l^(1-e) d^e, 2 Greville least squares) and angle exponent a. */
-static const struct { int len; double e, a; } CAND[CCN_POLY_COUNT] = {
-    {0, 0, 0},    {1, 0.1, 0},   {1, 0.2, 0},     {1, -0.1, 0}, {1, 0.05, 0},  {1, -0.05, 0},
-    {1, 0.15, 0}, {1, -0.2, 0},  {1, 0.3, 0},     {1, -0.3, 0}, {1, 0.4, 0},   {2, 0, 0},
-    {2, 0, -0.08}, {2, 0, -0.12}, {0, 0, -0.08},  {2, 0, -0.05}, {1, 0.1, -0.12}, {2, 0, -0.2},
-    {0, 0, -0.12}, {2, 0, -0.03}, {1, 0.1, -0.08}, {2, 0, -0.15},
+ * (0 paper, 1 l^(1-e) d^e, 2 Greville least squares, then ^(1-e) d^e), angle exponent a and
+ * sector weight w_s (0: (d_s d_{s+1})^a, 1: (d_s + d_{s+1})^a, 3: max(d_s, d_{s+1})^a). */
+static const struct { int len; double e, a; int fn; } CAND[CCN_POLY_COUNT] = {
+    {0, 0, 0, 0},    {1, 0.1, 0, 0},   {1, 0.2, 0, 0},     {1, -0.1, 0, 0}, {1, 0.05, 0, 0},
+    {1, -0.05, 0, 0}, {1, 0.15, 0, 0}, {1, -0.2, 0, 0},  {1, 0.3, 0, 0},     {1, -0.3, 0, 0},
+    {1, 0.4, 0, 0},   {2, 0, 0, 0},
+    {2, 0, -0.08, 0}, {2, 0, -0.12, 0}, {0, 0, -0.08, 0},  {2, 0, -0.05, 0}, {1, 0.1, -0.12, 0},
+    {2, 0, -0.2, 0},  {0, 0, -0.12, 0}, {2, 0, -0.03, 0}, {1, 0.1, -0.08, 0}, {2, 0, -0.15, 0},
+    {2, -0.1, -0.1, 3}, {2, 0.1, -0.06, 0}, {2, 0.1, -0.2, 0}, {2, 0.1, -0.03, 0},
+    {2, -0.1, -0.06, 0}, {0, 0, -0.15, 1},
 };
+
+static double sector_weight(int k, double a, double b) {
+    double x = CAND[k - 1].fn == 1 ? a + b : CAND[k - 1].fn == 3 ? (a > b ? a : b) : a * b;
+    return pow(x, CAND[k - 1].a);
+}
 
 /* Greville lengths, written independently of eigen_shape.c's Fourier solution: x = log l closest
  * (min-norm correction, LAPACK dgelsd) to the paper's x_p with x_{s+1} - x_{s-1} = b_s in the
@@ -557,13 +566,13 @@ static double candidate_polyhedron(int k, int n, const double *d, double *P) {
     int i, j;
     eigen_polyhedron(n, d, P); /* the paper's: read its lengths back */
     for (i = 0; i < n; i++) l[i] = hypot(P[2 * iE(i, n)], P[2 * iE(i, n) + 1]);
-    if (CAND[k - 1].len == 1)
-        for (i = 0; i < n; i++) l[i] = pow(l[i], 1 - CAND[k - 1].e) * pow(d[i], CAND[k - 1].e);
     if (CAND[k - 1].len == 2) greville_oracle(n, d, l);
-    for (i = 0; i < n; i++) sum += pow(d[i] * d[md(i + 1, n)], CAND[k - 1].a);
+    if (CAND[k - 1].len >= 1)
+        for (i = 0; i < n; i++) l[i] = pow(l[i], 1 - CAND[k - 1].e) * pow(d[i], CAND[k - 1].e);
+    for (i = 0; i < n; i++) sum += sector_weight(k, d[i], d[md(i + 1, n)]);
     for (i = 0; i < n; i++) {
         ang[i] = CAND[k - 1].a == 0 ? TWO_PI * i / n : phi;
-        phi += TWO_PI * pow(d[i] * d[md(i + 1, n)], CAND[k - 1].a) / sum;
+        phi += TWO_PI * sector_weight(k, d[i], d[md(i + 1, n)]) / sum;
     }
     for (i = 0; i < n; i++) {
         P[2 * iE(i, n)] = l[i] * cos(ang[i]);
