@@ -101,7 +101,33 @@ static void test_acceptance(void) {
     CHECK(t.all.caps >= 50, "caps measured: %d", t.all.caps);
 }
 
+/* Issue 14 item 5: at output levels L <= K the default cap costs nothing and changes nothing --
+ * no cap is built, the output is the refine plan's bit for bit -- and from L = K + 1 on the caps
+ * are there (the cube: eight valence-3 EVs, K = 2). */
+static void test_no_cap_work_at_low_levels(void) {
+    fcage c;
+    tear_box(&c);
+    ccn_cage g = fcage_view(&c);
+    for (int L = 1; L <= 3; L++) {
+        fplan pb, pr;
+        ccn_options o = {0};
+        o.levels = L;
+        CHECK(fplan_run(&g, o, &pb) == 0, "plan");
+        o.cap = CCN_CAP_REFINE;
+        CHECK(fplan_run(&g, o, &pr) == 0, "plan");
+        ccn_sizes sz;
+        ccn_plan_sizes(pb.p, &sz);
+        int same = memcmp(pb.x, pr.x, sizeof(double) * 3 * pr.nv) == 0 && memcmp(pb.n, pr.n, sizeof(double) * 3 * pr.nv) == 0;
+        if (L <= 2) CHECK(sz.num_caps == 0 && sz.num_cap_fallbacks == 0 && same, "L%d: %d caps, identical %d", L, sz.num_caps, same);
+        else CHECK(sz.num_caps == 4 && sz.num_cap_fallbacks == 4 && !same, "L%d: %d caps, %d fallbacks", L, sz.num_caps, sz.num_cap_fallbacks);
+        fplan_free(&pb);
+        fplan_free(&pr);
+    }
+    fcage_free(&c);
+}
+
 int main(void) {
+    RUN(test_no_cap_work_at_low_levels);
     RUN(test_acceptance);
     return TEST_SUMMARY();
 }
