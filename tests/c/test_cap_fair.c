@@ -63,13 +63,14 @@ static void test_acceptance(void) {
     tally t;
     memset(&t, 0, sizeof t);
     fair_init(&t.all);
-    for (int L = 4; L <= 6; L++) {
+    int small = getenv("CCN_TEST_SMALL") != NULL; /* the sanitizer run: level 4, a few cases */
+    for (int L = 4; L <= (small ? 4 : 6); L++) {
         fcage c;
         tear_box(&c);
         check_case("tear box", &c, L, 4, 4, &t); /* the -x corners (equal spokes) get caps */
         fcage_free(&c);
         for (int n = 3; n <= 12; n++) {
-            if (n == 4) continue;
+            if (n == 4 || (small && n > 6)) continue;
             double d[12];
             char what[64];
             for (int s = 0; s < n; s++) d[s] = 0.2 + 1.8 * tl_rand01();
@@ -98,7 +99,7 @@ static void test_acceptance(void) {
     }
     fair_print("all cases", &t.all);
     printf("# %d cases (levels 4-6): %d caps measured, %d fell back\n", t.cases, t.all.caps, t.all.fallbacks);
-    CHECK(t.all.caps >= 50, "caps measured: %d", t.all.caps);
+    CHECK(t.all.caps >= (small ? 5 : 50), "caps measured: %d", t.all.caps);
 }
 
 /* Issue 14 item 5: at output levels L <= K the default cap costs nothing and changes nothing --

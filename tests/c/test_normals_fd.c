@@ -329,7 +329,8 @@ static const char *SCHEME[3] = {"eigen", "nurss", "cc"};
 static void test_random_cages(void) {
     cage_t *c = malloc(sizeof *c);
     fd_stats st = {0, 0, 0, 0, 0};
-    for (int k = 0; k < 5; k++) {
+    int small = getenv("CCN_TEST_SMALL") != NULL; /* the sanitizer run: two cages, fewer levels */
+    for (int k = 0; k < (small ? 2 : 5); k++) {
         if (k == 0) box(c);
         if (k == 1) cylinder(c, 6, 2);
         if (k == 2) grid(c, 4, 3, 0);
@@ -343,8 +344,8 @@ static void test_random_cages(void) {
                 char what[80];
                 snprintf(what, sizeof what, "%s %s cap %s", c->name, SCHEME[sc], cap ? "refine" : "bi5");
                 fine_set fs;
-                if (fine_build(c, o, 5, &fs)) { CHECK(0, "%s fine plans", what); continue; }
-                for (int L = 1; L <= 3; L++) check_level(c, o, L, &fs, &st, what);
+                if (fine_build(c, o, small ? 4 : 5, &fs)) { CHECK(0, "%s fine plans", what); continue; }
+                for (int L = 1; L <= (small ? 2 : 3); L++) check_level(c, o, L, &fs, &st, what);
                 fine_free(&fs);
             }
     }
@@ -360,12 +361,13 @@ static void test_random_cages(void) {
 static void test_item3_cases(void) {
     cage_t *c = malloc(sizeof *c);
     fd_stats st = {0, 0, 0, 0, 0};
-    for (int seed = 0; seed < 4; seed++) {
+    int small = getenv("CCN_TEST_SMALL") != NULL;
+    for (int seed = 0; seed < (small ? 1 : 4); seed++) {
         cylinder(c, 8, 3);
         random_rings(c, 1e-3);
         ccn_options o = {.scheme = CCN_SCHEME_NURSS, .cap = CCN_CAP_REFINE, .threads = 1};
         fine_set fs;
-        if (fine_build(c, o, 5, &fs)) { CHECK(0, "cylinder fine plans"); continue; }
+        if (fine_build(c, o, small ? 4 : 5, &fs)) { CHECK(0, "cylinder fine plans"); continue; }
         char what[64];
         snprintf(what, sizeof what, "cylinder nurss #%d", seed);
         for (int L = 2; L <= 3; L++) check_level(c, o, L, &fs, &st, what);
@@ -377,8 +379,8 @@ static void test_item3_cases(void) {
     for (int dome = 0; dome < 2; dome++) {
         star_fan(c, 3, 4, d, dome ? 0.3 : 0.0);
         fine_set fs;
-        if (fine_build(c, o, 6, &fs)) { CHECK(0, "star fan fine plans"); continue; }
-        for (int i = 0; i < 3; i++) check_level(c, o, levels[i], &fs, &st, dome ? "star fan dome" : "flat star fan");
+        if (fine_build(c, o, small ? 4 : 6, &fs)) { CHECK(0, "star fan fine plans"); continue; }
+        for (int i = 0; i < (small ? 2 : 3); i++) check_level(c, o, levels[i], &fs, &st, dome ? "star fan dome" : "flat star fan");
         fine_free(&fs);
     }
     CHECK(st.flips == 0, "%d flipped normals", st.flips);
@@ -399,6 +401,7 @@ static void test_item3_cases(void) {
  * at level 10 the exact normals of the corner's neighbours differ from their own faces' by up
  * to 0.48 rad), so that corner is tested with intervals in [0.5, 1]. */
 static void test_corners(void) {
+    if (getenv("CCN_TEST_SMALL")) return; /* level 9: the plain build only */
     cage_t *c = malloc(sizeof *c);
     for (int shape = 0; shape < 2; shape++) {
         if (shape == 0) grid(c, 2, 2, 0); else grid(c, 2, 2, 1);
