@@ -133,7 +133,7 @@ static int fplan_run(const ccn_cage *cage, ccn_options o, fplan *f) {
     f->x = malloc(sizeof(double) * 3 * (size_t)f->nv);
     f->n = malloc(sizeof(double) * 3 * (size_t)f->nv);
     f->fv = malloc(sizeof(int32_t) * 4 * (size_t)f->nf);
-    ccn_limit_mesh lm = {f->x, f->n, f->fv, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = f->x, .normals = f->n, .face_verts = f->fv};
     if (ccn_plan_evaluate(f->p, NULL, &lm, &err)) { fprintf(stderr, "evaluate: %s\n", err.message); return -1; }
     return 0;
 }

@@ -207,7 +207,7 @@ static int run_plan(const cage_t *c, const ccn_options *o, outmesh *m) {
     m->pos = malloc(sizeof(double) * 3 * (size_t)m->nv);
     m->nrm = malloc(sizeof(double) * 3 * (size_t)m->nv);
     m->fv = malloc(sizeof(int32_t) * 4 * (size_t)m->nf);
-    ccn_limit_mesh out = {m->pos, m->nrm, m->fv, NULL, NULL};
+    ccn_limit_mesh out = {.positions = m->pos, .normals = m->nrm, .face_verts = m->fv};
     int rc = ccn_plan_evaluate(p, NULL, &out, &err) ? -1 : 0;
     ccn_plan_destroy(p);
     return rc;

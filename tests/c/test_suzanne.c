@@ -125,7 +125,7 @@ static void test_forehead(void) {
             ccn_plan_sizes(p, &s);
             double *x = malloc(sizeof(double) * 3 * s.num_verts), *n = malloc(sizeof(double) * 3 * s.num_verts);
             int32_t *q = malloc(sizeof(int32_t) * 4 * s.num_faces);
-            ccn_limit_mesh lm = {x, n, q, NULL, NULL};
+            ccn_limit_mesh lm = {.positions = x, .normals = n, .face_verts = q};
             CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
             jumps(x, n, q, s.num_faces, &J[L - 3][0][0], &J[L - 3][0][1]);
             fast_normals(x, q, s.num_verts, s.num_faces, n);
