@@ -194,7 +194,8 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         for (int32_t f = 0; f < cm->nf; f++) inv[f] = -1;
         for (int32_t f = 0; f < S->nf; f++) inv[fmap[f]] = f;
         ccn__level lv;
-        if ((st = ccn__level_prepare(&lv, S, v->scheme, v->pinned, v->crease_method, err))) goto done;
+        if ((st = ccn__level_prepare_ev(&lv, S, v->scheme, v->pinned, v->crease_method, v->ev_polyhedron,
+                                         v->ev_cache, err))) goto done;
         st = ccn__level_topology(&lv, &T, err);
         if (!st) ccn__level_points(&lv, T->pos);
         ccn__level_free(&lv);

@@ -64,11 +64,13 @@ ccn_status ccn__fill_level_create(const ccn__plan_view *v, const ccn_mesh *m, cc
     fl->child = malloc(sizeof(double) * 3 * ((size_t)m->nf + m->ne + m->nv + 1));
     fl->rw = ccn__ring_work_create();
     ccn_status st = !fl->child || !fl->rw ? ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)")
-                                          : ccn__level_prepare(&fl->lv, m, v->scheme, v->pinned, v->crease_method, err);
+                                          : ccn__level_prepare_ev(&fl->lv, m, v->scheme, v->pinned, v->crease_method,
+                                                                   v->ev_polyhedron, v->ev_cache, err);
     if (st) {
         ccn__fill_level_destroy(fl);
         return st;
     }
+    ccn__ring_work_set_ev(fl->rw, v->ev_polyhedron, v->ev_cache);
     fl->prepared = 1;
     *out = fl;
     return CCN_OK;
@@ -223,7 +225,7 @@ static ccn_status vertex_limit(ccn__fill_level *fl, int32_t w, double P[3], doub
     ccn_status st;
     fl->ring.nsec = 0;
     if (ccn__limit_kind(m, w, v->pinned) == CCN_LIMIT_EV) {
-        st = ccn__ev_limit(m, w, v->scheme, s, err);
+        st = ccn__ev_limit(m, w, v->scheme, v->ev_polyhedron, v->ev_cache, s, err);
     } else { /* stencils over w's child 1-ring */
         ccn__level_points_subset(&fl->lv, &w, 1, fl->child);
         st = ccn__child_limit_stencil(m, w, v->pinned, v->scheme, v->crease_method, fl->rw, s, &fl->ring, err);

@@ -143,6 +143,8 @@ void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v) {
     memcpy(v->centre, p->centre, sizeof v->centre);
     v->scale = p->scale;
     v->crease_method = p->opts.crease_method;
+    v->ev_polyhedron = p->opts.ev_polyhedron;
+    v->ev_cache = p->ev_cache;
 }
 
 /* ---- ccn_plan_patches ------------------------------------------------------------ */

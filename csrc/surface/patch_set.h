@@ -4,6 +4,7 @@
 #ifndef CCN_SURFACE_PATCH_SET_H
 #define CCN_SURFACE_PATCH_SET_H
 
+#include "rules/eigen_select.h"
 #include "topology/halfedge.h"
 
 enum {
@@ -50,6 +51,9 @@ typedef struct {
     int pinned;                /* boundary_corners == CCN_CORNERS_PINNED */
     double centre[3], scale;
     int32_t crease_method;     /* ccn_crease_method */
+    int32_t ev_polyhedron;     /* ccn_options.ev_polyhedron */
+    ccn__ev_cache *ev_cache;   /* the plan's eigen polyhedron choices (refinement and limits
+                                  elsewhere must make the plan's choice) */
 } ccn__plan_view;
 void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v);
 

@@ -76,6 +76,7 @@ struct ccn_plan {
     int32_t *bv_out, *bv_rf;
     double *bv_uv;
     ccn_sizes sizes;
+    ccn__ev_cache *ev_cache; /* eigen polyhedron choices, shared by every level and limit */
 };
 
 #endif

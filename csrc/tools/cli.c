@@ -198,6 +198,12 @@ int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_o
             else if (strcmp(val, "chaikin") == 0) o->crease_method = CCN_CREASE_CHAIKIN;
             else { fprintf(stderr, "ccnurbs: bad --crease-method '%s'\n", val); return 2; }
             i++;
+        } else if (strcmp(a, "--polyhedron") == 0 && val) {
+            if (ccn_cli_int(val, CCN_POLY_SELECT, CCN_POLY_COUNT, &o->ev_polyhedron)) {
+                fprintf(stderr, "ccnurbs: --polyhedron must be 0 (the per-vertex choice) .. %d\n", CCN_POLY_COUNT);
+                return 2;
+            }
+            i++;
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "ccnurbs: unknown or incomplete option '%s'\n", a);
             return 2;

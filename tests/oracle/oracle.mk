@@ -7,9 +7,10 @@ ORACLE_SAVED_GOAL := $(.DEFAULT_GOAL)
 ORACLE_CFLAGS      = -std=c11 -O2 -Wall -Wextra -Werror
 ORACLE_CXXFLAGS    = -std=c++14 -O2 -Wall -Wextra -Werror
 
-$(B)/osd_refine: tests/oracle/osd_refine.cpp
+OSD_REFINE_SRC = tests/oracle/osd_refine.cpp tests/oracle/osd_obj.cpp tests/oracle/osd_patch.cpp
+$(B)/osd_refine: $(OSD_REFINE_SRC) tests/oracle/osd_oracle.h
 	@mkdir -p $(@D)
-	$(CXX) $(ORACLE_CXXFLAGS) $< -o $@ -losdCPU
+	$(CXX) $(ORACLE_CXXFLAGS) $(OSD_REFINE_SRC) -o $@ -losdCPU
 
 $(B)/objdiff: tests/oracle/objdiff.c
 	@mkdir -p $(@D)
