@@ -78,7 +78,8 @@ class ccn_sizes(ctypes.Structure):
                 ("num_sharp_vertices", ctypes.c_int32),
                 ("num_sharp_corners", ctypes.c_int32),
                 ("num_ev_verified", ctypes.c_int32),
-                ("num_ev_outside_g1", ctypes.c_int32)]
+                ("num_ev_outside_g1", ctypes.c_int32),
+                ("num_caps_deferred", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):

@@ -180,6 +180,10 @@ typedef struct {
                                  (creases, corners): corner_normals differ from normals */
     int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 5) */
     int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
+    int32_t num_caps_deferred;/* cap EVs (bi-5) with no cap built because the output level is not
+                                 above the cap level (they would change no output sample); the
+                                 finite patch set (ccn_plan_patches, ccn_plan_export) needs them:
+                                 a plan one level finer builds them */
 } ccn_sizes;
 
 /* Caller-owned output buffers; sizes from ccn_plan_sizes. */
@@ -341,7 +345,9 @@ typedef struct {
  * plan has no patch (cap fallbacks, smooth boundary corners, boundary EVs) the exact pieces
  * of a deeper local refinement closed by fill faces, whose G1 deviation is measured. Faces
  * share their edges (one shell; closed cages: a solid). opts NULL = defaults; info may be
- * NULL. Nothing is written if the status is not CCN_OK before output starts. */
+ * NULL. Nothing is written if the status is not CCN_OK before output starts. A bi-5 plan
+ * whose caps were not built (ccn_sizes.num_caps_deferred > 0: output level not above the cap
+ * level) is CCN_ERR_ARGUMENT: create it with more levels. */
 ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_export_options *opts,
                            ccn_write_fn fn, void *user, ccn_export_info *info, ccn_error *err);
 

@@ -203,7 +203,10 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     if (count_evs(p->lev[1]) == 0) return CCN_OK;
     int32_t K = 2;
     for (; K <= 4; K++) {
-        if (K >= p->L) return CCN_OK; /* no cap level below the output level: nothing to do */
+        if (K >= p->L) { /* no cap level below the output level: nothing to do */
+            p->caps_deferred = count_evs(p->lev[1]);
+            return CCN_OK;
+        }
         ccn_status st = ccn__plan_build_levels(p, K, err);
         if (st) return st;
         const ccn_mesh *m = p->lev[K];

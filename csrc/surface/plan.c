@@ -96,6 +96,7 @@ static void fill_sizes(ccn_plan *p) {
     s->num_cage_verts = p->ncage;
     s->levels = p->L;
     s->refine_levels = p->R;
+    s->num_caps_deferred = p->caps_deferred;
     s->num_extraordinary = p->R >= 1 ? p->lev[1]->info.num_extraordinary : c->num_extraordinary;
     s->num_ev_fallbacks = r->num_ev_fallbacks;
     s->num_ring_conflicts = c->num_ring_conflicts;

@@ -27,6 +27,7 @@ struct ccn_plan {
     ccn_options opts;
     int threads;
     int32_t L, R, K;        /* output level, levels built (max(L, K)), cap level (-1: none) */
+    int32_t caps_deferred;  /* cap EVs left without caps because no cap level is below L */
     ccn_mesh **lev;         /* R+1 meshes: lev[0] is the cage */
     ccn__level *prep;       /* R prepared levels */
     /* level L+1, needed only around irregular vertices: either lev[L+1] (R > L) or computed

@@ -87,6 +87,25 @@ int ccn_cli_load_plan(const char *path, ccn_options *o, ccn_plan **plan) {
     return st ? ccn_cli_error(path, &err) : 0;
 }
 
+int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan) {
+    ccn_obj *obj = NULL;
+    ccn_cage cage;
+    int rc = load_cage(path, &obj, &cage);
+    if (rc) return rc;
+    resolve_options(obj, o);
+    ccn_error err;
+    ccn_status st = ccn_plan_create(&cage, o, plan, &err);
+    ccn_sizes sz;
+    while (!st && ccn_plan_sizes(*plan, &sz) == CCN_OK && sz.num_caps_deferred > 0 && sz.levels < 10) {
+        ccn_plan_destroy(*plan);
+        *plan = NULL;
+        o->levels = sz.levels + 1;
+        st = ccn_plan_create(&cage, o, plan, &err);
+    }
+    ccn_obj_destroy(obj);
+    return st ? ccn_cli_error(path, &err) : 0;
+}
+
 static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
     ccn_mesh_info in;
     ccn_mesh_info_get(m, &in);

@@ -18,6 +18,9 @@ int ccn_cli_load_mesh(const char *path, ccn_options *o, ccn_mesh **out);
 /* Parses an OBJ and creates a plan (options resolved as above); prints the error and returns
  * 2 on failure. */
 int ccn_cli_load_plan(const char *path, ccn_options *o, ccn_plan **plan);
+/* The same, for the finite patch set (patches, export): the output level o->levels is raised
+ * until the plan builds its bi-5 caps (none at levels not above the cap level, issue 14). */
+int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan);
 /* Writes a mesh as OBJ with "# knot", "# crease" and "# corner" lines to path via a temporary file and rename, so no
  * partial output is left behind on failure. Returns 0 on success. */
 int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header);

@@ -7,6 +7,8 @@
  *
  * --face-map FILE: per face "F index kind patch cells", then per cell "C cage_face sub u0 u1
  * v0 v1 s0 t0 s1 t1 s2 t2" (ccn_export_cell): where every face lies on the cage, for tests.
+ * --levels L: the plan's output level; raised until the plan builds its bi-5 caps (they exist
+ * only above the cap level; ccn_sizes.num_caps_deferred).
  * Output files are written to a temporary name and renamed: nothing is left on failure. */
 #include "cli.h"
 #include "commands.h"
@@ -84,7 +86,7 @@ int ccn_cmd_export(int argc, char **argv) {
             eo.format = CCN_EXPORT_IGES;
     }
     ccn_plan *plan = NULL;
-    if ((rc = ccn_cli_load_plan(in, &o, &plan))) return rc;
+    if ((rc = ccn_cli_load_plan_caps(in, &o, &plan))) return rc;
     char *tmp = tmp_name(out), *tmap = map ? tmp_name(map) : NULL;
     FILE *f = tmp ? fopen(tmp, "wb") : NULL, *fm = NULL;
     if (!f) { fprintf(stderr, "ccnurbs: cannot write %s\n", out); rc = 2; goto done; }

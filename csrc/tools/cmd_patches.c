@@ -1,5 +1,6 @@
 /* ccnurbs patches: the finite patch set in BezierView format (type 4 = tensor patch of
- * degree d: a line "4", a line "d", then (d+1)^2 points), for public viewers. */
+ * degree d: a line "4", a line "d", then (d+1)^2 points), for public viewers. The output
+ * level is raised until the bi-5 caps exist (issue 14: none at levels not above the cap level). */
 #include "cli.h"
 #include "commands.h"
 
@@ -23,7 +24,7 @@ int ccn_cmd_patches(int argc, char **argv) {
     int rc0 = ccn_cli_parse(argc, argv, 0, 0, &o, &in, &out);
     if (rc0) return rc0;
     ccn_plan *plan = NULL;
-    int rc = ccn_cli_load_plan(in, &o, &plan);
+    int rc = ccn_cli_load_plan_caps(in, &o, &plan);
     if (rc) return rc;
     ccn_sizes s;
     ccn_plan_sizes(plan, &s);
