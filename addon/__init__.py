@@ -19,7 +19,7 @@ bl_info = {
 
 _SUBMODULES = ("compat", "native", "cage", "props", "values", "knots", "modifier", "tap",
                "proxies", "sync", "hygiene", "overlay", "handlers", "objio", "operators", "errors",
-               "ui")
+               "cad_export", "ui")
 if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency order
     import importlib
     for _name in _SUBMODULES:
@@ -29,10 +29,10 @@ if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency ord
 import bpy  # noqa: E402
 
 from . import (compat, native, cage, props, values, knots, modifier, tap, proxies,  # noqa: E402
-               sync, hygiene, overlay, handlers, objio, operators, errors, ui)
+               sync, hygiene, overlay, handlers, objio, operators, errors, cad_export, ui)
 
 _classes = (props.classes + knots.classes + objio.classes + operators.classes + errors.classes
-            + ui.classes)
+            + cad_export.classes + ui.classes)
 
 
 def register():
@@ -42,11 +42,13 @@ def register():
     overlay.register()
     ui.register()
     objio.register()
+    cad_export.register_menu()
     handlers.register()
 
 
 def unregister():
     handlers.unregister()
+    cad_export.unregister_menu()
     objio.unregister()
     ui.unregister()
     overlay.unregister()

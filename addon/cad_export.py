@@ -5,11 +5,14 @@ STEP AP214 or IGES 5.3 through the library's ccn_plan_export: B-spline faces pac
 regular regions, the bi-5 caps at extraordinary points, one shell per cage (a solid when the
 cage is closed). Several selected cages: one file each (the object's name appended).
 
-Self-contained for the lead to wire in (this module is not registered by __init__.py yet):
-`classes`, `register()` (the operator and its File > Export menu entry), `unregister()`, and
-`export_objects()` / the operator `export_scene.ccnurbs_cad` for the CCNURBS panel. The ctypes
-binding of ccn_plan_export is the block below (structures mirror csrc/include/ccnurbs.h field
-by field, like native.py's); it loads the library through native.load().
+Registered by __init__.py: `classes` and `register_menu()` (the File > Export menu entry),
+`unregister()`; the CCNURBS modifier panel's "Export CAD" button calls the operator
+`export_scene.ccnurbs_cad` for its object only (`active_only`). The cage is what the modifier
+sees (the stack above it, read from its tap like the viewport; the object's own mesh when the
+tap is not in the depsgraph), with the modifier's settings: scheme, cap, boundary, Use Creases
+(edge and vertex creases as sharpness, as the modifier maps them). The ctypes binding of
+ccn_plan_export is the block below (structures mirror csrc/include/ccnurbs.h field by field,
+like native.py's); it loads the library through native.load().
 """
 import ctypes
 import os
@@ -65,7 +68,10 @@ class ccn_export_info(ctypes.Structure):
                 ("max_g1_deviation", ctypes.c_double),
                 ("max_fill_g1_deviation", ctypes.c_double),
                 ("size", ctypes.c_double),
-                ("bytes", ctypes.c_int64)]
+                ("bytes", ctypes.c_int64),
+                ("num_crease_edges", ctypes.c_int32),
+                ("min_crease_angle", ctypes.c_double),
+                ("max_crease_angle", ctypes.c_double)]
 
 
 _bound = []
@@ -131,7 +137,7 @@ def plan_export(plan, stream, fmt=EXPORT_STEP, packed=True, name="ccnurbs", fill
 def _settings(obj):
     s = getattr(obj, "ccnurbs", None)
     return (getattr(s, "scheme", "EIGEN"), getattr(s, "cap", "GUIDED_BI5"),
-            getattr(s, "boundary_smooth", "ALL"))
+            getattr(s, "boundary_smooth", "ALL"), bool(getattr(s, "use_creases", False)))
 
 
 def is_cage(obj):
@@ -139,24 +145,53 @@ def is_cage(obj):
     return obj is not None and obj.type == 'MESH' and getattr(s, "role", 'NONE') == 'CAGE'
 
 
-def _read_cage(obj):
-    """Positions (world or local), polygons, edges, knot intervals of a cage (edit mode too)."""
+def read_cages(objects, depsgraph=None):
+    """{name_full: Cage}: the cage each modifier sees (its tap in depsgraph: the stack above
+    it), read in one walk of the depsgraph (Blender 3.x iterates its instances once), else the
+    object's own mesh (edit mode too): positions (local), polygons, edges, intervals, creases."""
+    from . import cage, tap
+    found = {}
+    if depsgraph is not None:
+        try:
+            found = tap.read(depsgraph, objects)
+        except Exception:  # the tap is a matter of fidelity, never a reason to fail
+            found = {}
+    return {o.name_full: found.get(o.name_full) or cage.read(o) for o in objects}
+
+
+def make_plan(pos, c, scheme, cap, boundary, creases):
+    """A plan whose bi-5 caps exist: they are built only at output levels above the cap level
+    (ccn_sizes.num_caps_deferred), so the level is raised from 0 until none is deferred."""
+    sharp = cage_sharpness(c.edge_creases) if creases else None
+    vsharp = cage_sharpness(c.vertex_creases) if creases else None
+    levels = 0
+    while True:
+        plan = native.Plan(pos, c.face_sizes, c.face_verts, c.edge_verts, c.knots, scheme=scheme,
+                           cap=cap, boundary=boundary, levels=levels, edge_sharpness=sharp,
+                           vertex_sharpness=vsharp)
+        if plan.sizes.get("num_caps_deferred", 0) == 0 or plan.sizes["levels"] >= 6:
+            return plan
+        levels = plan.sizes["levels"] + 1
+        plan.close()
+
+
+def cage_sharpness(creases):
     from . import cage
-    return cage.read(obj)
+    return cage.sharpness(creases)
 
 
 def export_object(obj, path, fmt, packed=True, fill_levels=0, world=True, scale=1.0,
-                  progress=None):
-    """One cage to one file (written to a temporary name, then renamed). Returns the info."""
-    c = _read_cage(obj)
+                  progress=None, cage=None):
+    """One cage to one file (written to a temporary name, then renamed). cage: its Cage
+    (read_cages), None = the object's own mesh. Returns the info."""
+    c = cage if cage is not None else read_cages([obj])[obj.name_full]
     pos = c.positions
     if world:
         M = np.array(obj.matrix_world, dtype=np.float64)
         pos = pos @ M[:3, :3].T + M[:3, 3]
     pos = pos * float(scale)
-    scheme, cap, boundary = _settings(obj)
-    plan = native.Plan(pos, c.face_sizes, c.face_verts, c.edge_verts, c.knots, scheme=scheme,
-                       cap=cap, boundary=boundary, levels=0)
+    scheme, cap, boundary, creases = _settings(obj)
+    plan = make_plan(pos, c, scheme, cap, boundary, creases)
     tmp = path + ".tmp%d" % os.getpid()
     try:
         with open(tmp, "wb") as f:
@@ -170,7 +205,7 @@ def export_object(obj, path, fmt, packed=True, fill_levels=0, world=True, scale=
 
 
 def export_objects(objects, path, fmt=None, packed=True, fill_levels=0, world=True, scale=1.0,
-                   wm=None):
+                   wm=None, depsgraph=None):
     """Every cage of `objects`: one file at path (one cage) or path_<name> (several). fmt None:
     from the extension. Progress on wm (a WindowManager) when given. Returns [(path, info)]."""
     cages = [o for o in objects if is_cage(o)]
@@ -180,6 +215,7 @@ def export_objects(objects, path, fmt=None, packed=True, fill_levels=0, world=Tr
     if fmt is None:
         fmt = EXPORT_IGES if ext.lower() in (".igs", ".iges") else EXPORT_STEP
     out = []
+    read = read_cages(cages, depsgraph)
     if wm is not None:
         wm.progress_begin(0, 1000)
     try:
@@ -190,7 +226,8 @@ def export_objects(objects, path, fmt=None, packed=True, fill_levels=0, world=Tr
                 if wm is not None:
                     wm.progress_update(int(1000 * (i + x) / len(cages)))
 
-            out.append((p, export_object(obj, p, fmt, packed, fill_levels, world, scale, prog)))
+            out.append((p, export_object(obj, p, fmt, packed, fill_levels, world, scale, prog,
+                                         read[obj.name_full])))
     finally:
         if wm is not None:
             wm.progress_end()
@@ -205,7 +242,9 @@ def summary(info):
                                info["bytes"] / 1e6, info["max_g1_deviation"],
                                (", %d fills (G1 %.1e rad)" % (info["num_fills"],
                                                              info["max_fill_g1_deviation"])
-                                if info["num_fills"] else "")))
+                                if info["num_fills"] else "")
+                               + (", %d crease edges (C0)" % info["num_crease_edges"]
+                                  if info["num_crease_edges"] else "")))
 
 
 # ---- operator and menu ---------------------------------------------------------------------
@@ -236,10 +275,19 @@ class EXPORT_SCENE_OT_ccnurbs_cad(bpy.types.Operator, ExportHelper):
                                   description="World coordinates (object transform applied)")
     scale: FloatProperty(name="Scale", default=1000.0, min=1e-9, soft_max=1e6, description=""
                          "Millimetres per Blender unit (CAD files are in millimetres)")
+    active_only: BoolProperty(name="Active Object Only", default=False, options={'HIDDEN'},
+                              description="Export only the active object (the panel's button)")
 
     @classmethod
     def poll(cls, context):
         return any(is_cage(o) for o in context.scene.objects)
+
+    def draw(self, context):
+        layout = self.layout
+        for name in ("file_format", "packed", "fill_levels", "apply_transform", "scale"):
+            layout.prop(self, name)
+        if not self.active_only:
+            layout.prop(self, "use_selection")
 
     def invoke(self, context, event):
         self.scale = _default_scale(context)
@@ -256,18 +304,25 @@ class EXPORT_SCENE_OT_ccnurbs_cad(bpy.types.Operator, ExportHelper):
         return True
 
     def execute(self, context):
-        objs = context.selected_objects if self.use_selection else context.scene.objects
+        if self.active_only:
+            objs = [context.object] if context.object is not None else []
+        else:
+            objs = context.selected_objects if self.use_selection else context.scene.objects
         ext = os.path.splitext(self.filepath)[1].lower()
         fmt = (EXPORT_IGES if ext in (".igs", ".iges") else EXPORT_STEP if ext in (".step", ".stp")
                else EXPORT_IGES if self.file_format == 'IGES' else EXPORT_STEP)
         try:
             done = export_objects(objs, self.filepath, fmt, self.packed, self.fill_levels,
-                                  self.apply_transform, self.scale, context.window_manager)
+                                  self.apply_transform, self.scale, context.window_manager,
+                                  context.evaluated_depsgraph_get())
         except native.CCNError as e:
             self.report({'ERROR'}, "CCNURBS export: %s" % e)
             return {'CANCELLED'}
         except OSError as e:
             self.report({'ERROR'}, "CCNURBS export: %s" % e)
+            return {'CANCELLED'}
+        except Exception as e:  # never a silent failure: the report is the user's only view
+            self.report({'ERROR'}, "CCNURBS export failed: %s: %s" % (type(e).__name__, e))
             return {'CANCELLED'}
         for p, info in done:
             self.report({'INFO'}, "%s: %s" % (os.path.basename(p), summary(info)))
@@ -282,13 +337,22 @@ def menu_export(self, context):
 classes = (EXPORT_SCENE_OT_ccnurbs_cad,)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
+def register_menu():
     bpy.types.TOPBAR_MT_file_export.append(menu_export)
 
 
-def unregister():
+def unregister_menu():
     bpy.types.TOPBAR_MT_file_export.remove(menu_export)
+
+
+def register():
+    """Stand-alone registration (the add-on registers `classes` and the menu itself)."""
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    register_menu()
+
+
+def unregister():
+    unregister_menu()
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

@@ -185,6 +185,8 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
             col = layout.column()
             col.alert = True
             col.label(text="Render levels: " + rst.error, icon='ERROR')
+        op = layout.operator("export_scene.ccnurbs_cad", text="Export CAD", icon='EXPORT')
+        op.active_only = True
         layout.operator("object.ccnurbs_remove", icon='X')
 
 
