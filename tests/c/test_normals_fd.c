@@ -215,15 +215,23 @@ static int run_plan(const cage_t *c, const ccn_options *o, outmesh *m) {
 
 static void free_out(outmesh *m) { free(m->pos); free(m->nrm); free(m->fv); }
 
-/* Index of cage-level-L vertex v at level Lf (vertex points keep their vertex). */
-static int32_t descend(const cage_t *c, int32_t v, int L, int Lf) {
-    int64_t nf = c->nf, ne = c->ne, nfv = corner_start(c, c->nf);
-    for (int l = 0; l < Lf; l++) {
-        if (l >= L) v = (int32_t)(nf + ne + v);
-        int64_t nf2 = l == 0 ? nfv : 4 * nf, ne2 = 2 * ne + (l == 0 ? nfv : 4 * nf);
-        nf = nf2, ne = ne2;
-    }
-    return v;
+/* The output vertex of the level-Lf plan at corner j of output face f of the level-L plan, by
+ * face descent, independent of how the library numbers output vertices (first use by the output
+ * faces, which are in the refinement's quadtree order): the child quad at corner j of a face is
+ * that corner's half-edge (level 0: corner_start(f) + j, above: 4 f + j), and its corner 0 is the
+ * parent's corner j. */
+static int32_t fine_vertex(const cage_t *c, const outmesh *fine, int32_t f, int j, int L, int Lf) {
+    int64_t F = f;
+    for (int l = L; l < Lf; l++, j = 0) F = (l == 0 ? corner_start(c, (int32_t)F) : 4 * F) + j;
+    return fine->fv[4 * F + j];
+}
+
+/* A (face, corner) of each output vertex: its first use. */
+static int32_t *first_use(const outmesh *m) {
+    int32_t *fc = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    for (int32_t v = 0; v < m->nv; v++) fc[v] = -1;
+    for (int32_t k = 4 * m->nf - 1; k >= 0; k--) fc[m->fv[k]] = k;
+    return fc;
 }
 
 /* Sum of the diagonal cross products of the faces around every vertex (oriented by them). */
@@ -291,10 +299,11 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
     o.levels = L;
     if (run_plan(c, &o, &m)) { CHECK(0, "%s L%d plan", what, L); return; }
     double *am = face_normals(&m), pos_err = 0;
+    int32_t *fc = first_use(&m);
     for (int32_t v = 0; v < m.nv; v++) {
         double n[NFINE][3];
         for (int i = 0; i < NFINE; i++) {
-            int32_t w = descend(c, v, L, fs->Lf + i);
+            int32_t w = fine_vertex(c, &fs->m[i], fc[v] / 4, fc[v] % 4, L, fs->Lf + i);
             memcpy(n[i], fs->acc[i] + 3 * w, sizeof n[i]);
             unit(n[i]);
             if (i == NFINE - 1)
@@ -303,7 +312,7 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
         double d1 = angle(n[0], n[1]), d2 = angle(n[1], n[2]);
         double r = d1 > 1e-14 ? d2 / d1 : 0.5;
         if (r < 0.5) r = 0.5; /* a face normal converges O(h) at best where the surface is only C1 */
-        int32_t w2 = descend(c, v, L, fs->Lf + NFINE - 1);
+        int32_t w2 = fine_vertex(c, &fs->m[NFINE - 1], fc[v] / 4, fc[v] % 4, L, fs->Lf + NFINE - 1);
         int faces = (int)fs->acc[NFINE - 1][3 * (size_t)fs->m[NFINE - 1].nv + w2];
         if (faces != 2 && faces != 4) r = fmax(r, 0.9); /* EVs, corners: see above */
         if (r > 0.95) r = 0.95, st->slow++;
@@ -321,6 +330,7 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
     }
     CHECK(pos_err <= 1e-9, "%s L%d: positions differ from the fine plan's by %g (mapping)", what, L, pos_err);
     free(am);
+    free(fc);
     free_out(&m);
 }
 
@@ -413,14 +423,18 @@ static void test_corners(void) {
             outmesh m;
             o.levels = 1;
             if (run_plan(c, &o, &m)) { CHECK(0, "plan"); continue; }
-            int32_t v1 = descend(c, cv, 0, 1);
+            int32_t cf = -1, cj = 0; /* a face and corner of cage vertex cv */
+            for (int32_t g = 0, k = 0; g < c->nf && cf < 0; k += c->fsize[g++])
+                for (int j = 0; j < c->fsize[g]; j++)
+                    if (c->fverts[k + j] == cv) cf = g, cj = j;
+            int32_t v1 = fine_vertex(c, &m, cf, cj, 0, 1);
             double prev = 10, last = 10;
             int mono = 1;
             for (int Lf = 6; Lf <= 9; Lf++) {
                 outmesh f;
                 o.levels = Lf;
                 if (run_plan(c, &o, &f)) { CHECK(0, "plan"); break; }
-                int32_t w = descend(c, cv, 0, Lf), nb = -1;
+                int32_t w = fine_vertex(c, &f, cf, cj, 0, Lf), nb = -1;
                 for (int32_t q = 0; q < f.nf && nb < 0; q++)
                     for (int j = 0; j < 4; j++)
                         if (f.fv[4 * q + j] == w) {
