@@ -89,7 +89,7 @@ class TestFileHygiene(AddonTestCase):
                                  got["objects"])
 
     def test_apply_file_size_like_subsurf(self):
-        sizes = {}
+        sizes, raws = {}, {}
         for kind in ("SUBSURF", "CCNURBS"):
             reset_scene()
             ob = grid(16, "Apply" + kind)
@@ -103,10 +103,24 @@ class TestFileHygiene(AddonTestCase):
             update()
             bpy.ops.object.modifier_apply(modifier=m.name)
             sizes[kind] = os.path.getsize(save("apply_" + kind))
+            if bpy.app.version >= (5, 0, 0):  # saves compressed: also the uncompressed size
+                raw = os.path.join(TMP, "apply_raw_" + kind + ".blend")
+                bpy.ops.wm.save_as_mainfile(filepath=raw, copy=True, compress=False)
+                raws[kind] = os.path.getsize(raw)
             n = len(ob.data.vertices)
         print("measure apply-file: Subsurf %d bytes, CCNURBS %d bytes (%.3f), %d vertices"
               % (sizes["SUBSURF"], sizes["CCNURBS"], sizes["CCNURBS"] / sizes["SUBSURF"], n))
-        self.assertLessEqual(sizes["CCNURBS"], 1.10 * sizes["SUBSURF"])
+        if raws:
+            # Blender 5.0's compressed size of the same file varies between runs (measured on
+            # this cage: Subsurf 178.7k-180.6k, CCNURBS 180.7k-199.0k under load, the content
+            # being identical: uncompressed 749,278 / 749,630 bytes in every run), so the
+            # content is asserted uncompressed and the compressed file with a margin
+            print("measure apply-file uncompressed: Subsurf %d bytes, CCNURBS %d bytes (%.4f)"
+                  % (raws["SUBSURF"], raws["CCNURBS"], raws["CCNURBS"] / raws["SUBSURF"]))
+            self.assertLessEqual(raws["CCNURBS"], 1.10 * raws["SUBSURF"])
+            self.assertLessEqual(sizes["CCNURBS"], 1.25 * sizes["SUBSURF"])
+        else:
+            self.assertLessEqual(sizes["CCNURBS"], 1.10 * sizes["SUBSURF"])
 
     def test_rename_keeps_proxies_and_status(self):
         ob = add_modifier(grid(3, "Old"))

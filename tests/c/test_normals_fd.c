@@ -6,10 +6,8 @@
  * orientation of the cage's faces. Plus the two concrete cases of item 3 (a closed cylinder
  * with n-gon caps and a valence-3 star fan, scheme NURSS).
  *
- * The oracle: vertex v of level L is the vertex point of v at every finer level, found through
- * the faces (each level's faces are its parents' sub-quads in corner order, a sub-quad's corner 0
- * is its parent corner's vertex point; the output's vertices are numbered in first-use order),
- * so the fine plan samples the same surface point; its
+ * The oracle: vertex v of level L is the vertex point of v at every finer level (index
+ * nf_l + ne_l + v, ccnurbs.h's numbering), so the fine plan samples the same surface point; its
  * fine faces around that point give the finite-difference normal (sum of the faces' diagonal
  * cross products, oriented by the faces). The positions must agree too (a check of the mapping).
  * The finite difference converges O(h) at boundaries and EVs, so it is taken at two fine levels
@@ -217,22 +215,22 @@ static int run_plan(const cage_t *c, const ccn_options *o, outmesh *m) {
 
 static void free_out(outmesh *m) { free(m->pos); free(m->nrm); free(m->fv); }
 
-/* The level-Lf face (Lf > L) whose corner 0 is the vertex point of corner j of level-L face f:
- * sub-quad j of f (level 0: the cage face's corners are numbered by corner_start), then
- * sub-quad 0 down to Lf. */
-static int64_t descend_face(const cage_t *c, int64_t f, int j, int L, int Lf) {
-    int64_t F = L == 0 ? corner_start(c, (int32_t)f) + j : 4 * f + j;
-    for (int l = L + 1; l < Lf; l++) F *= 4;
-    return F;
+/* The output vertex of the level-Lf plan at corner j of output face f of the level-L plan, by
+ * face descent, independent of how the library numbers output vertices (first use by the output
+ * faces, which are in the refinement's quadtree order): the child quad at corner j of a face is
+ * that corner's half-edge (level 0: corner_start(f) + j, above: 4 f + j), and its corner 0 is the
+ * parent's corner j. */
+static int32_t fine_vertex(const cage_t *c, const outmesh *fine, int32_t f, int j, int L, int Lf) {
+    int64_t F = f;
+    for (int l = L; l < Lf; l++, j = 0) F = (l == 0 ? corner_start(c, (int32_t)F) : 4 * F) + j;
+    return fine->fv[4 * F + j];
 }
 
-/* For every vertex of an output mesh, one (face, corner) using it: fc[2v], fc[2v+1]. */
-static int32_t *vertex_corners(const outmesh *m) {
-    int32_t *fc = malloc(sizeof(int32_t) * 2 * (size_t)m->nv);
-    for (int32_t v = 0; v < 2 * m->nv; v++) fc[v] = -1;
-    for (int32_t f = 0; f < m->nf; f++)
-        for (int j = 0; j < 4; j++)
-            if (fc[2 * m->fv[4 * f + j]] < 0) { fc[2 * m->fv[4 * f + j]] = f; fc[2 * m->fv[4 * f + j] + 1] = j; }
+/* A (face, corner) of each output vertex: its first use. */
+static int32_t *first_use(const outmesh *m) {
+    int32_t *fc = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    for (int32_t v = 0; v < m->nv; v++) fc[v] = -1;
+    for (int32_t k = 4 * m->nf - 1; k >= 0; k--) fc[m->fv[k]] = k;
     return fc;
 }
 
@@ -301,14 +299,11 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
     o.levels = L;
     if (run_plan(c, &o, &m)) { CHECK(0, "%s L%d plan", what, L); return; }
     double *am = face_normals(&m), pos_err = 0;
-    int32_t *fc = vertex_corners(&m);
+    int32_t *fc = first_use(&m);
     for (int32_t v = 0; v < m.nv; v++) {
         double n[NFINE][3];
-        int32_t wf[NFINE];
-        for (int i = 0; i < NFINE; i++)
-            wf[i] = fs->m[i].fv[4 * descend_face(c, fc[2 * v], fc[2 * v + 1], L, fs->Lf + i)];
         for (int i = 0; i < NFINE; i++) {
-            int32_t w = wf[i];
+            int32_t w = fine_vertex(c, &fs->m[i], fc[v] / 4, fc[v] % 4, L, fs->Lf + i);
             memcpy(n[i], fs->acc[i] + 3 * w, sizeof n[i]);
             unit(n[i]);
             if (i == NFINE - 1)
@@ -317,7 +312,7 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
         double d1 = angle(n[0], n[1]), d2 = angle(n[1], n[2]);
         double r = d1 > 1e-14 ? d2 / d1 : 0.5;
         if (r < 0.5) r = 0.5; /* a face normal converges O(h) at best where the surface is only C1 */
-        int32_t w2 = wf[NFINE - 1];
+        int32_t w2 = fine_vertex(c, &fs->m[NFINE - 1], fc[v] / 4, fc[v] % 4, L, fs->Lf + NFINE - 1);
         int faces = (int)fs->acc[NFINE - 1][3 * (size_t)fs->m[NFINE - 1].nv + w2];
         if (faces != 2 && faces != 4) r = fmax(r, 0.9); /* EVs, corners: see above */
         if (r > 0.95) r = 0.95, st->slow++;
@@ -334,8 +329,8 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
         CHECK(angle(m.nrm + 3 * v, am + 3 * v) < PI / 2, "%s L%d vertex %d: against the faces", what, L, v);
     }
     CHECK(pos_err <= 1e-9, "%s L%d: positions differ from the fine plan's by %g (mapping)", what, L, pos_err);
-    free(fc);
     free(am);
+    free(fc);
     free_out(&m);
 }
 
@@ -428,18 +423,18 @@ static void test_corners(void) {
             outmesh m;
             o.levels = 1;
             if (run_plan(c, &o, &m)) { CHECK(0, "plan"); continue; }
-            int32_t cf = -1, cj = 0; /* a cage face and corner at cv */
-            for (int32_t g = 0; g < c->nf && cf < 0; g++)
+            int32_t cf = -1, cj = 0; /* a face and corner of cage vertex cv */
+            for (int32_t g = 0, k = 0; g < c->nf && cf < 0; k += c->fsize[g++])
                 for (int j = 0; j < c->fsize[g]; j++)
-                    if (c->fverts[corner_start(c, g) + j] == cv) { cf = g; cj = j; break; }
-            int32_t v1 = m.fv[4 * descend_face(c, cf, cj, 0, 1)];
+                    if (c->fverts[k + j] == cv) cf = g, cj = j;
+            int32_t v1 = fine_vertex(c, &m, cf, cj, 0, 1);
             double prev = 10, last = 10;
             int mono = 1;
             for (int Lf = 6; Lf <= 9; Lf++) {
                 outmesh f;
                 o.levels = Lf;
                 if (run_plan(c, &o, &f)) { CHECK(0, "plan"); break; }
-                int32_t w = f.fv[4 * descend_face(c, cf, cj, 0, Lf)], nb = -1;
+                int32_t w = fine_vertex(c, &f, cf, cj, 0, Lf), nb = -1;
                 for (int32_t q = 0; q < f.nf && nb < 0; q++)
                     for (int j = 0; j < 4; j++)
                         if (f.fv[4 * q + j] == w) {
