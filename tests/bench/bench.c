@@ -7,6 +7,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <sys/resource.h>
+
 static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -27,12 +29,13 @@ static char *slurp(const char *path, size_t *len) {
 }
 
 int main(int argc, char **argv) {
-    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron]\n"); return 2; }
+    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron] [threads]\n"); return 2; }
     int levels = atoi(argv[2]), reps = argc > 4 ? atoi(argv[4]) : 5;
     ccn_options o = {0};
     o.levels = levels;
     o.ev_polyhedron = argc > 5 ? atoi(argv[5]) : CCN_POLY_SELECT;
     o.cap = argc > 3 && strcmp(argv[3], "refine") == 0 ? CCN_CAP_REFINE : CCN_CAP_GUIDED_BI5;
+    o.threads = argc > 6 ? atoi(argv[6]) : 0;
     size_t len;
     char *text = slurp(argv[1], &len);
     ccn_obj *obj;
@@ -62,6 +65,8 @@ int main(int argc, char **argv) {
         double t1 = now() - t0;
         teval = t1 < teval ? t1 : teval;
     }
+    struct rusage ru; /* one plan alive at a time so far: its peak, with the cage and outputs */
+    getrusage(RUSAGE_SELF, &ru);
     double tref = 1e30;
     ccn_mesh *cm = NULL;
     if (ccn_mesh_create(&cage, &cm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
@@ -75,9 +80,9 @@ int main(int argc, char **argv) {
     }
     ccn_mesh_destroy(cm);
     printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s; "
-           "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d\n",
+           "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d; peak RSS %ld kB\n",
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,
-           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1);
+           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1, ru.ru_maxrss);
     ccn_plan_destroy(plan);
     ccn_obj_destroy(obj);
     free(text); free(pos); free(nrm); free(cp);
