@@ -77,18 +77,17 @@ for cage in $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj
 done
 # ---- Blender: the modifier vs Subdivision Surface ----------------------------------------------
 [ "${BENCH_BLENDER:-1}" = 0 ] && exit 0
-blender_rows() { # label out: the target rows from bench_blender.py's lines
+blender_rows() { # label target-for-position-updates log: the target rows from bench_blender.py
   pos_t=$2; grep '^bench' "$3" | sed 's/^/  /'
   grep '^bench .* exact normals' "$3" | while read -r line; do
     what=$(echo "$line" | sed 's/^bench \([^ ]* L[0-9]\).*/\1/')
-    pr=$(echo "$line" | sed -n 's/.* pos [0-9.]* s (\([0-9.]*\)x).*/\1/p')
-    er=$(echo "$line" | sed -n 's/.* edit [0-9.]* s (\([0-9.]*\)x).*/\1/p')
-    ir=$(echo "$line" | sed -n 's/.* interval [0-9.]* s (\([0-9.]*\)x.*/\1/p')
-    tr_=$(echo "$line" | sed -n 's/.* topo [0-9.]* s (\([0-9.]*\)x).*/\1/p')
-    row "position update, Object Mode, $what, Blender $1" "-" "Subsurf" "$pr" "$pos_t"
-    row "position update, Edit Mode, $what, Blender $1" "-" "Subsurf" "$er" "$pos_t"
-    row "interval edit, $what, Blender $1" "-" "Subsurf topology change" "$ir" 1.0
-    [ "$pos_t" = 0.5 ] && row "topology edit, $what, Blender $1" "-" "Subsurf" "$tr_" 1.5
+    sub=$(grep "^bench $what (.*subsurf pos" "$3" | head -n 1)
+    get() { echo "$1" | sed -n "s/.* $2 \([0-9.]*\) s.*/\1/p"; }
+    gr() { echo "$line" | sed -n "s/.* $1 [0-9.]* s (\([0-9.]*\)x.*/\1/p"; }
+    row "position update, Object Mode, $what, Blender $1" "$(get "$line" pos) s" "$(get "$sub" pos) s" "$(gr pos)" "$pos_t"
+    row "position update, Edit Mode, $what, Blender $1" "$(get "$line" edit) s" "$(get "$sub" edit) s" "$(gr edit)" "$pos_t"
+    row "interval edit, $what, Blender $1" "$(get "$line" interval) s" "$(get "$sub" topo) s (Subsurf topology change)" "$(gr interval)" 1.0
+    [ "$pos_t" = 0.5 ] && row "topology edit, $what, Blender $1" "$(get "$line" topo) s" "$(get "$sub" topo) s" "$(gr topo)" 1.5
   done
 }
 tmp=$(mktemp -d) || exit 2

@@ -27,7 +27,7 @@ import cagelib  # noqa: E402
 ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
 BENCH = os.path.abspath(ARGS[0] if ARGS else "build/bench")
 ZIP = os.path.abspath(ARGS[1] if len(ARGS) > 1 else "build/ccnurbs.zip")
-REPS = 5
+REPS = 3
 
 
 def update():
