@@ -54,23 +54,41 @@ static double bern_deriv(int32_t d, int32_t k, double t, int32_t order) {
 
 #define F5_ROWS (6 * 36 * 2)
 
-/* Weighted samples whose squared sum is F_5(tau) = int sum_{i+j=5} C(5,i) |d_u^i d_v^j tau|^2
- * (6x6 Gauss-Legendre, exact for these degrees). */
-static void f5_vec(const double complex *t, double out[F5_ROWS]) {
+/* The 6x6 Gauss-Legendre rule on [0,1]^2 of f5_vec, tabulated once per tau solve (f5_vec runs
+ * 30 + ns times on the same nodes): D[a][p][k] = d^a/dx^a B^5_k at node p, and the row weights
+ * sqrt(C(5,i) w_pa w_pb). Computed by the same expressions as before tabulation, so F_5 is
+ * bit-identical (issue 15: the pow calls were 76 % of a non-uniform plan). */
+typedef struct {
+    double D[6][6][6];
+    double sw[6][6][6];
+} f5_table;
+
+static void f5_table_init(f5_table *T) {
     static const double gx[6] = {-0.9324695142031521, -0.6612093864662645, -0.2386191860831969,
                                  0.2386191860831969, 0.6612093864662645, 0.9324695142031521};
     static const double gw[6] = {0.1713244923791704, 0.3607615730481386, 0.4679139345726910,
                                  0.4679139345726910, 0.3607615730481386, 0.1713244923791704};
+    for (int32_t a = 0; a <= 5; a++)
+        for (int32_t p = 0; p < 6; p++)
+            for (int32_t k = 0; k < 6; k++) T->D[a][p][k] = bern_deriv(5, k, 0.5 * (gx[p] + 1), a);
+    for (int32_t i = 0; i <= 5; i++)
+        for (int32_t pa = 0; pa < 6; pa++)
+            for (int32_t pb = 0; pb < 6; pb++)
+                T->sw[i][pa][pb] = sqrt(ccn__bi5_binom(5, i) * (0.25 * gw[pa] * gw[pb]));
+}
+
+/* Weighted samples whose squared sum is F_5(tau) = int sum_{i+j=5} C(5,i) |d_u^i d_v^j tau|^2
+ * (6x6 Gauss-Legendre, exact for these degrees). */
+static void f5_vec(const f5_table *T, const double complex *t, double out[F5_ROWS]) {
     int32_t r = 0;
     for (int32_t i = 0; i <= 5; i++)
         for (int32_t pa = 0; pa < 6; pa++)
             for (int32_t pb = 0; pb < 6; pb++) {
-                double x = 0.5 * (gx[pa] + 1), y = 0.5 * (gx[pb] + 1), w = 0.25 * gw[pa] * gw[pb];
+                const double *bu = T->D[i][pa], *bv = T->D[5 - i][pb];
                 double complex acc = 0;
                 for (int32_t k = 0; k < 6; k++)
-                    for (int32_t l = 0; l < 6; l++)
-                        acc += bern_deriv(5, k, x, i) * bern_deriv(5, l, y, 5 - i) * t[k * 6 + l];
-                acc *= sqrt(ccn__bi5_binom(5, i) * w);
+                    for (int32_t l = 0; l < 6; l++) acc += bu[k] * bv[l] * t[k * 6 + l];
+                acc *= T->sw[i][pa][pb];
                 out[r++] = creal(acc);
                 out[r++] = cimag(acc);
             }
@@ -265,16 +283,18 @@ static ccn_status tau_solve(const tau_problem *P, double complex *t, ccn_error *
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (tau)");
         goto done;
     }
+    f5_table T5;
+    f5_table_init(&T5);
     tau_make(P->ns, P->green, y, t); /* affine maps: value at 0, then unit columns */
     tau_cons(P, t, b);
-    for (int32_t s = 0; s < P->ns; s++) f5_vec(t + s * 36, f0 + (size_t)s * F5_ROWS);
+    for (int32_t s = 0; s < P->ns; s++) f5_vec(&T5, t + s * 36, f0 + (size_t)s * F5_ROWS);
     for (int32_t q = 0; q < ny; q++) {
         y[q] = 1.0;
         tau_make(P->ns, P->green, y, t);
         tau_cons(P, t, r);
         for (int32_t k = 0; k < na; k++) A[(size_t)q * na + k] = r[k] - b[k];
         if (q < 30) { /* the energy's linear part is the same for every sector */
-            f5_vec(t, F0 + (size_t)q * F5_ROWS);
+            f5_vec(&T5, t, F0 + (size_t)q * F5_ROWS);
             for (int32_t k = 0; k < F5_ROWS; k++) F0[(size_t)q * F5_ROWS + k] -= f0[k];
         }
         y[q] = 0.0;

@@ -10,6 +10,7 @@
 #include "rules/bspline.h"
 #include "rules/crease.h"
 #include "surface/limit.h"
+#include "surface/op_cache.h"
 #include "surface/patches.h"
 #include "surface/plan_levels.h"
 #include "surface/surround.h"
@@ -96,7 +97,8 @@ static void cap_cnet(const ccn_mesh *m, int32_t ev, int32_t n, int32_t *cnet) {
 }
 
 /* The operator for valence n: the paper's ring speeds, or (exact_surround) a first ring of
- * speed 1/2 in front of them (bi5.h [R13]). Shared by the caps of the plan. */
+ * speed 1/2 in front of them (bi5.h [R13]). Shared by the caps of the plan, or by every plan
+ * of the caller's ccn_cache. */
 static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround, ccn_error *err) {
     int32_t key = exact_surround ? -n : n;
     for (int32_t i = 0; i < p->nops; i++)
@@ -105,6 +107,7 @@ static const struct ccn__bi5 *cap_op(ccn_plan *p, int32_t n, int exact_surround,
     static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
     const double *sig = exact_surround ? (n == 3 ? h3 : h5) : (n == 3 ? s3 : s5);
     int32_t nsig = (n == 3 ? 1 : 3) + (exact_surround ? 1 : 0);
+    if (p->op_cache) return ccn__cache_op(p->op_cache, key, n, sig, nsig, err); /* shared */
     struct ccn__bi5 **ops = realloc(p->ops, sizeof(*ops) * ((size_t)p->nops + 1));
     if (ops) p->ops = ops;
     int32_t *op_n = realloc(p->op_n, sizeof(int32_t) * ((size_t)p->nops + 1));

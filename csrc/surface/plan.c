@@ -113,6 +113,11 @@ static void fill_sizes(ccn_plan *p) {
 
 ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
                            ccn_error *err) {
+    return ccn_plan_create_cached(cage, opts, NULL, out, err);
+}
+
+ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
+                                  ccn_plan **out, ccn_error *err) {
     ccn__ok(err);
     if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
     *out = NULL;
@@ -123,6 +128,7 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     ccn_plan *p = calloc(1, sizeof *p);
     if (!p) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     p->opts = o;
+    p->op_cache = cache;
     p->threads = ccn__thread_count(o.threads);
     p->lev = calloc(1, sizeof(ccn_mesh *));
     p->ev_cache = ccn__ev_cache_create();

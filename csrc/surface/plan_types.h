@@ -15,7 +15,7 @@ typedef struct {
     int32_t *ring;      /* 2n+1 level-K 1-ring (centre stencil support) */
     double *l0;         /* 2n+1 limit weights (centre point) */
     double *knots;      /* n spoke intervals at level K */
-    const struct ccn__bi5 *op; /* shared per valence, owned by the plan */
+    const struct ccn__bi5 *op; /* shared per valence, owned by the plan or its ccn_cache */
     double *patches;    /* (3*nsig+1)*n bi-5 patches, 36*3 doubles each */
     int exact_surround; /* 1: arbitrary NU intervals, border = level-(K+1) pieces (bi5.h [R13]) */
     double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
@@ -78,6 +78,8 @@ struct ccn_plan {
     double *bv_uv;
     ccn_sizes sizes;
     ccn__ev_cache *ev_cache; /* eigen polyhedron choices, shared by every level and limit */
+    ccn_cache *op_cache;     /* the caller's bi-5 operators (ccn_plan_create_cached), or NULL:
+                                then ops holds the plan's own */
 };
 
 #endif

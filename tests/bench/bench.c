@@ -7,6 +7,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <sys/resource.h>
+
 static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -27,12 +29,13 @@ static char *slurp(const char *path, size_t *len) {
 }
 
 int main(int argc, char **argv) {
-    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron]\n"); return 2; }
+    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron] [threads] [cached]\n"); return 2; }
     int levels = atoi(argv[2]), reps = argc > 4 ? atoi(argv[4]) : 5;
     ccn_options o = {0};
     o.levels = levels;
     o.ev_polyhedron = argc > 5 ? atoi(argv[5]) : CCN_POLY_SELECT;
     o.cap = argc > 3 && strcmp(argv[3], "refine") == 0 ? CCN_CAP_REFINE : CCN_CAP_GUIDED_BI5;
+    o.threads = argc > 6 ? atoi(argv[6]) : 0;
     size_t len;
     char *text = slurp(argv[1], &len);
     ccn_obj *obj;
@@ -40,12 +43,15 @@ int main(int argc, char **argv) {
     if (!text || ccn_obj_parse(text, len, &obj, &err)) { fprintf(stderr, "cannot read %s\n", argv[1]); return 2; }
     ccn_cage cage;
     ccn_obj_cage(obj, &cage);
-    double tplan = 1e30, teval = 1e30;
+    double tplan = 1e30, teval = 1e30, tfirst = 0;
     ccn_plan *plan = NULL;
+    ccn_cache *cache = NULL; /* "cached": one ccn_cache for every plan (a session's rebuilds) */
+    if (argc > 7 && strcmp(argv[7], "cached") == 0 && ccn_cache_create(&cache, &err)) return 2;
     for (int r = 0; r < reps; r++) {
         double t0 = now();
-        if (ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+        if (ccn_plan_create_cached(&cage, &o, cache, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
         double t1 = now() - t0;
+        if (r == 0) tfirst = t1;
         tplan = t1 < tplan ? t1 : tplan;
         if (r + 1 < reps) ccn_plan_destroy(plan);
     }
@@ -62,6 +68,8 @@ int main(int argc, char **argv) {
         double t1 = now() - t0;
         teval = t1 < teval ? t1 : teval;
     }
+    struct rusage ru; /* one plan alive at a time so far: its peak, with the cage and outputs */
+    getrusage(RUSAGE_SELF, &ru);
     double tref = 1e30;
     ccn_mesh *cm = NULL;
     if (ccn_mesh_create(&cage, &cm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
@@ -75,10 +83,12 @@ int main(int argc, char **argv) {
     }
     ccn_mesh_destroy(cm);
     printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s; "
-           "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d\n",
+           "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d; peak RSS %ld kB; first plan %.4f s%s\n",
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,
-           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1);
+           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1, ru.ru_maxrss, tfirst,
+           cache ? " (one ccn_cache)" : "");
     ccn_plan_destroy(plan);
+    ccn_cache_destroy(cache);
     ccn_obj_destroy(obj);
     free(text); free(pos); free(nrm); free(cp);
     return 0;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Benchmark cages (standard library only): a quad cube-sphere (6 x 37 x 37 = 8214 faces),
-a production-like cage with valences 3-6 (>= 1500 faces, built by one Catmull-Clark-style
-split of a mixed cage), and a cage with non-uniform knot intervals."""
+a 50k-face one (6 x 91 x 91), a production-like cage with valences 3-6 (>= 1500 faces, built by
+one Catmull-Clark-style split of a mixed cage), a cage with non-uniform knot intervals and
+Blender's default 32-sided cylinder with one ring of intervals set to 3."""
 import math, os, random, sys
 
 def write(path, V, F, knots=None):
@@ -68,10 +69,25 @@ def nonuniform(V, F):
                 knots.append((f[j], f[(j + 1) % len(f)], 10 ** random.uniform(-1, 1)))
     return knots
 
+def cylinder32():
+    """Blender's default cylinder (32 vertices, N-gon caps, radius 1, depth 2)."""
+    n = 32
+    V = [[math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n), z] for z in (-1, 1) for i in range(n)]
+    F = [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    F += [list(range(n))[::-1], [n + i for i in range(n)]]
+    return V, F
+
 if __name__ == "__main__":
     out = sys.argv[1] if len(sys.argv) > 1 else "."
     os.makedirs(out, exist_ok=True)
     V, F = cube_sphere(37); write(os.path.join(out, "sphere8k.obj"), V, F)
     V, F = car_like(); write(os.path.join(out, "carlike.obj"), V, F)
     write(os.path.join(out, "carlike_knots.obj"), V, F, nonuniform(V, F))
-    print("sphere8k: %d faces" % (6 * 37 * 37))
+    V, F = cube_sphere(91); write(os.path.join(out, "sphere50k.obj"), V, F)
+    # issue 15's rebuild case: one ring of the default cylinder set to 3 -- the ring of the 32
+    # side edges (every rim vertex gets spoke ratio 3) and the ring of one rim edge pair (the
+    # 32-gon centres get one spoke of 3)
+    V, F = cylinder32()
+    write(os.path.join(out, "cyl32_side3.obj"), V, F, [(i, 32 + i, 3.0) for i in range(32)])
+    write(os.path.join(out, "cyl32_rim3.obj"), V, F, [(0, 1, 3.0), (32, 33, 3.0)])
+    print("sphere8k: %d faces, sphere50k: %d faces" % (6 * 37 * 37, 6 * 91 * 91))

@@ -1,7 +1,17 @@
-// OpenSubdiv uniform refinement benchmark: topology refinement and primvar interpolation
-// of the same OBJ cage, min time over repeats. Prints "osd <file> L<k>: topology T s,
-// points P s, limit Q s" (limit = PrimvarRefiner::Limit with tangents at the last level).
+// OpenSubdiv benchmark on an OBJ cage, min time over repeats.
+//   osd_bench in.obj L [repeats]          uniform refinement: prints "osd <file> L<k>: topology T s,
+//                                         points P s, limit Q s" (limit = PrimvarRefiner::Limit
+//                                         with tangents at the last level).
+//   osd_bench in.obj L repeats stencil    the limit-stencil pipeline (what ccn_plan_create /
+//                                         ccn_plan_evaluate do): adaptive refiner (isolation 3,
+//                                         Blender's default Quality) + LimitStencilTableFactory
+//                                         at 2^L x 2^L samples per quad ptex face (2^(L-1) per
+//                                         sub-face of an n-gon), then UpdateValues + UpdateDerivs.
+//                                         Prints "osd-stencil <file> L<k>: N stencils; create C s,
+//                                         update U s; table B bytes; peak RSS R kB".
 #include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/ptexIndices.h>
+#include <opensubdiv/far/stencilTableFactory.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
@@ -12,6 +22,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <sys/resource.h>
 
 using namespace OpenSubdiv;
 
@@ -50,6 +62,62 @@ int main(int argc, char **argv) {
     desc.numFaces = (int)sizes.size();
     desc.numVertsPerFace = sizes.data();
     desc.vertIndicesPerFace = idx.data();
+    if (argc > 4 && std::string(argv[4]) == "stencil") {
+        typedef Far::LimitStencilTableFactoryReal<double> LF;
+        std::vector<double> us, vs;
+        std::vector<std::pair<int, int>> ranges; // per ptex face: first sample, count
+        double tc = 1e30, tu = 1e30;
+        size_t nst = 0, bytes = 0;
+        for (int r = 0; r < reps; r++) {
+            double t0 = now();
+            Far::TopologyRefiner *ref = Far::TopologyRefinerFactory<Far::TopologyDescriptor>::Create(
+                desc, Far::TopologyRefinerFactory<Far::TopologyDescriptor>::Options(Sdc::SCHEME_CATMARK, opt));
+            ref->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(3));
+            if (us.empty()) { // the sample locations (not timed)
+                Far::PtexIndices pt(*ref);
+                for (int f = 0, p = 0; f < (int)sizes.size(); f++) {
+                    int nsub = sizes[f] == 4 ? 1 : sizes[f], g = sizes[f] == 4 ? (1 << levels) : (1 << (levels > 0 ? levels - 1 : 0));
+                    for (int k = 0; k < nsub; k++, p++) {
+                        ranges.push_back(std::make_pair((int)us.size(), g * g));
+                        for (int i = 0; i < g; i++)
+                            for (int j = 0; j < g; j++) { us.push_back((double)i / g); vs.push_back((double)j / g); }
+                    }
+                    (void)pt;
+                }
+            }
+            LF::LocationArrayVec locs(ranges.size());
+            for (size_t k = 0; k < ranges.size(); k++) {
+                locs[k].ptexIdx = (int)k;
+                locs[k].numLocations = ranges[k].second;
+                locs[k].s = us.data() + ranges[k].first;
+                locs[k].t = vs.data() + ranges[k].first;
+            }
+            Far::LimitStencilTableReal<double> const *tab = LF::Create(*ref, locs);
+            double t1 = now();
+            nst = (size_t)tab->GetNumStencils();
+            std::vector<Vtx> P(nst), Du(nst), Dv(nst);
+            double tbest = 1e30;
+            for (int q = 0; q < 3; q++) {
+                verts[0].p[0] += 1e-3;
+                double t2 = now();
+                tab->UpdateValues(verts.data(), P.data());
+                tab->UpdateDerivs(verts.data(), Du.data(), Dv.data());
+                double t3 = now() - t2;
+                if (t3 < tbest) tbest = t3;
+            }
+            bytes = tab->GetSizes().size() * sizeof(int) * 2 + tab->GetControlIndices().size() * sizeof(int) +
+                    tab->GetWeights().size() * sizeof(double) * 3;
+            if (t1 - t0 < tc) tc = t1 - t0;
+            if (tbest < tu) tu = tbest;
+            delete tab;
+            delete ref;
+        }
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        std::printf("osd-stencil %s L%d: %zu stencils; create %.4f s, update %.4f s; table %zu bytes; peak RSS %ld kB\n",
+                    argv[1], levels, nst, tc, tu, bytes, ru.ru_maxrss);
+        return 0;
+    }
     double ttopo = 1e30, tpts = 1e30, tlim = 1e30;
     size_t nout = 0;
     for (int r = 0; r < reps; r++) {

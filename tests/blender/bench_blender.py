@@ -3,27 +3,31 @@ the same output density ((2^L+1)^2 samples per cage quad), headless, on the same
 
     blender --background --factory-startup --python-exit-code 1 \
             --python tests/blender/bench_blender.py -- BENCH_DIR build/ccnurbs.zip
+    VENV/bin/python tests/blender/bench_blender.py BENCH_DIR build/ccnurbs.zip   (bpy 4.5 / 5.x)
 
 For each cage and level: the time from a change to the evaluated mesh being available
 (depsgraph update + evaluated mesh access, min over repeats), for a position-only change (one
-vertex moved) and a topology change (the mesh datablock swapped for one with a face removed).
+vertex moved, in Object Mode and in Edit Mode), a topology change (the mesh datablock swapped
+for one with a face removed) and, for CCNURBS, an interval edit (one edge's knot interval
+changed: same topology). Default settings (Exact normals, Guided Bi-5 cap) and Fast normals.
 Prints lines starting with "bench".
 """
 import os
 import sys
 import time
 
-import addon_utils
-import bpy
-import numpy as np
+import bpy  # first: the bpy module (4.5 / 5.x venvs) puts addon_utils and bmesh on the path
+import addon_utils  # noqa: E402
+import bmesh  # noqa: E402
+import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cagelib  # noqa: E402
 
-ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
 BENCH = os.path.abspath(ARGS[0] if ARGS else "build/bench")
 ZIP = os.path.abspath(ARGS[1] if len(ARGS) > 1 else "build/ccnurbs.zip")
-REPS = 5
+REPS = 3
 
 
 def update():
@@ -68,6 +72,41 @@ def time_positions(ob):
     return best
 
 
+def time_edit_positions(ob):
+    """One vertex moved in Edit Mode (bmesh + update_edit_mesh, as a grab does)."""
+    bpy.context.view_layer.objects.active = ob
+    bpy.ops.object.mode_set(mode='EDIT')
+    bm = bmesh.from_edit_mesh(ob.data)
+    bm.verts.ensure_lookup_table()
+    evaluated(ob)
+    evaluated(ob)
+    best = 1e30
+    for r in range(REPS):
+        bm.verts[0].co.x += 1e-3
+        bmesh.update_edit_mesh(ob.data)
+        t0 = time.perf_counter()
+        evaluated(ob)
+        evaluated(ob)
+        best = min(best, time.perf_counter() - t0)
+    bpy.ops.object.mode_set(mode='OBJECT')
+    return best
+
+
+def time_interval(ob):
+    """One edge's knot interval changed (the add-on's EDGE attribute): same topology."""
+    me = ob.data
+    att = me.attributes.get("knot_interval") or me.attributes.new("knot_interval", 'FLOAT', 'EDGE')
+    best = 1e30
+    for r in range(REPS):
+        att.data[0].value = 1.0 + 0.125 * (1 + (att.data[0].value / 0.125) % 7)  # always a new value
+        me.update()
+        t0 = time.perf_counter()
+        evaluated(ob)
+        evaluated(ob)
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
 def time_topology(ob, me_a, me_b):
     best = 1e30
     for r in range(REPS):
@@ -87,34 +126,52 @@ def bench(name, level):
     mod.levels = mod.render_levels = level
     n_sub = evaluated(ob)
     sub_pos = time_positions(ob)
+    sub_edit = time_edit_positions(ob)
     sub_topo = time_topology(ob, me_a, me_b)
     ob.modifiers.remove(mod)
     bpy.ops.object.ccnurbs_add()
     ob.ccnurbs.levels = level
     n_ccn = evaluated(ob)
     evaluated(ob)
-    ccn_pos = time_positions(ob)
-    ccn_topo = time_topology(ob, me_a, me_b)
-    ob.ccnurbs.normals = 'FAST'
-    evaluated(ob)
-    evaluated(ob)
-    fast_pos = time_positions(ob)
-    fast_topo = time_topology(ob, me_a, me_b)
-    print("bench %s L%d: %d vs %d verts | subsurf pos %.4f s topo %.4f s | ccnurbs exact normals "
-          "pos %.4f s topo %.4f s (ratio %.2f, %.2f) | fast normals pos %.4f s topo %.4f s "
-          "(ratio %.2f, %.2f)" % (name, level, n_ccn, n_sub, sub_pos, sub_topo, ccn_pos, ccn_topo,
-                                  ccn_pos / sub_pos, ccn_topo / sub_topo, fast_pos, fast_topo,
-                                  fast_pos / sub_pos, fast_topo / sub_topo))
+    r = {}
+    for normals in ('EXACT', 'FAST'):
+        ob.ccnurbs.normals = normals
+        evaluated(ob)
+        evaluated(ob)
+        r[normals] = (time_positions(ob), time_edit_positions(ob), time_interval(ob),
+                      time_topology(ob, me_a, me_b))
+    print("bench %s L%d (Blender %s): %d vs %d verts | subsurf pos %.4f s edit %.4f s topo %.4f s"
+          % (name, level, bpy.app.version_string, n_ccn, n_sub, sub_pos, sub_edit, sub_topo))
+    for normals in ('EXACT', 'FAST'):
+        pos, edit, itv, topo = r[normals]
+        print("bench %s L%d (Blender %s) ccnurbs %s normals: pos %.4f s (%.2fx) edit %.4f s (%.2fx) "
+              "interval %.4f s (%.2fx subsurf topo) topo %.4f s (%.2fx)"
+              % (name, level, bpy.app.version_string, normals.lower(), pos, pos / sub_pos, edit,
+                 edit / sub_edit, itv, itv / sub_topo, topo, topo / sub_topo))
     sys.stdout.flush()
 
 
-def main():
-    bpy.ops.preferences.addon_install(filepath=ZIP, overwrite=True)
-    if addon_utils.enable("ccnurbs", default_set=True) is None:
+def install():
+    if bpy.app.version >= (4, 2, 0):
+        res = bpy.ops.extensions.package_install_files(filepath=ZIP, repo="user_default",
+                                                       enable_on_install=False)
+        if res != {'FINISHED'}:
+            raise RuntimeError("extensions.package_install_files: %s" % res)
+        name = "bl_ext.user_default.ccnurbs"
+    else:
+        bpy.ops.preferences.addon_install(filepath=ZIP, overwrite=True)
+        name = "ccnurbs"
+    if addon_utils.enable(name, default_set=True) is None:
         raise RuntimeError("cannot enable the add-on")
-    for name in ("sphere8k", "carlike", "carlike_knots"):
-        for level in (2, 3):
-            bench(name, level)
+
+
+def main():
+    install()
+    cases = os.environ.get("CCN_BENCH_BLENDER_CASES",
+                           "sphere8k:2 sphere8k:3 sphere50k:2 carlike_knots:2 carlike_knots:3")
+    for c in cases.split():
+        name, level = c.split(":")
+        bench(name, int(level))
 
 
 main()

@@ -454,7 +454,57 @@ static void test_nonuniform_planar(void) {
     CHECK(worst <= 1e-12, "off-plane %g", worst);
 }
 
+/* ccn_plan_create_cached (issue 15): plans sharing one ccn_cache of bi-5 operators give output
+ * byte-identical to ccn_plan_create, also the second plan of each valence (operator reused),
+ * with uniform and non-uniform (exact surround) caps; the cache outlives the plans. */
+static void test_shared_cache(void) {
+    static const int valences[] = {3, 5, 8, 5, 3, 8};
+    ccn_cache *cache = NULL;
+    ccn_error err;
+    CHECK(ccn_cache_create(&cache, &err) == CCN_OK, "%s", err.message);
+    int same = 0, caps = 0;
+    for (int k = 0; k < 6 && cache; k++) {
+        int n = valences[k];
+        cage_buf c;
+        make_fan(n, 0.2, &c);
+        double d[8];
+        for (int s = 0; s < n; s++) d[s] = k < 3 ? 1.0 : 1 + 0.04 * (tl_rand01() - 0.5);
+        ccn_cage cage;
+        int32_t *ev;
+        double *kn;
+        fan_knots(&c, n, d, &cage, &ev, &kn);
+        ccn_options o = {0};
+        o.levels = 3;
+        ccn_plan *a = NULL, *b = NULL;
+        CHECK(ccn_plan_create(&cage, &o, &a, &err) == CCN_OK, "%s", err.message);
+        CHECK(ccn_plan_create_cached(&cage, &o, cache, &b, &err) == CCN_OK, "%s", err.message);
+        if (a && b) {
+            ccn_sizes sa, sb;
+            ccn_plan_sizes(a, &sa);
+            ccn_plan_sizes(b, &sb);
+            caps += sb.num_caps;
+            size_t nv = (size_t)sa.num_verts;
+            double *xa = malloc(sizeof(double) * 6 * nv), *xb = malloc(sizeof(double) * 6 * nv);
+            ccn_limit_mesh la = {.positions = xa, .normals = xa + 3 * nv}, lb = {.positions = xb, .normals = xb + 3 * nv};
+            CHECK(ccn_plan_evaluate(a, NULL, &la, &err) == CCN_OK, "%s", err.message);
+            CHECK(ccn_plan_evaluate(b, NULL, &lb, &err) == CCN_OK, "%s", err.message);
+            int eq = sa.num_verts == sb.num_verts && sa.num_caps == sb.num_caps &&
+                     memcmp(xa, xb, sizeof(double) * 6 * nv) == 0;
+            CHECK(eq, "n = %d (case %d): the cached plan's output differs", n, k);
+            same += eq;
+            free(xa); free(xb);
+        }
+        ccn_plan_destroy(a);
+        ccn_plan_destroy(b);
+        free(ev); free(kn); free(c.pos); free(c.fv); free(c.fs);
+    }
+    printf("  shared ccn_cache: %d of 6 plans byte-identical, %d caps\n", same, caps);
+    CHECK(caps >= 6, "caps built: %d", caps);
+    ccn_cache_destroy(cache);
+}
+
 int main(void) {
+    RUN(test_shared_cache);
     RUN(test_nonuniform_planar);
     RUN(test_nonuniform_extreme);
     RUN(test_nonuniform_general);
