@@ -43,15 +43,16 @@ class Cage:
         used_e[self.loop_edges] = True
         return int((~used_v).sum()), int((~used_e).sum())
 
-    def topology_key(self, *settings, creases=False):
-        """Hash of everything a plan (and the proxy's topology) depends on except positions:
-        polygons, edges, intervals, material indices, settings (and creases once the library
-        uses them)."""
+    def topology_key(self, *settings, creases=False, knots=True):
+        """Hash of everything a plan depends on except positions: polygons, edges, intervals,
+        material indices, settings and (with Use Creases) creases. With knots=False, the key of
+        the proxy's topology: intervals change the plan but not the limit mesh's faces."""
         h = hashlib.blake2b(digest_size=16)
         for a in (self.face_sizes, self.face_verts, self.edge_verts, self.material_index):
             h.update(np.ascontiguousarray(a).tobytes())
             h.update(b"|")
-        h.update(b"K" + (self.knots.tobytes() if self.knots is not None else b"-"))
+        if knots:
+            h.update(b"K" + (self.knots.tobytes() if self.knots is not None else b"-"))
         if creases:
             for a in (self.edge_creases, self.vertex_creases):
                 h.update(b"C" + (a.tobytes() if a is not None else b"-"))

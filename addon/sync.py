@@ -8,7 +8,8 @@ reads what it wrote:
   proxy mesh; an update whose key equals the stored one does nothing (this also ends the update
   our own write causes, and survives undo, which restores proxy and key together);
 * same topology key → the cached plan is evaluated with new positions and only positions and
-  normals are rewritten; otherwise a new plan is made and the proxy rebuilt;
+  normals are rewritten; otherwise a new plan is made, and the proxy is rebuilt only if its
+  faces change (an interval edit keeps them: positions and normals are rewritten in place);
 * any failure is recorded as the cage's status (shown in the panel) and nothing is raised; the
   proxy keeps the previous limit, except for a cage without faces, which shows itself.
 
@@ -108,6 +109,7 @@ def sync_object(obj, kind, cage, force=False):
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases)
+        faces = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases, knots=False)
         key = topo + ":" + cage.position_key()
         proxies.sync_materials(obj.data, p)
         old = _status.get(key_name)
@@ -123,7 +125,9 @@ def sync_object(obj, kind, cage, force=False):
         stats["syncs"] += 1
         plan = _plan_for(key_name, topo, cage, s, levels)
         me = proxies.own_mesh(p)
-        same_topology = (me.get(proxies.TOPO_PROP) == topo
+        # an interval edit changes the plan, not the output faces: positions (and normals)
+        # are rewritten in place, the proxy keeps its topology (issue 15 item 4)
+        same_topology = (me.get(proxies.TOPO_PROP) == faces
                          and len(me.vertices) == plan.sizes["num_verts"]
                          and len(me.polygons) == plan.sizes["num_faces"])
         exact = s.normals == 'EXACT'
@@ -136,7 +140,7 @@ def sync_object(obj, kind, cage, force=False):
             proxies.write_topology(me, plan.evaluate(cage.positions, topology=True), cage, exact)
             stats["rebuilds"] += 1
         me[proxies.KEY_PROP] = key
-        me[proxies.TOPO_PROP] = topo
+        me[proxies.TOPO_PROP] = faces
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:

@@ -84,14 +84,21 @@ class TestModifier(AddonTestCase):
         self.assertGreaterEqual(d["skipped"], 1, d)
         self.assertEqual(d["syncs"], 0, d)
 
-        # change an interval (ring of the first spoke) → rebuild with the new intervals
+        # change an interval (ring of the first spoke) → a new plan with the new intervals;
+        # the limit mesh keeps its faces, so the proxy is updated in place, not rebuilt
         st = dict(ccn.sync.stats)
         k = cagelib.get_knots(me)
         k[0] = 6.0
         me.attributes["knot_interval"].data.foreach_set("value", k)
         me.update()
         self.assertMatchesCLI(ob)
-        self.assertEqual(ccn.sync.stats["syncs"] - st["syncs"], 1)
+        d = {k: ccn.sync.stats[k] - st[k] for k in st}
+        self.assertEqual(d["syncs"], 1, d)
+        self.assertEqual(d["rebuilds"], 0, d)
+        self.assertEqual(d["position_updates"], 1, d)
+        self.assertIs(ccn.modifier.proxy(ob, 'VIEW').data, proxy_me)
+        ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
+        np.testing.assert_array_equal(loops_before, loops_after)
 
         # levels → new vertex count
         n2 = len(evaluated_positions(ob))
