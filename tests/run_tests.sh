@@ -8,7 +8,7 @@
 cd "$(dirname "$0")/.." || exit 2
 JOBS=${CCN_TEST_JOBS:-2}
 LOG=build/test-logs
-HEAVY="tests/asan/run_asan.sh tests/experiments/run_experiments.sh tests/oracle/run_cad_patches.sh
+HEAVY="tests/asan/run_asan.sh tests/experiments/run_experiments.sh tests/oracle/run_export.sh
        tests/blender/run_blender.sh tests/fuzz/run_fuzz.sh build/tests/test_cap build/tests/test_cap_fair
        build/tests/test_creases build/tests/test_normals_fd tests/oracle/run_osd_shapes.sh"
 rm -rf "$LOG" && mkdir -p "$LOG" || exit 2
