@@ -20,6 +20,10 @@ typedef struct {
     size_t *Moff;
     double *H;           /* scratch: 3*ne curve edge points */
     int32_t fallbacks;
+    /* Face-varying channels (refine/fvar.c), else NULL: vertex v's rule (smooth, crease or
+     * corner, and the fractional weight where it changes) follows the sharpness of vertex
+     * partner[v] >= 0 (OpenSubdiv's dependent sharpness), its crease along its own edges. */
+    const int32_t *partner;
 } ccn__level;
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                               int crease_method, ccn_error *err);
