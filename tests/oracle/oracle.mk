@@ -7,7 +7,7 @@ ORACLE_SAVED_GOAL := $(.DEFAULT_GOAL)
 ORACLE_CFLAGS      = -std=c11 -O2 -Wall -Wextra -Werror
 ORACLE_CXXFLAGS    = -std=c++14 -O2 -Wall -Wextra -Werror
 
-$(B)/osd_refine: tests/oracle/osd_refine.cpp
+$(B)/osd_refine: tests/oracle/osd_refine.cpp tests/oracle/osd_oracle.h
 	@mkdir -p $(@D)
 	$(CXX) $(ORACLE_CXXFLAGS) $< -o $@ -losdCPU
 

@@ -68,593 +68,25 @@
 //     vertices under interpolateboundary 0.
 //   --limit-osd: plain PrimvarRefiner::Limit at level K (OpenSubdiv's own approximation
 //     described above), for comparison.
+//   --fvar-linear M (0..5 or none, corners-only, corners-plus1, corners-plus2, boundaries,
+//     all): the face-varying interpolation (wins over the file's facevaryinginterpolateboundary
+//     tag; neither: OpenSubdiv's default, all).
+// UV maps. When every face corner has a texture index (`f v/vt`), the `vt` values are a
+// face-varying channel and the output has the level-K values as `vt` lines and faces as
+// `f v/vt` (`f v/vt/vn` with --limit-normals), in OpenSubdiv's order: InterpolateFaceVarying
+// level by level; with --limit (levels >= 1), the exact limit of each value: LimitFaceVarying
+// at level K where it is exact, with its crease weights in double precision, and where Limit is
+// not (see above) the one-ring refinement, carrying the values (osd_oracle.h, localLimitFVar,
+// limitFaceVaryingExact).
 // Level-K vertex order: OpenSubdiv "orderVerticesFromFacesFirst" (at each level face
 // points, then edge points, then vertex points). Errors: message on stderr, exit 2.
-#include <opensubdiv/far/primvarRefiner.h>
-#include <opensubdiv/far/topologyDescriptor.h>
+#include "osd_oracle.h"
 
-#include <algorithm>
-#include <cerrno>
-#include <cfloat>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
-#include <map>
-#include <set>
-#include <sstream>
-#include <string>
-#include <utility>
-#include <vector>
-
-using namespace OpenSubdiv;
-
-namespace {
-
-struct Vertex3 {
-    double p[3];
-    void Clear(void * = nullptr) { p[0] = p[1] = p[2] = 0.0; }
-    void AddWithWeight(Vertex3 const &s, double w) {
-        p[0] += w * s.p[0];
-        p[1] += w * s.p[1];
-        p[2] += w * s.p[2];
-    }
-};
-
-struct Mesh {
-    std::vector<Vertex3> verts;
-    std::vector<int> faceSizes;
-    std::vector<int> faceVerts;
-    // sharpness, 0-based; later entries replace earlier ones
-    std::map<std::pair<int, int>, float> creases;  // key: (min, max) vertex
-    std::map<int, float> corners;
-    // options from tags (-1 = not given)
-    int interpolateBoundary = -1;
-    int fvarInterpolateBoundary = -1;
-    int creaseMethod = -1;  // 0 normal, 1 chaikin
-    int smoothTriangles = -1;
-};
-
-int g_osdErrors = 0;
-double g_settle = 1e-16;  // environment OSD_REFINE_SETTLE overrides (for experiments)
-int g_maxLevels = 120;
-
-void osdError(Far::ErrorType, const char *msg) {
-    std::fprintf(stderr, "osd_refine: OpenSubdiv error: %s\n", msg);
-    g_osdErrors++;
-}
-
-void osdWarning(const char *msg) {
-    std::fprintf(stderr, "osd_refine: OpenSubdiv warning: %s\n", msg);
-}
-
-[[noreturn]] void die(const std::string &msg) {
-    std::fprintf(stderr, "osd_refine: %s\n", msg.c_str());
-    std::exit(2);
-}
-
-void usage() {
-    die("usage: osd_refine [--levels K] [--corners smooth|pinned] "
-        "[--limit | --limit-normals | --limit-osd] in.obj out.obj");
-}
-
-bool parseLong(const std::string &tok, long &out) {
-    char *end = nullptr;
-    errno = 0;
-    long x = std::strtol(tok.c_str(), &end, 10);
-    if (end == tok.c_str() || *end != '\0' || errno) return false;
-    out = x;
-    return true;
-}
-
-bool parseDouble(const std::string &tok, double &out) {
-    char *end = nullptr;
-    errno = 0;
-    double x = std::strtod(tok.c_str(), &end);
-    if (end == tok.c_str() || *end != '\0') return false;
-    out = x;
-    return true;
-}
-
-// OpenSubdiv clamps sharpness with std::max(0.0f, s), which also turns NaN into 0.
-float clampSharpness(double s) {
-    float f = (float)s;
-    return std::max(0.0f, f);
-}
-
-// Parses a `t` line (tokens after "t"). Returns false with msg on a malformed tag.
-bool parseTag(std::istringstream &ss, Mesh &m, const std::string &where, std::string &msg) {
-    std::string name, counts;
-    if (!(ss >> name >> counts)) {
-        msg = where + "tag needs a name and nints/nfloats/nstrings";
-        return false;
-    }
-    long n[3] = {0, 0, 0};
-    {
-        std::vector<std::string> parts;
-        std::string part;
-        std::istringstream cs(counts);
-        while (std::getline(cs, part, '/')) parts.push_back(part);
-        if (parts.size() != 3) {
-            msg = where + "tag counts must be nints/nfloats/nstrings, got '" + counts + "'";
-            return false;
-        }
-        for (int k = 0; k < 3; k++)
-            if (!parseLong(parts[k], n[k]) || n[k] < 0 || n[k] > 100000000L) {
-                msg = where + "bad tag count '" + counts + "'";
-                return false;
-            }
-    }
-    std::vector<long> ints;
-    std::vector<double> floats;
-    std::vector<std::string> strings;
-    std::string tok;
-    for (long k = 0; k < n[0]; k++) {
-        long x;
-        if (!(ss >> tok) || !parseLong(tok, x)) {
-            msg = where + "tag '" + name + "' needs " + std::to_string(n[0]) + " integers";
-            return false;
-        }
-        ints.push_back(x);
-    }
-    for (long k = 0; k < n[1]; k++) {
-        double x;
-        if (!(ss >> tok) || !parseDouble(tok, x)) {
-            msg = where + "tag '" + name + "' needs " + std::to_string(n[1]) + " numbers";
-            return false;
-        }
-        floats.push_back(x);
-    }
-    for (long k = 0; k < n[2]; k++) {
-        if (!(ss >> tok)) {
-            msg = where + "tag '" + name + "' needs " + std::to_string(n[2]) + " strings";
-            return false;
-        }
-        strings.push_back(tok);
-    }
-    if (ss >> tok) {
-        msg = where + "tag '" + name + "' has extra value '" + tok + "'";
-        return false;
-    }
-    auto oneInt = [&](long lo, long hi, int &dst) {
-        if (ints.size() != 1 || ints[0] < lo || ints[0] > hi) {
-            msg = where + "tag '" + name + "' needs one integer in " + std::to_string(lo) +
-                  ".." + std::to_string(hi);
-            return false;
-        }
-        dst = (int)ints[0];
-        return true;
-    };
-    if (name == "crease") {
-        const size_t pairs = ints.size() / 2;
-        if (ints.size() < 2 || ints.size() % 2 || !(floats.size() == 1 || floats.size() == pairs)) {
-            msg = where + "crease tag needs vertex pairs and one sharpness or one per pair";
-            return false;
-        }
-        for (size_t k = 0; k < pairs; k++) {
-            long a = ints[2 * k], b = ints[2 * k + 1];
-            if (a < 0 || b < 0 || a > 2000000000L || b > 2000000000L || a == b) {
-                msg = where + "bad crease edge " + std::to_string(a) + " " + std::to_string(b);
-                return false;
-            }
-            m.creases[{(int)std::min(a, b), (int)std::max(a, b)}] =
-                clampSharpness(floats.size() == 1 ? floats[0] : floats[k]);
-        }
-    } else if (name == "corner") {
-        if (ints.empty() || !(floats.size() == 1 || floats.size() == ints.size())) {
-            msg = where + "corner tag needs vertices and one sharpness or one per vertex";
-            return false;
-        }
-        for (size_t k = 0; k < ints.size(); k++) {
-            if (ints[k] < 0 || ints[k] > 2000000000L) {
-                msg = where + "bad corner vertex " + std::to_string(ints[k]);
-                return false;
-            }
-            m.corners[(int)ints[k]] = clampSharpness(floats.size() == 1 ? floats[0] : floats[k]);
-        }
-    } else if (name == "interpolateboundary") {
-        return oneInt(0, 2, m.interpolateBoundary);
-    } else if (name == "facevaryinginterpolateboundary") {
-        return oneInt(0, 5, m.fvarInterpolateBoundary);
-    } else if (name == "creasemethod") {
-        if (strings.size() != 1 ||
-            !(strings[0] == "normal" || strings[0] == "uniform" || strings[0] == "chaikin")) {
-            msg = where + "creasemethod tag needs one string: normal (or uniform) or chaikin";
-            return false;
-        }
-        m.creaseMethod = strings[0] == "chaikin" ? 1 : 0;
-    } else if (name == "smoothtriangles") {
-        if (strings.size() != 1 || !(strings[0] == "catmark" || strings[0] == "smooth")) {
-            msg = where + "smoothtriangles tag needs one string: catmark or smooth";
-            return false;
-        }
-        m.smoothTriangles = strings[0] == "smooth" ? 1 : 0;
-    } else {
-        std::fprintf(stderr, "osd_refine: warning: %signoring unsupported tag '%s'\n",
-                     where.c_str(), name.c_str());
-    }
-    return true;
-}
-
-// "# crease i j s" / "# corner i s" (1-based). Other comments are ignored.
-bool parseComment(std::istringstream &ss, Mesh &m, const std::string &where, std::string &msg) {
-    std::string kw;
-    if (!(ss >> kw)) return true;
-    if (kw != "crease" && kw != "corner") return true;
-    const int nInts = kw == "crease" ? 2 : 1;
-    long idx[2] = {0, 0};
-    double s = 0;
-    std::string tok;
-    // "# crease tags for perimeter:" (OpenSubdiv's shapes) is prose, not a statement
-    if (!(ss >> tok) || !parseLong(tok, idx[0])) return true;
-    for (int k = 0; k < nInts; k++) {
-        if ((k > 0 && !(ss >> tok)) || !parseLong(tok, idx[k]) || idx[k] < 1 ||
-            idx[k] > 2000000000L) {
-            msg = where + "expected '# " + kw + (nInts == 2 ? " i j s" : " i s") +
-                  "' with 1-based vertex indices";
-            return false;
-        }
-    }
-    if (!(ss >> tok) || !parseDouble(tok, s)) {
-        msg = where + "expected a sharpness after '# " + kw + "'";
-        return false;
-    }
-    if (nInts == 2) {
-        if (idx[0] == idx[1]) {
-            msg = where + "crease edge needs two different vertices";
-            return false;
-        }
-        m.creases[{(int)std::min(idx[0], idx[1]) - 1, (int)std::max(idx[0], idx[1]) - 1}] =
-            clampSharpness(s);
-    } else {
-        m.corners[(int)idx[0] - 1] = clampSharpness(s);
-    }
-    return true;
-}
-
-// Parses an OBJ file; returns false with msg set on error.
-bool readObj(const char *path, Mesh &m, std::string &msg) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        msg = std::string("cannot open ") + path + ": " + std::strerror(errno);
-        return false;
-    }
-    std::string line;
-    long lineNo = 0;
-    while (std::getline(in, line)) {
-        lineNo++;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        std::ostringstream where;
-        where << path << ":" << lineNo << ": ";
-        size_t first = line.find_first_not_of(" \t");
-        if (first != std::string::npos && line[first] == '#') {
-            std::istringstream cs(line.substr(first + 1));
-            if (!parseComment(cs, m, where.str(), msg)) return false;
-            continue;
-        }
-        std::istringstream ss(line);
-        std::string tag;
-        if (!(ss >> tag)) continue;
-        if (tag == "v") {
-            Vertex3 v;
-            for (int k = 0; k < 3; k++) {
-                std::string tok;
-                if (!(ss >> tok)) {
-                    msg = where.str() + "vertex needs 3 coordinates";
-                    return false;
-                }
-                char *end = nullptr;
-                errno = 0;
-                v.p[k] = std::strtod(tok.c_str(), &end);
-                if (end == tok.c_str() || *end != '\0' || !std::isfinite(v.p[k])) {
-                    msg = where.str() + "bad coordinate '" + tok + "'";
-                    return false;
-                }
-            }
-            m.verts.push_back(v);
-        } else if (tag == "f") {
-            std::string tok;
-            int n = 0;
-            while (ss >> tok) {
-                char *end = nullptr;
-                errno = 0;
-                long idx = std::strtol(tok.c_str(), &end, 10);
-                if (end == tok.c_str() || (*end != '\0' && *end != '/') || errno) {
-                    msg = where.str() + "bad face index '" + tok + "'";
-                    return false;
-                }
-                long nv = (long)m.verts.size();
-                if (idx < 0) idx = nv + idx + 1;  // relative index
-                if (idx < 1 || idx > 2000000000L) {
-                    msg = where.str() + "face index out of range '" + tok + "'";
-                    return false;
-                }
-                m.faceVerts.push_back((int)(idx - 1));
-                n++;
-            }
-            if (n < 3) {
-                msg = where.str() + "face with fewer than 3 vertices";
-                return false;
-            }
-            m.faceSizes.push_back(n);
-        } else if (tag == "t") {
-            if (!parseTag(ss, m, where.str(), msg)) return false;
-        }
-    }
-    if (in.bad()) {
-        msg = std::string("read error on ") + path;
-        return false;
-    }
-    const int nv = (int)m.verts.size();
-    std::set<std::pair<int, int>> edges;
-    size_t off = 0;
-    for (size_t f = 0; f < m.faceSizes.size(); f++) {
-        const int n = m.faceSizes[f];
-        for (int i = 0; i < n; i++) {
-            const int a = m.faceVerts[off + i];
-            if (a >= nv) {
-                msg = std::string(path) + ": face " + std::to_string(f + 1) +
-                      " references vertex " + std::to_string(a + 1) + " of " +
-                      std::to_string(nv);
-                return false;
-            }
-            for (int j = i + 1; j < n; j++) {
-                if (m.faceVerts[off + j] == a) {
-                    msg = std::string(path) + ": face " + std::to_string(f + 1) +
-                          " repeats vertex " + std::to_string(a + 1);
-                    return false;
-                }
-            }
-            const int b = m.faceVerts[off + (i + 1) % n];
-            edges.insert({std::min(a, b), std::max(a, b)});
-        }
-        off += (size_t)n;
-    }
-    if (m.faceSizes.empty()) {
-        msg = std::string(path) + ": no faces";
-        return false;
-    }
-    for (auto const &c : m.creases) {
-        if (!edges.count(c.first)) {
-            msg = std::string(path) + ": crease on vertices " + std::to_string(c.first.first) +
-                  " " + std::to_string(c.first.second) +
-                  " (0-based) which are not joined by an edge";
-            return false;
-        }
-    }
-    for (auto const &c : m.corners) {
-        if (c.first >= nv) {
-            msg = std::string(path) + ": corner on vertex " + std::to_string(c.first) +
-                  " (0-based) of " + std::to_string(nv);
-            return false;
-        }
-    }
-    return true;
-}
-
-typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-
-// A mesh with its sharpness, ready for a TopologyDescriptor.
-struct Cage {
-    std::vector<Vertex3> pos;
-    std::vector<int> faceSizes, faceVerts;
-    std::vector<int> creasePairs;
-    std::vector<float> creaseWeights;
-    std::vector<int> cornerVerts;
-    std::vector<float> cornerWeights;
-};
-
-Far::TopologyRefiner *createRefiner(Cage const &c, Sdc::Options const &opts) {
-    Far::TopologyDescriptor desc;
-    desc.numVertices = (int)c.pos.size();
-    desc.numFaces = (int)c.faceSizes.size();
-    desc.numVertsPerFace = c.faceSizes.data();
-    desc.vertIndicesPerFace = c.faceVerts.data();
-    desc.numCreases = (int)c.creaseWeights.size();
-    desc.creaseVertexIndexPairs = c.creasePairs.empty() ? nullptr : c.creasePairs.data();
-    desc.creaseWeights = c.creaseWeights.empty() ? nullptr : c.creaseWeights.data();
-    desc.numCorners = (int)c.cornerWeights.size();
-    desc.cornerVertexIndices = c.cornerVerts.empty() ? nullptr : c.cornerVerts.data();
-    desc.cornerWeights = c.cornerWeights.empty() ? nullptr : c.cornerWeights.data();
-    return Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opts));
-}
-
-bool isSemiSharp(float s) { return s > 0.0f && s < Sdc::Crease::SHARPNESS_INFINITE; }
-
-bool isSmoothRule(Sdc::Crease::Rule r) {
-    return r == Sdc::Crease::RULE_SMOOTH || r == Sdc::Crease::RULE_DART;
-}
-
-// Interior vertex of two faces with the smooth or dart rule: Limit() uses the corner mask.
-bool isInteriorValence2(Far::TopologyLevel const &lev, int v) {
-    return !lev.IsVertexBoundary(v) && lev.GetVertexFaces(v).size() == 2 &&
-           isSmoothRule(lev.GetVertexRule(v));
-}
-
-bool hasSemiSharp(Far::TopologyLevel const &lev, int v) {
-    if (isSemiSharp(lev.GetVertexSharpness(v))) return true;
-    Far::ConstIndexArray ve = lev.GetVertexEdges(v);
-    for (int i = 0; i < ve.size(); i++)
-        if (isSemiSharp(lev.GetEdgeSharpness(ve[i]))) return true;
-    return false;
-}
-
-bool facesAllQuads(Far::TopologyLevel const &lev, int v) {
-    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
-    for (int i = 0; i < vf.size(); i++)
-        if (lev.GetFaceVertices(vf[i]).size() != 4) return false;
-    return true;
-}
-
-// Limit() uses the smooth mask at a dart, but the dart's sharp edge refines with the crease
-// rule, so the mask is not that of the vertex's refinement matrix; at an interior valence-2
-// vertex Limit() uses the corner mask. Both need refining until the point settles.
-bool needsSettling(Far::TopologyLevel const &lev, int v) {
-    return isInteriorValence2(lev, v) || lev.GetVertexRule(v) == Sdc::Crease::RULE_DART;
-}
-
-// Does Limit() at this level give the exact limit of vertex v? (see the header)
-bool limitMaskExact(Far::TopologyLevel const &lev, int v) {
-    return !hasSemiSharp(lev, v) && !needsSettling(lev, v) && facesAllQuads(lev, v);
-}
-
-// Whether Tan1 x Tan2 of Limit() is the surface normal at v (see the header); the rule is
-// final there (limitMaskExact, or valence 2 refined to convergence).
-bool normalDefined(Far::TopologyLevel const &lev, int v, Sdc::Options const &opts) {
-    const bool boundary = lev.IsVertexBoundary(v);
-    const int nf = lev.GetVertexFaces(v).size();
-    if (boundary && opts.GetVtxBoundaryInterpolation() == Sdc::Options::VTX_BOUNDARY_NONE)
-        return false;
-    switch (lev.GetVertexRule(v)) {
-    case Sdc::Crease::RULE_SMOOTH: return !boundary && nf >= 3;
-    case Sdc::Crease::RULE_CREASE: return boundary && nf == 2;
-    case Sdc::Crease::RULE_CORNER: return boundary && nf == 1;
-    default: return false;
-    }
-}
-
-double diagonal(std::vector<Vertex3> const &p) {
-    if (p.empty()) return 0.0;
-    double mn[3], mx[3];
-    for (int k = 0; k < 3; k++) mn[k] = mx[k] = p[0].p[k];
-    for (auto const &q : p)
-        for (int k = 0; k < 3; k++) {
-            mn[k] = std::min(mn[k], q.p[k]);
-            mx[k] = std::max(mx[k], q.p[k]);
-        }
-    return std::sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) +
-                     (mx[2] - mn[2]) * (mx[2] - mn[2]));
-}
-
-// The faces around vertex v of level lev (positions P) with every sharpness they carry, as
-// a Cage; returns v's index in it.
-int extractRing(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v, Cage &c) {
-    c = Cage();
-    std::map<int, int> local;
-    std::vector<int> global;
-    auto loc = [&](int g) {
-        auto it = local.find(g);
-        if (it != local.end()) return it->second;
-        const int l = (int)c.pos.size();
-        local[g] = l;
-        global.push_back(g);
-        c.pos.push_back(P[(size_t)g]);
-        return l;
-    };
-    const int center = loc(v);
-    std::set<int> seen;
-    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
-    for (int i = 0; i < vf.size(); i++) {
-        Far::ConstIndexArray fv = lev.GetFaceVertices(vf[i]);
-        c.faceSizes.push_back(fv.size());
-        for (int k = 0; k < fv.size(); k++) c.faceVerts.push_back(loc(fv[k]));
-        Far::ConstIndexArray fe = lev.GetFaceEdges(vf[i]);
-        for (int k = 0; k < fe.size(); k++) {
-            if (!seen.insert(fe[k]).second) continue;
-            const float s = lev.GetEdgeSharpness(fe[k]);
-            if (s > 0.0f) {
-                Far::ConstIndexArray ev = lev.GetEdgeVertices(fe[k]);
-                c.creasePairs.push_back(loc(ev[0]));
-                c.creasePairs.push_back(loc(ev[1]));
-                c.creaseWeights.push_back(s);
-            }
-        }
-    }
-    for (size_t l = 0; l < global.size(); l++) {
-        const float s = lev.GetVertexSharpness(global[l]);
-        if (s > 0.0f) {
-            c.cornerVerts.push_back((int)l);
-            c.cornerWeights.push_back(s);
-        }
-    }
-    return center;
-}
-
-struct LimitPoint {
-    Vertex3 pos, tan1, tan2;
-    bool normalOk;
-};
-
-// Exact limit of vertex v of level lev by refining its one-ring (see the header).
-LimitPoint localLimit(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v,
-                      Sdc::Options const &opts) {
-    Cage c;
-    int center = extractRing(lev, P, v, c);
-    const double scale = diagonal(c.pos);
-    bool settled = false;  // valence 2 or dart: the point no longer moves
-    for (int it = 0;; it++) {
-        Far::TopologyRefiner *ref = createRefiner(c, opts);
-        if (!ref || g_osdErrors) die("OpenSubdiv rejected a vertex one-ring");
-        Far::TopologyLevel const &l0 = ref->GetLevel(0);
-        if (!hasSemiSharp(l0, center) && facesAllQuads(l0, center) &&
-            (settled || !needsSettling(l0, center))) {
-            std::vector<Vertex3> pos(c.pos.size()), t1(c.pos.size()), t2(c.pos.size());
-            Far::PrimvarRefinerReal<double> pr(*ref);
-            pr.Limit(c.pos, pos, t1, t2);
-            LimitPoint r{pos[(size_t)center], t1[(size_t)center], t2[(size_t)center],
-                         normalDefined(l0, center, opts)};
-            delete ref;
-            return r;
-        }
-        if (it >= g_maxLevels) die("a vertex limit did not settle in " + std::to_string(g_maxLevels) + " levels");
-        Far::TopologyRefiner::UniformOptions uo(1);
-        uo.fullTopologyInLastLevel = true;
-        ref->RefineUniform(uo);
-        if (g_osdErrors) die("OpenSubdiv refinement of a vertex one-ring failed");
-        std::vector<Vertex3> next((size_t)ref->GetLevel(1).GetNumVertices());
-        Far::PrimvarRefinerReal<double> pr(*ref);
-        pr.Interpolate(1, c.pos, next);
-        const int child = ref->GetLevel(0).GetVertexChildVertex(center);
-        double d2 = 0.0, mag = 0.0;
-        for (int k = 0; k < 3; k++) {
-            const double d = next[(size_t)child].p[k] - c.pos[(size_t)center].p[k];
-            d2 += d * d;
-            mag = std::max(mag, std::fabs(next[(size_t)child].p[k]));
-        }
-        // the move cannot get below the rounding of the coordinates themselves
-        settled = std::sqrt(d2) <= std::max(g_settle * scale, 4 * DBL_EPSILON * mag);
-        Cage nc;
-        center = extractRing(ref->GetLevel(1), next, child, nc);
-        c.pos.swap(nc.pos);
-        c.faceSizes.swap(nc.faceSizes);
-        c.faceVerts.swap(nc.faceVerts);
-        c.creasePairs.swap(nc.creasePairs);
-        c.creaseWeights.swap(nc.creaseWeights);
-        c.cornerVerts.swap(nc.cornerVerts);
-        c.cornerWeights.swap(nc.cornerWeights);
-        delete ref;
-    }
-}
-
-Vertex3 unitNormal(Vertex3 const &a, Vertex3 const &b) {
-    Vertex3 n;
-    n.p[0] = a.p[1] * b.p[2] - a.p[2] * b.p[1];
-    n.p[1] = a.p[2] * b.p[0] - a.p[0] * b.p[2];
-    n.p[2] = a.p[0] * b.p[1] - a.p[1] * b.p[0];
-    const double len = std::sqrt(n.p[0] * n.p[0] + n.p[1] * n.p[1] + n.p[2] * n.p[2]);
-    if (!(len > 0.0) || !std::isfinite(len)) {
-        n.Clear();
-        return n;
-    }
-    for (int k = 0; k < 3; k++) n.p[k] /= len;
-    return n;
-}
-
-const char *boundaryName(Sdc::Options::VtxBoundaryInterpolation b) {
-    switch (b) {
-    case Sdc::Options::VTX_BOUNDARY_NONE: return "none";
-    case Sdc::Options::VTX_BOUNDARY_EDGE_ONLY: return "edge-only";
-    case Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER: return "edge-and-corner";
-    }
-    return "?";
-}
-
-}  // namespace
 
 int main(int argc, char **argv) {
     int levels = 1;
     bool pinned = false, limit = false, normals = false, limitOsd = false;
+    int fvarLinear = -1;
     const char *inPath = nullptr, *outPath = nullptr;
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
@@ -668,6 +100,13 @@ int main(int argc, char **argv) {
             if (c == "smooth") pinned = false;
             else if (c == "pinned") pinned = true;
             else die("--corners must be smooth or pinned");
+        } else if (a == "--fvar-linear" && i + 1 < argc) {
+            static const char *names[6] = {"none", "corners-only", "corners-plus1", "corners-plus2",
+                                           "boundaries", "all"};
+            const std::string m = argv[++i];
+            for (int k = 0; k < 6; k++)
+                if (m == names[k] || m == std::to_string(k)) fvarLinear = k;
+            if (fvarLinear < 0) die("--fvar-linear must be 0..5 or an OpenSubdiv name");
         } else if (a == "--limit") {
             limit = true;
         } else if (a == "--limit-normals") {
@@ -694,6 +133,8 @@ int main(int argc, char **argv) {
     Mesh m;
     std::string msg;
     if (!readObj(inPath, m, msg)) die(msg);
+    if (fvarLinear >= 0) m.fvarInterpolateBoundary = fvarLinear;
+    const bool uv = m.hasUV();
 
     Sdc::Options sdcOpts;
     sdcOpts.SetVtxBoundaryInterpolation(pinned ? Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER
@@ -731,6 +172,10 @@ int main(int argc, char **argv) {
         base.cornerVerts.push_back(c.first);
         base.cornerWeights.push_back(c.second);
     }
+    if (uv) {
+        base.fvValues = (int)m.uvs.size();
+        base.fvIndices = m.faceUVs;
+    }
     Far::TopologyRefiner *refiner = createRefiner(base, sdcOpts);
     if (!refiner || g_osdErrors) die("OpenSubdiv rejected the topology");
 
@@ -747,15 +192,33 @@ int main(int argc, char **argv) {
     }
 
     Far::PrimvarRefinerReal<double> primvar(*refiner);
-    std::vector<Vertex3> cur = m.verts, next;
+    std::vector<Vertex3> cur = m.verts, next, curfv = m.uvs, nextfv;
     for (int l = 1; l <= levels; l++) {
         next.assign((size_t)refiner->GetLevel(l).GetNumVertices(), Vertex3());
         primvar.Interpolate(l, cur, next);
         cur.swap(next);
+        if (uv) {
+            nextfv.assign((size_t)refiner->GetLevel(l).GetNumFVarValues(0), Vertex3());
+            primvar.InterpolateFaceVarying(l, curfv, nextfv, 0);
+            curfv.swap(nextfv);
+        }
     }
     Far::TopologyLevel const &lev = refiner->GetLevel(levels);
     std::vector<Vertex3> nrm;
     int nLocal = 0, nNoNormal = 0;
+    if (limit && uv) {
+        if (levels < 1) die("face-varying limits need --levels >= 1");
+        std::vector<Vertex3> lim;
+        limitFaceVaryingExact(*refiner, curfv, lim);
+        for (int v = 0; !limitOsd && v < (int)cur.size(); v++) {
+            if (limitMaskExact(lev, v)) continue;
+            std::vector<Vertex3> per = localLimitFVar(lev, cur, curfv, v, sdcOpts);
+            Far::ConstIndexArray vf = lev.GetVertexFaces(v);
+            for (int i = 0; i < vf.size(); i++)
+                lim[(size_t)lev.GetFaceFVarValues(vf[i], 0)[cornerOf(lev, vf[i], v)]] = per[(size_t)i];
+        }
+        curfv.swap(lim);
+    }
     if (limit) {
         std::vector<Vertex3> pos(cur.size()), t1(cur.size()), t2(cur.size());
         primvar.Limit(cur, pos, t1, t2);
@@ -803,12 +266,18 @@ int main(int argc, char **argv) {
         std::fprintf(out, "v %.17g %.17g %.17g\n", cur[i].p[0], cur[i].p[1], cur[i].p[2]);
     for (size_t i = 0; i < nrm.size(); i++)
         std::fprintf(out, "vn %.17g %.17g %.17g\n", nrm[i].p[0], nrm[i].p[1], nrm[i].p[2]);
+    for (size_t i = 0; uv && i < curfv.size(); i++) {
+        std::fprintf(out, "vt");
+        for (int k = 0; k < m.uvWidth; k++) std::fprintf(out, " %.17g", curfv[i].p[k]);
+        std::fputc('\n', out);
+    }
     for (int f = 0; f < lev.GetNumFaces(); f++) {
         Far::ConstIndexArray fv = lev.GetFaceVertices(f);
         std::fputc('f', out);
         for (int i = 0; i < fv.size(); i++) {
-            if (normals) std::fprintf(out, " %d//%d", fv[i] + 1, fv[i] + 1);
-            else std::fprintf(out, " %d", fv[i] + 1);
+            std::fprintf(out, " %d", fv[i] + 1);
+            if (uv) std::fprintf(out, "/%d", lev.GetFaceFVarValues(f, 0)[i] + 1);
+            if (normals) std::fprintf(out, "%s/%d", uv ? "" : "/", fv[i] + 1);
         }
         std::fputc('\n', out);
     }
