@@ -15,6 +15,12 @@ $(B)/objdiff: tests/oracle/objdiff.c
 	@mkdir -p $(@D)
 	$(CC) $(ORACLE_CFLAGS) $< -o $@ -lm
 
-TEST_DEPS += $(B)/osd_refine $(B)/objdiff
+# fvar_oracle links the library too: ccnurbs' face-varying channels against OpenSubdiv in one
+# process (tests/oracle/run_fvar_shapes.sh)
+$(B)/fvar_oracle: tests/oracle/fvar_oracle.cpp tests/oracle/osd_oracle.h $(B)/libccnurbs.a csrc/include/ccnurbs.h
+	@mkdir -p $(@D)
+	$(CXX) $(ORACLE_CXXFLAGS) -Icsrc/include $< -o $@ $(B)/libccnurbs.a -losdCPU $(LDLIBS)
+
+TEST_DEPS += $(B)/osd_refine $(B)/objdiff $(B)/fvar_oracle
 DEPS_SCRIPTS += tests/oracle/osd_shapes_deps.sh
 .DEFAULT_GOAL := $(ORACLE_SAVED_GOAL)
