@@ -232,9 +232,10 @@ ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_
                              ccn_error *err);
 void ccn_plan_destroy(ccn_plan *plan);
 
-/* Face-varying channels on the plan's output: the topology of the values is built once per
- * channel; each evaluation refines the values and applies exact limit stencils, so new values
- * (same indices) need no rebuild. The output values are limit values at the output vertices
+/* Face-varying channels on the plan's output: ccn_plan_add_fvar refines the channel's value
+ * topology with the plan's levels and composes its exact limit stencils into weights over the
+ * channel's values, so each evaluation of new values (same indices) is one sparse product, no
+ * rebuild. The output values are limit values at the output vertices
  * (per value vertex: the corners of faces meeting at an output vertex on one side of a seam
  * share one value); face_values gives each output face corner (4 * num_faces, the order of
  * ccn_limit_mesh.face_verts) its value. In guided-cap holes the values are the exact limit of

@@ -1,22 +1,16 @@
 /* Face-varying channels and per-vertex data on a plan's output (surface/plan_fvar.h).
  *
- * A channel is the value mesh of refine/fvar.c refined through the plan's L levels in
- * lockstep with the vertex levels (their intervals and creases), plus the exact limit stencil
- * of every level-L value vertex built as for positions (surface/limit.c on the value mesh:
- * tensor B-spline stencils where the 3x3 neighbourhood is regular, one level finer next to
- * irregular value vertices, the stationary 1-ring matrix on seams, corners and creases, the
- * left eigenvectors of M at EVs, taken over from the positions' stencil where the value
- * vertex matches the vertex). Evaluation re-runs only the arithmetic: values through the
- * levels (3 components at a time), then the stencils. Mode ALL is bilinear: the level-L values
- * are the limit. Per-vertex data runs through the plan's own levels and stencils, on scratch
- * positions, so the plan's geometry stays that of the last ccn_plan_evaluate.
+ * A channel is its composed limit stencils (surface/fvar_compose.c): each output value as
+ * weights over the caller's values, so evaluating new values is one sparse product. Per-vertex
+ * data runs through the plan's own levels and stencils, on scratch positions, so the plan's
+ * geometry stays that of the last ccn_plan_evaluate.
  */
 #include "surface/plan_fvar.h"
 
 #include "base/error.h"
 #include "base/parallel.h"
 #include "refine/fvar.h"
-#include "surface/limit.h"
+#include "surface/fvar_compose.h"
 
 #include <math.h>
 #include <string.h>
@@ -24,164 +18,26 @@
 struct ccn__fvchan {
     int32_t width, ncage;
     double *cage_values;      /* width * ncage: the values given to ccn_plan_add_fvar */
-    int32_t *value_of;        /* level-0 value vertex -> cage value */
-    int32_t L;
-    ccn__fvar_level *lev;     /* L + 1 levels */
-    ccn__level *prep;         /* L prepared levels */
-    ccn__level sub;           /* level L -> L+1 around near[] (has_sub) */
-    int has_sub;
-    double *posS;             /* level-(L+1) points, 3 * (nf + ne + nv) of level L */
-    int32_t nnear, *near;
-    int32_t *st_start, *st_v; /* CSR per level-L value vertex; index >= nvL: an (L+1) point */
-    double *st_w;
-    int bilinear;
-    int32_t num_seams, num_sharp;
+    ccn__fvar_stencils s;
 };
 
 void ccn__fvchan_free(struct ccn__fvchan *c) {
     if (!c) return;
-    for (int32_t l = 0; c->lev && l <= c->L; l++) ccn__fvar_free(&c->lev[l]);
-    for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
-    if (c->has_sub) ccn__level_free(&c->sub);
-    free(c->lev); free(c->prep); free(c->posS); free(c->near); free(c->cage_values);
-    free(c->value_of); free(c->st_start); free(c->st_v); free(c->st_w);
+    ccn__fvar_stencils_free(&c->s);
+    free(c->cage_values);
     free(c);
-}
-
-/* ---- building a channel --------------------------------------------------------------- */
-
-typedef struct { int32_t n, cap; int32_t *v; double *w; } wbuf;
-
-static int push(wbuf *b, const ccn__stencil *s, int32_t off) {
-    if (b->n + s->n > b->cap) {
-        int64_t nc = 2 * (int64_t)b->cap + s->n + 1024;
-        if (nc > INT32_MAX) return -1;
-        int32_t *v = realloc(b->v, sizeof(int32_t) * (size_t)nc);
-        if (v) b->v = v;
-        double *w = realloc(b->w, sizeof(double) * (size_t)nc);
-        if (w) b->w = w;
-        if (!v || !w) return -1;
-        b->cap = (int32_t)nc;
-    }
-    for (int i = 0; i < s->n; i++) {
-        b->v[b->n] = s->v[i] + off;
-        b->w[b->n++] = s->wp[i];
-    }
-    return 0;
-}
-
-static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irr) {
-    if (irr[v]) return 1;
-    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-        int32_t f = m->hface[m->vfan[k]];
-        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
-            if (irr[m->hvert[h]]) return 1;
-    }
-    return 0;
-}
-
-/* A value vertex u at an interior EV of the value mesh has the vertex's fan, intervals and
- * scheme: its child stencil is the positions' stencil of vertex v, renumbered (level L+1 face
- * points keep their index, the edge points of v's spokes and v's vertex point map to u's). */
-static int reuse_ev_stencil(const ccn_plan *p, const ccn_mesh *fm, int32_t u, int32_t v,
-                            ccn__stencil *s) {
-    const ccn_mesh *vm = p->lev[p->L];
-    int32_t o = p->vmapL[v], nvL = vm->nv;
-    if (o < 0) return 0;
-    s->n = 0;
-    for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
-        int32_t i = p->st_v[k] - nvL, j = -1;
-        if (i < 0 || s->n >= CCN_STENCIL_MAX) return 0;
-        if (i < vm->nf) j = i;
-        else if (i >= vm->nf + vm->ne) j = i == vm->nf + vm->ne + v ? fm->nf + fm->ne + u : -1;
-        else
-            for (int32_t q = vm->vfan_start[v]; q < vm->vfan_start[v + 1] && j < 0; q++)
-                if (vm->hedge[vm->vfan[q]] == i - vm->nf) j = fm->nf + fm->hedge[vm->vfan[q]];
-        if (j < 0) return 0;
-        s->v[s->n] = j; s->wp[s->n] = p->st_wp[k]; s->wu[s->n] = s->wv[s->n] = 0.0;
-        s->n++;
-    }
-    return 1;
-}
-
-static ccn_status channel_stencils(const ccn_plan *p, struct ccn__fvchan *c, ccn_error *err) {
-    const ccn__fvar_level *fl = &c->lev[c->L];
-    const ccn_mesh *m = fl->m;
-    ccn__stencil *s = malloc(sizeof *s);
-    ccn__ring_limit *ring = malloc(sizeof *ring);
-    ccn__ring_work *work = ccn__ring_work_create();
-    uint8_t *irr = malloc((size_t)m->nv);
-    wbuf b = {0, 0, NULL, NULL};
-    c->st_start = malloc(sizeof(int32_t) * ((size_t)m->nv + 1));
-    c->near = malloc(sizeof(int32_t) * (size_t)m->nv);
-    ccn_status st = CCN_OK;
-    if (!s || !ring || !work || !irr || !c->st_start || !c->near) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-        goto done;
-    }
-    c->st_start[0] = 0;
-    for (int32_t v = 0; v < m->nv; v++) irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR;
-    for (int32_t v = 0; v < m->nv && !st; v++) {
-        int32_t off = 0;
-        if (!near_irregular(m, v, irr)) {
-            ccn__limit_stencil(m, v, 0, s);
-        } else {
-            c->near[c->nnear++] = v;
-            off = m->nv;
-            if (!(ccn__limit_kind(m, v, 0) == CCN_LIMIT_EV && reuse_ev_stencil(p, m, v, fl->vvert[v], s)))
-                st = ccn__child_limit_stencil(m, v, 0, p->opts.scheme, p->opts.crease_method, work, s,
-                                              ring, err);
-        }
-        if (!st && push(&b, s, off))
-            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-        c->st_start[v + 1] = b.n;
-    }
-done:
-    c->st_v = b.v;
-    c->st_w = b.w;
-    free(s); free(ring); free(irr);
-    ccn__ring_work_destroy(work);
-    return st;
 }
 
 static ccn_status build_channel(ccn_plan *p, const ccn_fvar_channel *ch, struct ccn__fvchan *c,
                                 ccn_error *err) {
-    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     c->width = ch->width;
     c->ncage = ch->num_values;
-    c->L = p->L;
-    c->bilinear = ch->linear == CCN_FVAR_LINEAR_ALL;
     size_t nval = (size_t)ch->width * (size_t)ch->num_values;
     c->cage_values = malloc(sizeof(double) * nval);
-    c->lev = calloc((size_t)c->L + 1, sizeof *c->lev);
-    c->prep = calloc((size_t)(c->L ? c->L : 1), sizeof *c->prep);
-    if (!c->cage_values || !c->lev || !c->prep)
+    if (!c->cage_values)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     memcpy(c->cage_values, ch->values, sizeof(double) * nval);
-    ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
-    if (st) return st;
-    c->num_seams = c->lev[0].num_seams;
-    for (int32_t l = 0; l < c->L; l++) {
-        if ((st = ccn__fvar_prepare(&c->prep[l], &c->lev[l], p->opts.scheme, p->opts.crease_method, err))) {
-            memset(&c->prep[l], 0, sizeof c->prep[l]);
-            return st;
-        }
-        c->prep[l].threads = p->threads;
-        if ((st = ccn__fvar_child(&c->lev[l], &c->prep[l], p->lev[l], p->lev[l + 1], &c->lev[l + 1], err)))
-            return st;
-    }
-    const ccn_mesh *mL = c->lev[c->L].m;
-    c->num_sharp = ccn__fvar_num_sharp(&c->lev[c->L]);
-    if (c->bilinear) return CCN_OK;
-    if ((st = channel_stencils(p, c, err))) return st;
-    if (c->nnear) {
-        if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method, err)))
-            return st;
-        c->has_sub = 1;
-        c->posS = malloc(sizeof(double) * 3 * ((size_t)mL->nf + mL->ne + mL->nv));
-        if (!c->posS) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
-    }
-    return CCN_OK;
+    return ccn__fvar_compose(p, ch, &c->s, err);
 }
 
 ccn_status ccn_plan_add_fvar(ccn_plan *p, const ccn_fvar_channel *ch, int32_t *channel,
@@ -211,10 +67,10 @@ ccn_status ccn_plan_fvar_sizes(const ccn_plan *p, int32_t channel, ccn_fvar_size
     if (!p || !s || channel < 0 || channel >= p->nfv) return CCN_ERR_ARGUMENT;
     const struct ccn__fvchan *c = p->fv[channel];
     s->width = c->width;
-    s->num_values = c->lev[c->L].m->nv;
+    s->num_values = c->s.nout;
     s->num_cage_values = c->ncage;
-    s->num_seam_edges = c->num_seams;
-    s->num_sharp_values = c->num_sharp;
+    s->num_seam_edges = c->s.num_seams;
+    s->num_sharp_values = c->s.num_sharp;
     return CCN_OK;
 }
 
@@ -240,20 +96,59 @@ static ccn_status check_values(const double *v, int32_t w, int32_t n, ccn_error 
 typedef struct {
     const int32_t *start, *idx; const double *w;
     const double *PL, *PS; int32_t nvL;
-    double *out; int32_t width, c0, e;
+    double *out; int32_t width, c0;
+    double up; /* the power-of-two scale back */
 } apply_job;
 
+/* Level-L points and level-(L+1) points (index >= nvL) through stencils (vertex data). */
 static void apply_range(void *ctx, int32_t b, int32_t end) {
     const apply_job *j = ctx;
-    int nk = j->width - j->c0 < 3 ? j->width - j->c0 : 3;
+    const int32_t *start = j->start, *idx = j->idx, nvL = j->nvL, width = j->width, c0 = j->c0;
+    const double *w = j->w, *PL = j->PL, *PS = j->PS, up = j->up;
+    double *out = j->out;
+    int nk = width - c0 < 3 ? width - c0 : 3;
     for (int32_t o = b; o < end; o++) {
-        double x[3] = {0, 0, 0};
-        for (int32_t k = j->start[o]; k < j->start[o + 1]; k++) {
-            int32_t i = j->idx[k];
-            const double *q = i < j->nvL ? j->PL + 3 * (size_t)i : j->PS + 3 * ((size_t)i - j->nvL);
-            for (int c = 0; c < 3; c++) x[c] += j->w[k] * q[c];
+        double x0 = 0, x1 = 0, x2 = 0;
+        for (int32_t k = start[o]; k < start[o + 1]; k++) {
+            int32_t i = idx[k];
+            const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
+            double wk = w[k];
+            x0 += wk * q[0]; x1 += wk * q[1]; x2 += wk * q[2];
         }
-        for (int c = 0; c < nk; c++) j->out[(size_t)j->width * o + j->c0 + c] = ldexp(x[c], j->e);
+        double *dst = out + (size_t)width * o + c0;
+        dst[0] = up * x0;
+        if (nk > 1) dst[1] = up * x1;
+        if (nk > 2) dst[2] = up * x2;
+    }
+}
+
+typedef struct { const ccn__fvar_stencils *s; const double *vals; double *out; int32_t width; } spmv_job;
+
+static void spmv_range(void *ctx, int32_t b, int32_t end) {
+    const spmv_job *j = ctx;
+    const int32_t *start = j->s->start, *idx = j->s->idx, w = j->width;
+    const double *wt = j->s->w, *vals = j->vals;
+    double *out = j->out;
+    if (w == 2) { /* UV maps */
+        for (int32_t o = b; o < end; o++) {
+            double x = 0, y = 0;
+            for (int32_t k = start[o]; k < start[o + 1]; k++) {
+                const double *v = vals + 2 * (size_t)idx[k];
+                x += wt[k] * v[0];
+                y += wt[k] * v[1];
+            }
+            out[2 * (size_t)o] = x;
+            out[2 * (size_t)o + 1] = y;
+        }
+        return;
+    }
+    for (int32_t o = b; o < end; o++) {
+        double *dst = out + (size_t)w * o;
+        for (int32_t c = 0; c < w; c++) dst[c] = 0.0;
+        for (int32_t k = start[o]; k < start[o + 1]; k++) {
+            const double *v = vals + (size_t)w * idx[k];
+            for (int32_t c = 0; c < w; c++) dst[c] += wt[k] * v[c];
+        }
     }
 }
 
@@ -267,24 +162,9 @@ ccn_status ccn_plan_evaluate_fvar(ccn_plan *p, int32_t channel, const double *va
     const double *vals = values ? values : c->cage_values;
     ccn_status st = check_values(vals, c->width, c->ncage, err);
     if (st) return st;
-    int32_t w = c->width, e = value_exponent(vals, (size_t)w * (size_t)c->ncage);
-    ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
-    for (int32_t c0 = 0; c0 < w; c0 += 3) {
-        for (int32_t v = 0; v < m0->nv; v++)
-            for (int k = 0; k < 3; k++)
-                m0->pos[3 * (size_t)v + k] = c0 + k < w ? ldexp(vals[(size_t)w * c->value_of[v] + c0 + k], -e) : 0.0;
-        for (int32_t l = 0; l < c->L; l++) ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
-        if (c->bilinear) {
-            int nk = w - c0 < 3 ? w - c0 : 3;
-            for (int32_t v = 0; v < mL->nv; v++)
-                for (int k = 0; k < nk; k++) out_values[(size_t)w * v + c0 + k] = ldexp(mL->pos[3 * (size_t)v + k], e);
-            continue;
-        }
-        if (c->has_sub) ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
-        apply_job j = {c->st_start, c->st_v, c->st_w, mL->pos, c->posS, mL->nv, out_values, w, c0, e};
-        ccn__parallel_for(p->threads, mL->nv, apply_range, &j);
-    }
-    if (face_values) memcpy(face_values, mL->hvert, sizeof(int32_t) * (size_t)mL->nh);
+    spmv_job j = {&c->s, vals, out_values, c->width};
+    ccn__parallel_for(p->threads, c->s.nout, spmv_range, &j);
+    if (face_values) memcpy(face_values, c->s.face_values, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
 }
 
@@ -318,14 +198,15 @@ ccn_status ccn_plan_evaluate_vertex_data(ccn_plan *p, int32_t width, const doubl
     }
     double *PS = p->has_sub ? buf : p->R > p->L ? p->lev[p->L + 1]->pos : NULL;
     int e = value_exponent(data, (size_t)width * (size_t)p->ncage);
+    double down = ldexp(1.0, -e), up = ldexp(1.0, e);
     ccn_mesh *m0 = p->lev[0];
     for (int32_t c0 = 0; c0 < width; c0 += 3) {
         for (int32_t v = 0; v < m0->nv; v++)
             for (int k = 0; k < 3; k++)
-                m0->pos[3 * (size_t)v + k] = c0 + k < width ? ldexp(data[(size_t)width * v + c0 + k], -e) : 0.0;
+                m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * data[(size_t)width * v + c0 + k] : 0.0;
         for (int32_t l = 0; l < top; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
         if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, PS);
-        apply_job j = {p->st_start, p->st_v, p->st_wp, mL->pos, PS, mL->nv, out, width, c0, e};
+        apply_job j = {p->st_start, p->st_v, p->st_wp, mL->pos, PS, mL->nv, out, width, c0, up};
         ccn__parallel_for(p->threads, p->nout_v, apply_range, &j);
     }
     for (int32_t l = 0; l <= top; l++) p->lev[l]->pos = saved[l];
