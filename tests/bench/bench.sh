@@ -23,6 +23,17 @@ done
 echo "refine ratio = ccn_refine (topology + points) / OSD uniform refinement (topology + points);"
 echo "evaluate ratio = plan evaluate (positions + normals) / OSD re-interpolation + Limit with tangents;"
 echo "plan ratio = plan creation / OSD topology + points + limit."
+echo "One UV channel (the cages' box unwrap, --cap refine; target: <= 1.5x the plan without):"
+echo "mesh level | plan | plan + uv | ratio | evaluate | evaluate + uv | ratio | memory MB | memory + uv MB | ratio"
+for cage in sphere8k carlike carlike_knots; do
+  for L in 2 3; do
+    u=$(build/bench/ccn_bench "$D/$cage.obj" "$L" refine 3 | grep '^ccn uv') || exit 2
+    num() { echo "$u" | sed -n "s/.*$1 \([0-9.]*\) \(s\|MB\).*/\1/p"; }
+    p0=$(num "plan"); p1=$(num "plan [0-9.]* s, with uv"); e0=$(num "evaluate"); e1=$(num "evaluate [0-9.]* s, with uv")
+    m0=$(num "memory"); m1=$(num "memory [0-9.]* MB, with uv")
+    echo "$cage L$L | $p0 | $p1 | $(ratio "$p1" "$p0") | $e0 | $e1 | $(ratio "$e1" "$e0") | $m0 | $m1 | $(ratio "$m1" "$m0")"
+  done
+done
 if command -v blender > /dev/null; then
   echo "Blender $(blender --version 2>/dev/null | head -n 1 | cut -d' ' -f2): CCNURBS modifier vs Subdivision Surface, same density (ratio = ours / Subsurf):"
   tmp=$(mktemp -d) || exit 2
