@@ -334,7 +334,7 @@ static void test_uv_corners_follow_mode(void) {
         ccn_fvar_channel ch = grid_channel(&g, t < 2 ? CCN_FVAR_LINEAR_CORNERS_ONLY : CCN_FVAR_LINEAR_NONE);
         ccn_plan *p = NULL;
         ccn_error err;
-        int32_t c;
+        int32_t c = -1;
         CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK && ccn_plan_add_fvar(p, &ch, &c, &err) == CCN_OK, "%s", err.message);
         ccn_sizes s;
         ccn_fvar_sizes fs;

@@ -8,7 +8,9 @@
 # FVarLinearInterpolation modes, the refined values (ccn_fvar_refine vs InterpolateFaceVarying)
 # and the limit values (ccn_plan_evaluate_fvar vs OpenSubdiv's exact limits) per face corner,
 # <= 1e-9 of the UV bounding box (and the corner positions, so the corners are the same).
-# One line per shape, level and scheme, then "N passed, N failed". Shapes come as for
+# Then the CLI's UV path (OBJ vt in and out) on three shapes against osd_refine's vt output,
+# per face corner (objdiff --uv). One line per shape, level and scheme (and CLI comparison),
+# then "N passed, N failed". Shapes come as for
 # tests/oracle/run_osd_shapes.sh (OSD_SHAPES, or the cache tests/oracle/osd_shapes_deps.sh fills).
 # Environment (optional): OSD_SHAPES, OSD_SHAPES_ONLY (names), FVAR_LEVELS (default "1 2 3"),
 # FVAR_SCHEMES (default cc,eigen), ORACLE_TIMEOUT (seconds per shape, default 120).
@@ -60,6 +62,31 @@ for name in $scope; do
   pass=$((pass + p)); fail=$((fail + f))
 done
 [ "$shapes" -gt 0 ] || { echo "FAIL no shape with a UV map"; fail=$((fail + 1)); }
+
+# The CLI's UV path (OBJ vt in, refined / limit vt out) on a few shapes, against osd_refine's
+# vt output, compared per face corner by build/objdiff --uv (vertex and face order free).
+CCN=${CCNURBS:-build/ccnurbs}
+for name in ${FVAR_CLI_SHAPES:-catmark_fvar_bound1 catmark_fvar_bound3 catmark_cube}; do
+  in="$dir/$name.obj"
+  [ -f "$in" ] || { echo "FAIL $name: no $in"; fail=$((fail + 1)); continue; }
+  for mode in corners-plus1 boundaries none; do
+    for kind in refine limit; do
+      if [ $kind = refine ]; then
+        $TO "$CCN" refine --scheme eigen --levels 2 --fvar-linear $mode "$in" "$tmp/c.obj" >"$tmp/log" 2>&1 &&
+          $TO build/osd_refine --levels 2 --fvar-linear $mode "$in" "$tmp/o.obj" >>"$tmp/log" 2>&1
+      else
+        $TO "$CCN" limit --cap refine --scheme eigen --levels 2 --fvar-linear $mode "$in" "$tmp/c.obj" >"$tmp/log" 2>&1 &&
+          $TO build/osd_refine --limit --levels 2 --fvar-linear $mode "$in" "$tmp/o.obj" >>"$tmp/log" 2>&1
+      fi
+      if [ $? -ne 0 ]; then echo "FAIL $name CLI $kind $mode: $(head -c 300 "$tmp/log")"; fail=$((fail + 1)); continue; fi
+      if msg=$(build/objdiff --uv 1e-9 "$tmp/o.obj" "$tmp/c.obj" 2>&1); then
+        echo "ok   $name CLI L2 eigen $kind --fvar-linear $mode: $msg"; pass=$((pass + 1))
+      else
+        echo "FAIL $name CLI L2 eigen $kind --fvar-linear $mode: $msg"; fail=$((fail + 1))
+      fi
+    done
+  done
+done
 echo "$shapes shapes with UV maps"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ]
