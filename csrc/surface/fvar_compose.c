@@ -268,7 +268,25 @@ static int32_t colour(const ccn_mesh *m, const csr *K, int32_t *col) {
     I.start[0] = 0;
     for (int32_t c = 0; c <= nv; c++) mark[c] = -1;
     for (int32_t v = 0; v < nv; v++) col[v] = -1;
-    for (int32_t v = 0; v < nv; v++) {
+    /* breadth-first order over the value mesh's edges: fronts colour like a tiling */
+    int32_t *order = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1)), head = 0, tail = 0;
+    uint8_t *queued = calloc((size_t)(nv ? nv : 1), 1);
+    if (!order || !queued) { free(order); free(queued); free(I.start); free(I.list); free(mark); return -1; }
+    for (int32_t s0 = 0; s0 < nv; s0++) {
+        if (queued[s0]) continue;
+        queued[s0] = 1;
+        order[tail++] = s0;
+        while (head < tail) {
+            int32_t u = order[head++];
+            for (int32_t q = m->vfan_start[u]; q < m->vfan_start[u + 1]; q++) {
+                int32_t h = m->vfan[q], a = m->hvert[ccn__next(m, h)], z = m->hvert[ccn__prev(m, h)];
+                if (!queued[a]) { queued[a] = 1; order[tail++] = a; }
+                if (!queued[z]) { queued[z] = 1; order[tail++] = z; }
+            }
+        }
+    }
+    for (int32_t t = 0; t < nv; t++) {
+        int32_t v = order[t];
         for (int32_t i = I.start[v]; i < I.start[v + 1]; i++) {
             int32_t f = I.list[i];
             for (int32_t k = K->start[f]; k < K->start[f + 1]; k++)
@@ -279,6 +297,7 @@ static int32_t colour(const ccn_mesh *m, const csr *K, int32_t *col) {
         col[v] = c;
         if (c + 1 > ncol) ncol = c + 1;
     }
+    free(order); free(queued);
     free(I.start); free(I.list); free(mark);
     return ncol;
 }
@@ -293,10 +312,9 @@ static void origin_faces(const ccn_plan *p, const ccn_mesh *mL, int32_t *fo) {
 }
 
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
- * stencil run; W[o * ncol + 3b + k] gets output o's result for colour 3b + k (out: scratch, 3
- * per output value). */
-static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, int32_t ncol,
-                  double *out, double *W) {
+ * stencil run (out: 3 per output value); each candidate weight of those colours is read off. */
+static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, double *out,
+                  const ccn__fvar_stencils *cand, const int32_t *ccol, double *cw) {
     ccn_mesh *m0 = c->lev[0].m;
     for (int32_t v = 0; v < m0->nv; v++)
         for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
@@ -306,7 +324,10 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
     int32_t nout = c->lev[c->L].m->nv;
     ccn__parallel_for(p->threads, nout, limit_range, &j);
     for (int32_t o = 0; o < nout; o++)
-        for (int k = 0; k < 3 && 3 * b + k < ncol; k++) W[(size_t)o * ncol + 3 * b + k] = out[3 * (size_t)o + k];
+        for (int32_t e = cand->start[o]; e < cand->start[o + 1]; e++) {
+            int32_t cu = ccol[e] - 3 * b;
+            if ((uint32_t)cu < 3u) cw[e] = out[3 * (size_t)o + cu];
+        }
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
@@ -314,45 +335,56 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     int32_t nout = mL->nv;
     csr K = {NULL, NULL};
     int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv), *fo = malloc(sizeof(int32_t) * (size_t)nout);
-    double *W = NULL, *out3 = malloc(sizeof(double) * 3 * (size_t)nout);
-    int32_t ncol = -1;
+    double *out3 = malloc(sizeof(double) * 3 * (size_t)nout);
+    int32_t ncol = -1, *ccol = NULL;
     ccn_status st = CCN_OK;
     if (col && fo && !neighbourhoods(m0, &K)) ncol = colour(m0, &K, col);
-    int32_t npass = (ncol + 2) / 3;
-    if (ncol > 0) W = malloc(sizeof(double) * (size_t)ncol * (size_t)nout);
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
-    if (ncol < 0 || !W || !out3 || !s->start) {
+    if (ncol < 0 || !out3 || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
-    for (int32_t b = 0; b < npass; b++) probe(p, c, col, b, ncol, out3, W);
+    /* the candidates: for each output, the value vertices of its cage face's neighbourhood */
     origin_faces(p, mL, fo);
-    /* the stencils: for each output, the values of its neighbourhood with their weights */
     int64_t total = 0;
     for (int32_t o = 0; o < nout; o++) total += K.start[fo[o] + 1] - K.start[fo[o]];
     if (total > INT32_MAX) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large"); goto done; }
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
-    s->w = malloc(sizeof(double) * (size_t)(total ? total : 1));
+    s->w = calloc((size_t)(total ? total : 1), sizeof(double));
     if (!s->idx || !s->w) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
-    int32_t n = 0;
+    ccol = malloc(sizeof(int32_t) * (size_t)(total ? total : 1)); /* each candidate's colour */
+    if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
     s->start[0] = 0;
+    for (int32_t o = 0, n = 0; o < nout; o++) {
+        for (int32_t k = K.start[fo[o]]; k < K.start[fo[o] + 1]; k++) {
+            ccol[n] = col[K.list[k]];
+            s->idx[n++] = K.list[k];
+        }
+        s->start[o + 1] = n;
+    }
+    for (int32_t b = 0; 3 * b < ncol; b++) probe(p, c, col, b, out3, s, ccol, s->w);
+    free(ccol);
+    ccol = NULL;
+    /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
+     * value vertices once), and every stencil sums to 1 */
+    int32_t n = 0, e0 = 0;
     for (int32_t o = 0; o < nout && !st; o++) {
-        int32_t f = fo[o], first = n;
+        int32_t first = n, e1 = s->start[o + 1]; /* the row as built (start is rewritten) */
         double sum = 0.0;
-        for (int32_t k = K.start[f]; k < K.start[f + 1]; k++) {
-            int32_t u = K.list[k], cu = col[u];
-            double w = W[(size_t)o * ncol + cu];
+        for (int32_t e = e0; e < e1; e++) {
+            double w = s->w[e];
             if (w == 0.0) continue;
             sum += w;
-            int32_t val = c->value_of[u], e = first;
-            while (e < n && s->idx[e] != val) e++; /* a value on two value vertices: once */
-            if (e < n) s->w[e] += w;
+            int32_t val = c->value_of[s->idx[e]], q = first;
+            while (q < n && s->idx[q] != val) q++;
+            if (q < n) s->w[q] += w;
             else { s->idx[n] = val; s->w[n++] = w; }
         }
         if (!(fabs(sum - 1.0) <= 1e-9)) /* weight outside the neighbourhood: cannot happen */
             st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
                            "face-varying stencil of output value %d sums to %.17g", (int)o, sum);
         s->start[o + 1] = n;
+        e0 = e1;
     }
     if (!st) {
         int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
@@ -361,7 +393,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         if (b) s->w = b;
     }
 done:
-    free(K.start); free(K.list); free(col); free(fo); free(W); free(out3);
+    free(K.start); free(K.list); free(col); free(fo); free(out3); free(ccol);
     return st;
 }
 
