@@ -22,6 +22,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "refine/fvar.h"
+#include "rules/crease.h"
 #include "surface/limit.h"
 
 #include <math.h>
@@ -112,6 +113,26 @@ static int reuse_ev_stencil(const ccn_plan *p, const ccn_mesh *fm, int32_t u, in
     return 1;
 }
 
+/* A value whose rule follows its partner's sharpness (OpenSubdiv's dependent sharpness): does
+ * the partner still have semi-sharp edges (then the value's limit is taken one level finer,
+ * where the sub level applied the rule), and their sharpness one level finer, the largest, to
+ * take as the value's own vertex sharpness there (the same corner-to-crease levels and
+ * fractional weight when one edge is semi-sharp, as in the shapes that have it; 0: none). */
+static int partner_semisharp(const ccn__fvar_level *fl, int32_t v, int method, float *child) {
+    const ccn_mesh *m = fl->m;
+    *child = 0.0f;
+    if (!fl->partner || fl->partner[v] < 0 || !m->esharp) return 0;
+    int32_t a = fl->partner[v], n = ccn__valence(m, a), semi = 0;
+    for (int32_t k = 0; k < n; k++) {
+        if (m->vboundary[a] && (k == 0 || k == n - 1)) continue;
+        int32_t e = ccn__fan_edge(m, a, k);
+        semi |= m->esharp[e] > 0.0f && m->esharp[e] < CCN_SHARPNESS_INFINITE;
+        float cs = ccn__child_edge_sharpness(m, method, e, a);
+        if (cs > 0.0f && cs < CCN_SHARPNESS_INFINITE && cs > *child) *child = cs;
+    }
+    return semi;
+}
+
 static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) {
     const ccn__fvar_level *fl = &c->lev[c->L];
     const ccn_mesh *m = fl->m;
@@ -128,11 +149,23 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
         goto done;
     }
     c->st_start[0] = 0;
-    for (int32_t v = 0; v < m->nv; v++) irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR;
+    float dep;
+    for (int32_t v = 0; v < m->nv; v++)
+        irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(fl, v, p->opts.crease_method, &dep);
     for (int32_t v = 0; v < m->nv && !st; v++) {
         int32_t off = 0;
+        partner_semisharp(fl, v, p->opts.crease_method, &dep);
         if (!near_irregular(m, v, irr)) {
             ccn__limit_stencil(m, v, 0, s);
+        } else if (dep > 0.0f) { /* the partner's sharpness as its own */
+            c->near[c->nnear++] = v;
+            off = m->nv;
+            st = ccn__ring_limit_eval_vs(m, v, p->opts.scheme, 0, p->opts.crease_method, dep, work, ring, err);
+            s->n = 0;
+            for (int32_t i = 0; !st && i < ring->npts; i++) {
+                s->v[s->n] = ring->pts[i]; s->wp[s->n] = ring->wp[i]; s->wu[s->n] = s->wv[s->n] = 0.0;
+                s->n++;
+            }
         } else {
             c->near[c->nnear++] = v;
             off = m->nv;
