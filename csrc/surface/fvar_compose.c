@@ -347,7 +347,7 @@ static void origin_faces(const ccn_plan *p, const ccn_mesh *mL, int32_t *fo) {
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
  * stencil run (out: 3 per output value); each candidate weight of those colours is read off. */
 static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, double *out,
-                  const ccn__fvar_stencils *cand, const int32_t *ccol, double *cw) {
+                  const int32_t *bucket, const int32_t *owner, const int32_t *ccol, double *cw) {
     ccn_mesh *m0 = c->lev[0].m;
     for (int32_t v = 0; v < m0->nv; v++)
         for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
@@ -356,11 +356,10 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
     limit_job j = {c, out};
     int32_t nout = c->lev[c->L].m->nv;
     ccn__parallel_for(p->threads, nout, limit_range, &j);
-    for (int32_t o = 0; o < nout; o++)
-        for (int32_t e = cand->start[o]; e < cand->start[o + 1]; e++) {
-            int32_t cu = ccol[e] - 3 * b;
-            if ((uint32_t)cu < 3u) cw[e] = out[3 * (size_t)o + cu];
-        }
+    for (int32_t i = bucket[b]; i < bucket[b + 1]; i++) { /* the candidates of these colours */
+        int32_t e = owner[2 * (size_t)i], o = owner[2 * (size_t)i + 1];
+        cw[e] = out[3 * (size_t)o + ccol[e] - 3 * b];
+    }
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
@@ -369,7 +368,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     csr K = {NULL, NULL};
     int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv), *fo = malloc(sizeof(int32_t) * (size_t)nout);
     double *out3 = malloc(sizeof(double) * 3 * (size_t)nout);
-    int32_t ncol = -1, *ccol = NULL;
+    int32_t ncol = -1, *ccol = NULL, *bucket = NULL, *owner = NULL;
     ccn_status st = CCN_OK;
     if (col && fo && !neighbourhoods(m0, &K)) ncol = colour(m0, &K, col);
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
@@ -395,9 +394,24 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         }
         s->start[o + 1] = n;
     }
-    for (int32_t b = 0; 3 * b < ncol; b++) probe(p, c, col, b, out3, s, ccol, s->w);
-    free(ccol);
-    ccol = NULL;
+    /* the candidates by pass (counting sort): (entry, output) pairs */
+    int32_t npass = (ncol + 2) / 3;
+    bucket = calloc((size_t)npass + 1, sizeof(int32_t));
+    owner = malloc(sizeof(int32_t) * 2 * (size_t)(total ? total : 1));
+    if (!bucket || !owner) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    for (int32_t e = 0; e < (int32_t)total; e++) bucket[ccol[e] / 3 + 1]++;
+    for (int32_t b = 0; b < npass; b++) bucket[b + 1] += bucket[b];
+    for (int32_t o = 0; o < nout; o++)
+        for (int32_t e = s->start[o]; e < s->start[o + 1]; e++) {
+            int32_t i = bucket[ccol[e] / 3]++;
+            owner[2 * (size_t)i] = e;
+            owner[2 * (size_t)i + 1] = o;
+        }
+    for (int32_t b = npass; b > 0; b--) bucket[b] = bucket[b - 1];
+    bucket[0] = 0;
+    for (int32_t b = 0; b < npass; b++) probe(p, c, col, b, out3, bucket, owner, ccol, s->w);
+    free(ccol); free(bucket); free(owner);
+    ccol = bucket = owner = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
      * value vertices once), and every stencil sums to 1 */
     int32_t n = 0, e0 = 0;
@@ -426,7 +440,8 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         if (b) s->w = b;
     }
 done:
-    free(K.start); free(K.list); free(col); free(fo); free(out3); free(ccol);
+    free(K.start); free(K.list); free(col); free(fo); free(out3); free(ccol); free(bucket);
+    free(owner);
     return st;
 }
 
