@@ -130,10 +130,11 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
  * default is ALL. */
 typedef enum {
     CCN_FVAR_LINEAR_NONE = 0,      /* smooth everywhere, seams are smooth boundaries ("All") */
-    CCN_FVAR_LINEAR_CORNERS_ONLY,  /* sharpen corners ("Keep Corners", Blender's default) */
+    CCN_FVAR_LINEAR_CORNERS_ONLY,  /* sharpen corners ("Keep Corners") */
     CCN_FVAR_LINEAR_CORNERS_PLUS1, /* and junctions of 3+ values ("Keep Corners, Junctions") */
     CCN_FVAR_LINEAR_CORNERS_PLUS2, /* and darts, corners of 2 values ("..., Concave") */
-    CCN_FVAR_LINEAR_BOUNDARIES,    /* linear along seams and boundaries ("Keep Boundaries") */
+    CCN_FVAR_LINEAR_BOUNDARIES,    /* linear along seams and boundaries ("Keep Boundaries",
+                                      what a new Subdivision Surface modifier gets) */
     CCN_FVAR_LINEAR_ALL            /* bilinear everywhere ("None") */
 } ccn_fvar_linear;
 
