@@ -18,7 +18,8 @@ bl_info = {
 }
 
 _SUBMODULES = ("compat", "native", "cage", "props", "values", "knots", "modifier", "tap",
-               "proxies", "sync", "hygiene", "overlay", "handlers", "objio", "operators", "ui")
+               "proxies", "sync", "hygiene", "overlay", "handlers", "objio", "operators", "errors",
+               "ui")
 if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency order
     import importlib
     for _name in _SUBMODULES:
@@ -28,9 +29,10 @@ if "bpy" in locals():  # Reload Scripts: reload the submodules in dependency ord
 import bpy  # noqa: E402
 
 from . import (compat, native, cage, props, values, knots, modifier, tap, proxies,  # noqa: E402
-               sync, hygiene, overlay, handlers, objio, operators, ui)
+               sync, hygiene, overlay, handlers, objio, operators, errors, ui)
 
-_classes = props.classes + knots.classes + objio.classes + operators.classes + ui.classes
+_classes = (props.classes + knots.classes + objio.classes + operators.classes + errors.classes
+            + ui.classes)
 
 
 def register():

@@ -44,6 +44,14 @@ def set_vertex_normals(mesh, normals):
     mesh.normals_split_custom_set_from_vertices(normals)
 
 
+def set_corner_normals(mesh, normals):
+    """Custom split normals per face corner (loop order), smooth shading: each side of a crease
+    keeps its own exact normal. < 4.1 needs `use_auto_smooth`, as above."""
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = True
+    mesh.normals_split_custom_set(normals)
+
+
 def use_plain_normals(mesh):
     """Blender's own smooth vertex normals (no custom normals): < 4.1 turns auto smooth off
     (custom normals are then ignored); 4.1+ has none after `clear_geometry`."""

@@ -20,6 +20,7 @@ c_double_p = ctypes.POINTER(ctypes.c_double)
 SCHEMES = {"EIGEN": 0, "NURSS": 1, "CATMULL_CLARK": 2}
 CAPS = {"GUIDED_BI5": 0, "REFINE": 1}
 CORNERS = {"ALL": 0, "PRESERVE_CORNERS": 1}
+CREASE_METHODS = {"UNIFORM": 0, "CHAIKIN": 1}
 # ccn_fvar_linear from Blender's UV Smooth (Subdivision Surface's names): OpenSubdiv's modes
 FVAR_LINEAR = {"SMOOTH_ALL": 0, "PRESERVE_CORNERS": 1, "PRESERVE_CORNERS_AND_JUNCTIONS": 2,
                "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": 3, "PRESERVE_BOUNDARIES": 4, "NONE": 5}
@@ -87,7 +88,8 @@ class ccn_limit_mesh(ctypes.Structure):
                 ("normals", c_double_p),
                 ("face_verts", c_int32_p),
                 ("face_origin", c_int32_p),
-                ("corner_normals", c_double_p)]
+                ("corner_normals", c_double_p),
+                ("corner_edge_origin", c_int32_p)]
 
 
 class ccn_fvar_channel(ctypes.Structure):
@@ -193,14 +195,14 @@ class Plan:
     """A ccn_plan: topology, knot intervals and options, evaluated for new positions.
 
     cage: positions (V,3), face_sizes (F,), face_verts (sum,), edge_verts (E,2) or None,
-    edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None (passed as
-    ccn_cage.edge_creases, which the library reserves and does not use yet).
-    options: scheme/cap/boundary (enum identifiers), levels.
+    edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None and
+    vertex_sharpness (V,) or None (OpenSubdiv sharpness: ccn_cage.edge_creases / vertex_creases).
+    options: scheme/cap/boundary/crease_method (enum identifiers), levels.
     """
 
     def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
                  scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0,
-                 edge_sharpness=None):
+                 edge_sharpness=None, vertex_sharpness=None, crease_method="UNIFORM"):
         lib = load()
         self._lib = lib
         self._handle = None
@@ -220,14 +222,23 @@ class Plan:
                 es = np.ascontiguousarray(edge_sharpness, dtype=np.float64).reshape(-1)
         if pos.size % 3:
             raise CCNError("CCN_ERR_ARGUMENT", "positions must be 3 floats per vertex")
+        vs = None
+        if vertex_sharpness is not None:
+            vs = np.ascontiguousarray(vertex_sharpness, dtype=np.float64).reshape(-1)
+            if vs.size * 3 != pos.size:
+                raise CCNError("CCN_ERR_ARGUMENT", "vertex_sharpness has %d values for %d vertices"
+                               % (vs.size, pos.size // 3))
+        self._keep = (pos, fs, fv, ev, ek, es, vs)  # the arrays must outlive plan creation
         cage = ccn_cage(num_verts=pos.size // 3, num_faces=fs.size,
                         num_edges=(ev.size // 2) if ev is not None else 0,
                         positions=_ptr(pos, ctypes.c_double), face_sizes=_ptr(fs, ctypes.c_int32),
                         face_verts=_ptr(fv, ctypes.c_int32), edge_verts=_ptr(ev, ctypes.c_int32),
                         edge_knots=_ptr(ek, ctypes.c_double),
-                        edge_creases=_ptr(es, ctypes.c_double))
+                        edge_creases=_ptr(es, ctypes.c_double),
+                        vertex_creases=_ptr(vs, ctypes.c_double))
         opts = ccn_options(scheme=SCHEMES[scheme], cap=CAPS[cap], levels=int(levels),
-                           boundary_corners=CORNERS[boundary], threads=int(threads))
+                           boundary_corners=CORNERS[boundary], threads=int(threads),
+                           crease_method=CREASE_METHODS[crease_method])
         handle = ctypes.c_void_p()
         err = ccn_error()
         st = lib.ccn_plan_create(ctypes.byref(cage), ctypes.byref(opts), ctypes.byref(handle),
@@ -243,19 +254,26 @@ class Plan:
         self.sizes = {name: int(getattr(s, name)) for name, _ in ccn_sizes._fields_}
 
     def evaluate(self, positions=None, topology=True):
-        """Returns dict positions (N,3) f64, normals (N,3) f64 and, if topology, face_verts
-        (F,4) int32 and face_origin (F,) int32."""
+        """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces
+        corner_normals (F*4,3) f64 (each face corner's own side), and, if topology, face_verts
+        (F,4) int32, face_origin (F,) int32 and corner_edge_origin (F,4) int32 (the cage face
+        corner whose edge each output corner's edge lies on, -1 inside a cage face)."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
         n, f = self.sizes["num_verts"], self.sizes["num_faces"]
         out = {"positions": np.empty((n, 3), np.float64), "normals": np.empty((n, 3), np.float64)}
+        if self.sizes.get("num_sharp_corners", 0) > 0:
+            out["corner_normals"] = np.empty((4 * f, 3), np.float64)
         if topology:
             out["face_verts"] = np.empty((f, 4), np.int32)
             out["face_origin"] = np.empty(f, np.int32)
+            out["corner_edge_origin"] = np.empty((f, 4), np.int32)
         lm = ccn_limit_mesh(positions=_ptr(out["positions"], ctypes.c_double),
                             normals=_ptr(out["normals"], ctypes.c_double),
                             face_verts=_ptr(out.get("face_verts"), ctypes.c_int32),
-                            face_origin=_ptr(out.get("face_origin"), ctypes.c_int32))
+                            face_origin=_ptr(out.get("face_origin"), ctypes.c_int32),
+                            corner_normals=_ptr(out.get("corner_normals"), ctypes.c_double),
+                            corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32))
         pos = None
         if positions is not None:
             pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)

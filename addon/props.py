@@ -78,6 +78,11 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
                             description="Controls how smoothing is applied to UVs (as in "
                             "Subdivision Surface)", update=_tag)
     normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
+    use_creases: BoolProperty(
+        name="Use Creases", default=True, update=_tag,
+        description="Use the mesh's edge and vertex creases (Shift+E) as sharpness, mapped as the "
+                    "Subdivision Surface modifier does (sharpness 10 c²: crease 1 is infinitely "
+                    "sharp)")
     store_render_mesh: BoolProperty(
         name="Store Render Mesh in File", default=False, update=_store_changed,
         description="Keep the Render-levels limit mesh computed (refreshed a second after "
@@ -87,7 +92,8 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
 
     def option_tuple(self):
-        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.uv_smooth)
+        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.uv_smooth,
+                self.use_creases)
 
 
 def _overlay_toggled(self, context):

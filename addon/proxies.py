@@ -28,11 +28,41 @@ def own_mesh(p):
     return me
 
 
-def write_normals(me, normals, exact):
-    if exact:
-        compat.set_vertex_normals(me, normals.astype(np.float32))
-    else:
+def write_normals(me, res, exact):
+    """Exact: the library's normals as custom split normals, per face corner where the surface
+    has creases or corners (each side its own), else per vertex. Fast: Blender's own."""
+    if not exact:
         compat.use_plain_normals(me)
+    elif "corner_normals" in res:
+        compat.set_corner_normals(me, res["corner_normals"].astype(np.float32))
+    else:
+        compat.set_vertex_normals(me, res["normals"].astype(np.float32))
+
+
+def write_creases(me, res, cage):
+    """The cage's edge creases on the limit mesh's edges that lie on creased cage edges
+    (corner_edge_origin), so a crease survives Apply as on Subdivision Surface's result."""
+    if cage.edge_creases is None or not np.any(cage.edge_creases > 0) or "corner_edge_origin" not in res:
+        return
+    fs = np.asarray(cage.face_sizes, np.int64)
+    fv = np.asarray(cage.face_verts, np.int64)
+    start = np.repeat(np.cumsum(fs) - fs, fs)
+    nxt = np.arange(len(fv)) + 1
+    nxt = np.where(nxt - start >= np.repeat(fs, fs), start, nxt)  # the face's next corner
+    a, b = np.minimum(fv, fv[nxt]), np.maximum(fv, fv[nxt])
+    ev = np.asarray(cage.edge_verts, np.int64).reshape(-1, 2)
+    nvk = int(max(fv.max(), ev.max())) + 1
+    ekey = np.minimum(ev[:, 0], ev[:, 1]) * nvk + np.maximum(ev[:, 0], ev[:, 1])
+    order = np.argsort(ekey)
+    pos = np.searchsorted(ekey[order], a * nvk + b).clip(0, len(ekey) - 1)
+    corner_crease = np.where(ekey[order][pos] == a * nvk + b, cage.edge_creases[order][pos], 0.0)
+    origin = res["corner_edge_origin"].ravel()
+    loop_edge = np.empty(len(me.loops), np.int32)
+    me.loops.foreach_get("edge_index", loop_edge)
+    out = np.zeros(len(me.edges), np.float32)
+    on = origin >= 0
+    np.maximum.at(out, loop_edge[on], corner_crease[origin[on]].astype(np.float32))
+    compat.set_edge_creases(me, out)
 
 
 def write_topology(me, res, cage, exact=True):
@@ -52,13 +82,14 @@ def write_topology(me, res, cage, exact=True):
         me.polygons.foreach_set("material_index", cage.material_index[origin])
     me.attributes.new(LIMIT_ATTR, 'BOOLEAN', 'FACE').data.foreach_set("value", np.ones(nf, bool))
     me.update(calc_edges=True)
-    write_normals(me, res["normals"], exact)
+    write_creases(me, res, cage)
+    write_normals(me, res, exact)
 
 
 def write_positions(me, res, exact=True):
     me.vertices.foreach_set("co", res["positions"].astype(np.float32).ravel())
     me.update()
-    write_normals(me, res["normals"], exact)
+    write_normals(me, res, exact)
 
 
 def clear(p):

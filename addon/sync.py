@@ -22,10 +22,8 @@ import traceback
 from . import attrs, modifier, native, proxies
 from . import cage as cagemod
 
-# Issue 12 hook: the library does not use creases yet. When it does, set USE_CREASES = True:
-# edge sharpness (10 c^2, as Blender's Subdivision Surface) goes to ccn_cage.edge_creases and the
-# vertex sharpness in Cage.vertex_creases is waiting for a ccn_cage field.
-USE_CREASES = False
+# Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
+# ccn_cage.edge_creases / vertex_creases when the cage's Use Creases is on (the default).
 
 stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "skipped": 0, "errors": 0,
          "internal_errors": 0, "render_frames": 0}
@@ -35,7 +33,7 @@ _status = {}     # (object name, kind) -> Status
 
 class Status:
     __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
-                 "showing", "loose")
+                 "showing", "loose", "element")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
@@ -44,6 +42,7 @@ class Status:
         self.seconds = 0.0
         self.showing = "limit"   # limit | last valid limit | cage
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
+        self.element = None      # (ccn_element_kind, index) an error names (errors.py)
 
 
 def status(obj, kind='VIEW'):
@@ -86,10 +85,11 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
     if cached is not None:
         cached[1].close()
         del _plans[key_name]
-    sharp = cagemod.sharpness(cage.edge_creases) if USE_CREASES else None
+    sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
+    vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
     plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
                        cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
-                       levels=levels, edge_sharpness=sharp)
+                       levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
     plan.face_origin = None
     _plans[key_name] = (topo, plan)
@@ -121,7 +121,7 @@ def sync_object(obj, kind, cage, force=False):
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
-        topo = cage.topology_key(levels, *s.option_tuple(), creases=USE_CREASES) + uv_topo
+        topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases) + uv_topo
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
         key = topo + ":" + cage.position_key() + ":" + ekey
         proxies.sync_materials(obj.data, p)
@@ -160,6 +160,7 @@ def sync_object(obj, kind, cage, force=False):
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:
         st.error = str(e)
+        st.element = (e.element_kind, e.element) if e.element >= 0 else None
         stats["errors"] += 1
         if not len(cage.face_sizes) and p is not None:  # nothing to show but the cage itself
             proxies.clear(p)

@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import modifier, native, sync, tap, values
+from . import errors, modifier, native, sync, tap, values
 
 
 def active_edge_interval(obj):
@@ -57,6 +57,13 @@ def _draw_status(layout, obj):
         col.label(text=error_heading(st), icon='ERROR')
         for line in _wrap(st.error, 48):
             col.label(text=line)
+        what = errors.advice(st.error)
+        if what:
+            col = box.column()
+            for i, line in enumerate(_wrap(what, 48)):
+                col.label(text=line, icon='QUESTION' if i == 0 else 'BLANK1')
+        if errors.selectable(st):
+            box.operator("object.ccnurbs_select_error", text="Select", icon='RESTRICT_SELECT_OFF')
         return
     box.label(text="Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces), icon='MESH_DATA')
     z = dict(st.sizes)
@@ -65,6 +72,11 @@ def _draw_status(layout, obj):
         box.label(text="Extraordinary: %d, caps: %d" % (z.get("num_extraordinary", 0),
                                                       z.get("num_caps", 0)))
         notes = []
+        if z.get("num_sharp_edges") or z.get("num_sharp_vertices"):
+            notes.append("creases: %d sharp edges, %d sharp vertices; %d limit vertices with "
+                         "one normal per side" % (z.get("num_sharp_edges", 0),
+                                                  z.get("num_sharp_vertices", 0),
+                                                  z.get("num_sharp_corners", 0)))
         if z.get("num_ring_conflicts"):
             notes.append("%d ring conflicts (mean used)" % z["num_ring_conflicts"])
         if z.get("num_ev_fallbacks"):
@@ -160,6 +172,7 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         layout.prop(s, "cap")
         layout.prop(s, "boundary_smooth")
         layout.prop(s, "uv_smooth")
+        layout.prop(s, "use_creases")
         layout.prop(s, "normals")
         layout.prop(s, "store_render_mesh")
         layout.label(text=render_mesh_line(obj), icon='FILE_BLEND')

@@ -217,6 +217,12 @@ typedef struct {
                                corners, may be NULL. Equal to the vertex normal except on
                                sharp creases and corners, where each face gets the normal
                                of its own side (the vertex normal is then their mean). */
+    int32_t *corner_edge_origin; /* 4 * num_faces: the edge from corner k to corner k+1 lies
+                               on the edge of cage face face_origin that starts at cage face
+                               corner j (this array holds the index of that corner in the
+                               cage's face_verts, so its edge is face_verts[j] -> the face's next
+                               corner), or -1 inside the cage face; may be NULL. Carries
+                               creases, seams and sharp marks over to the limit mesh. */
 } ccn_limit_mesh;
 
 /* Output topology: the level-L refinement of the cage, i.e. every cage quad sampled on a

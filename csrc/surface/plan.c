@@ -36,7 +36,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t c = 0; c < p->ncap; c++) ccn__cap_free(&p->caps[c]);
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
     free(p->ops); free(p->op_n); free(p->caps); free(p->prep); free(p->lev);
-    free(p->vmapL); free(p->out_fv); free(p->out_origin);
+    free(p->vmapL); free(p->out_vL); free(p->out_fv); free(p->out_origin); free(p->out_eorigin);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
@@ -265,5 +265,7 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
         for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
     if (out->face_verts) memcpy(out->face_verts, p->out_fv, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
+    if (out->corner_edge_origin)
+        memcpy(out->corner_edge_origin, p->out_eorigin, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
 }

@@ -42,7 +42,9 @@ struct ccn_plan {
     /* output mesh = level L without isolated vertices */
     int32_t nout_v, nout_f;
     int32_t *vmapL;         /* level-L vertex -> output vertex (-1: isolated) */
+    int32_t *out_vL;        /* output vertex -> level-L vertex */
     int32_t *out_fv, *out_origin;
+    int32_t *out_eorigin;   /* 4 * nout_f: cage edge under each face corner's outgoing edge */
     /* limit stencils, CSR; index < lev[L]->nv: a level-L vertex, else (index - lev[L]->nv)
      * is a level-(L+1) point (face points, edge points, vertex points) */
     int32_t *st_start, *st_v;

@@ -15,16 +15,41 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
     if (!p->vmapL || !p->out_fv || !p->out_origin)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    /* output vertices are numbered in the order the output faces first use them (the faces
+     * are in the refinement's quadtree order), so neighbours on the surface get near numbers:
+     * the index arrays of a saved mesh compress like Subdivision Surface's; loose cage vertices
+     * (no face) get none */
     int32_t no = 0;
-    for (int32_t v = 0; v < mL->nv; v++)
-        p->vmapL[v] = mL->vfan_start[v + 1] > mL->vfan_start[v] ? no++ : -1;
+    for (int32_t v = 0; v < mL->nv; v++) p->vmapL[v] = -1;
+    for (int32_t h = 0; h < mL->nh; h++) {
+        int32_t v = mL->hvert[h];
+        if (p->vmapL[v] < 0) p->vmapL[v] = no++;
+        p->out_fv[h] = p->vmapL[v];
+    }
     p->nout_v = no;
     p->nout_f = mL->nf;
-    for (int32_t h = 0; h < mL->nh; h++) p->out_fv[h] = p->vmapL[mL->hvert[h]];
+    p->out_vL = malloc(sizeof(int32_t) * (size_t)(no ? no : 1));
+    if (!p->out_vL) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    for (int32_t v = 0; v < mL->nv; v++)
+        if (p->vmapL[v] >= 0) p->out_vL[p->vmapL[v]] = v;
     for (int32_t f = 0; f < mL->nf; f++) {
         int32_t g = f;
         for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
         p->out_origin[f] = g;
+    }
+    /* the child quad q of level l+1 at corner j of a level-l face is that corner's half-edge
+     * (refine/level.c): its corner 0 -> 1 lies on the parent half-edge q, its corner 3 -> 0 on the
+     * parent's previous half-edge, its corners 1 -> 2 and 2 -> 3 inside the parent face */
+    p->out_eorigin = malloc(sizeof(int32_t) * (size_t)(mL->nh ? mL->nh : 1));
+    if (!p->out_eorigin) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    for (int32_t h = 0; h < mL->nh; h++) {
+        int32_t g = h;
+        for (int32_t l = p->L; l > 0 && g >= 0; l--) {
+            const ccn_mesh *m = p->lev[l], *up = p->lev[l - 1];
+            int32_t q = m->hface[g], k = g - m->fstart[q];
+            g = k == 0 ? q : k == 3 ? ccn__prev(up, q) : -1;
+        }
+        p->out_eorigin[h] = g;
     }
     return CCN_OK;
 }
@@ -142,9 +167,8 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     p->st_start[0] = 0;
     p->nnear = 0;
     for (int32_t v = 0; v < mL->nv; v++) irr[v] = ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_REGULAR;
-    for (int32_t v = 0; v < mL->nv; v++) {
-        int32_t o = p->vmapL[v];
-        if (o < 0) continue;
+    for (int32_t o = 0; o < p->nout_v; o++) {
+        int32_t v = p->out_vL[o];
         if (!near_irregular(mL, v, irr)) {
             ccn__limit_stencil(mL, v, pinned, s);
         } else {

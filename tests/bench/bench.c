@@ -62,7 +62,7 @@ int main(int argc, char **argv) {
     double *pos = malloc(sizeof(double) * 3 * s.num_verts), *nrm = malloc(sizeof(double) * 3 * s.num_verts);
     double *cp = malloc(sizeof(double) * 3 * cage.num_verts);
     memcpy(cp, cage.positions, sizeof(double) * 3 * cage.num_verts);
-    ccn_limit_mesh lm = {pos, nrm, NULL, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = pos, .normals = nrm};
     for (int r = 0; r < 3 * reps; r++) {
         cp[0] += 1e-3;
         double t0 = now();

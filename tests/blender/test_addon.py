@@ -22,8 +22,8 @@ print("CCNURBS test Blender %s" % bpy.app.version_string.split()[0])
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bltest  # noqa: E402
 
-CASES = ("case_package", "case_knots", "case_modifier", "case_stack", "case_animation",
-         "case_files", "case_objio", "case_values", "case_uv", "case_zenable")
+CASES = ("case_package", "case_knots", "case_modifier", "case_creases", "case_stack",
+         "case_animation", "case_files", "case_objio", "case_values", "case_uv", "case_zenable")
 
 
 class _Result(unittest.TestResult):
@@ -57,7 +57,8 @@ def main():
     bltest.install()
     loader = unittest.defaultTestLoader
     suite = unittest.TestSuite()
-    for name in CASES:
+    only = os.environ.get("CCN_CASES")  # e.g. "case_creases": run only these (development)
+    for name in (only.split(",") if only else CASES):
         try:
             mod = __import__(name)
         except ImportError as e:

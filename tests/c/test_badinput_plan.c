@@ -33,7 +33,7 @@ static int eval_check(ccn_plan *p, const ccn_cage *c, const double *positions, c
     double *N = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)z.num_faces);
     int32_t *fo = malloc(sizeof(int32_t) * (size_t)z.num_faces);
-    ccn_limit_mesh out = {P, N, fv, fo, NULL};
+    ccn_limit_mesh out = {.positions = P, .normals = N, .face_verts = fv, .face_origin = fo};
     ccn_error err;
     ccn_status st = ccn_plan_evaluate(p, positions, &out, &err);
     CHECK(st == CCN_OK, "%s: evaluate: %s", what, err.message);
@@ -103,13 +103,13 @@ static void row_nan_inf_coordinate(void) {
     ccn_sizes z;
     ccn_plan_sizes(pl, &z);
     double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
-    ccn_limit_mesh out = {P, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh out = {.positions = P};
     CHECK(ccn_plan_evaluate(pl, p, &out, &err) == CCN_ERR_ARGUMENT, "evaluate with Inf");
     CHECK(strstr(err.message, "vertex 3 has a non-finite coordinate") != NULL, "%s", err.message);
     p[9] = NAN;
     CHECK(ccn_plan_evaluate(pl, p, &out, &err) == CCN_ERR_ARGUMENT, "evaluate with NaN");
     /* NULL output buffers */
-    ccn_limit_mesh none = {NULL, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh none = {0};
     CHECK(ccn_plan_evaluate(pl, NULL, &none, &err) == CCN_ERR_ARGUMENT, "NULL out->positions");
     CHECK(strstr(err.message, "NULL") != NULL, "%s", err.message);
     CHECK(ccn_plan_evaluate(pl, NULL, NULL, &err) == CCN_ERR_ARGUMENT, "NULL out");
@@ -270,7 +270,7 @@ static void row_coordinates_1e30(void) {
         double *b = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         double *u = malloc(sizeof(double) * 3 * (size_t)s.nv);
         for (int32_t i = 0; i < 3 * s.nv; i++) u[i] = s.pos[i] / 1e30;
-        ccn_limit_mesh oa = {a, NULL, NULL, NULL, NULL}, ob = {b, NULL, NULL, NULL, NULL};
+        ccn_limit_mesh oa = {.positions = a}, ob = {.positions = b};
         CHECK(ccn_plan_evaluate(pl, s.pos, &oa, &err) == CCN_OK, "%s", err.message);
         CHECK(ccn_plan_evaluate(pl, u, &ob, &err) == CCN_OK, "%s", err.message);
         double d = 0;
@@ -312,7 +312,7 @@ static void row_coordinates_near_dbl_max(void) {
                 ccn_sizes z;
                 ccn_plan_sizes(p, &z);
                 double *out = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
-                ccn_limit_mesh lm = {out, NULL, NULL, NULL, NULL};
+                ccn_limit_mesh lm = {.positions = out};
                 CHECK(ccn_plan_evaluate(p, big, &lm, &err) == CCN_ERR_ARGUMENT, "evaluate must refuse");
                 free(out);
             }
@@ -345,7 +345,7 @@ static void row_two_million_faces(void) {
         double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)z.num_faces);
         if (P && fv) {
-            ccn_limit_mesh out = {P, NULL, fv, NULL, NULL};
+            ccn_limit_mesh out = {.positions = P, .face_verts = fv};
             CHECK(ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK, "%s", err.message);
             int bad = 0;
             for (int64_t i = 0; i < 3 * (int64_t)z.num_verts; i++) bad += !isfinite(P[i]);

@@ -200,7 +200,7 @@ static void compare_cage(const ccn_cage *cage, int levels, cap_stats *st) {
     ccn_plan_sizes(pb, &s);
     double *xb = malloc(sizeof(double) * 3 * s.num_verts), *nb = malloc(sizeof(double) * 3 * s.num_verts);
     double *xr = malloc(sizeof(double) * 3 * s.num_verts), *nr = malloc(sizeof(double) * 3 * s.num_verts);
-    ccn_limit_mesh lb = {xb, nb, NULL, NULL, NULL}, lr = {xr, nr, NULL, NULL, NULL};
+    ccn_limit_mesh lb = {.positions = xb, .normals = nb}, lr = {.positions = xr, .normals = nr};
     CHECK(ccn_plan_evaluate(pb, NULL, &lb, &err) == CCN_OK, "%s", err.message);
     CHECK(ccn_plan_evaluate(pr, NULL, &lr, &err) == CCN_OK, "%s", err.message);
     uint8_t *inside = calloc(s.num_verts, 1);
@@ -343,7 +343,7 @@ static void test_nonuniform_period4(void) {
             ccn_plan_sizes(p, &s);
             st.caps += s.num_caps;
             double *x = malloc(sizeof(double) * 3 * s.num_verts), *nn = malloc(sizeof(double) * 3 * s.num_verts);
-            ccn_limit_mesh lm = {x, nn, NULL, NULL, NULL};
+            ccn_limit_mesh lm = {.positions = x, .normals = nn};
             CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
             check_separators(p, &st, 6.0);
             st.inside += p->nhv;
@@ -439,7 +439,7 @@ static void test_nonuniform_planar(void) {
             ccn_plan_sizes(p, &sz);
             caps += sz.num_caps;
             double *x = malloc(sizeof(double) * 3 * sz.num_verts);
-            ccn_limit_mesh lm = {x, NULL, NULL, NULL, NULL};
+            ccn_limit_mesh lm = {.positions = x};
             CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
             for (int32_t v = 0; v < sz.num_verts; v++)
                 worst = fmax(worst, fabs(x[3 * v + 2] - (0.25 * x[3 * v] - 0.5 * x[3 * v + 1] + 1)));

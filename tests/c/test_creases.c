@@ -184,7 +184,7 @@ static ccn_cage grid_cage(const grid *g) {
     return c;
 }
 
-typedef struct { int32_t nv, nf; double *pos, *nrm, *cn; int32_t *fv; ccn_sizes s; } lmesh;
+typedef struct { int32_t nv, nf; double *pos, *nrm, *cn; int32_t *fv, *eo; ccn_sizes s; } lmesh;
 
 static int limit(const ccn_cage *c, const ccn_options *o, lmesh *lm) {
     ccn_plan *p = NULL;
@@ -197,13 +197,15 @@ static int limit(const ccn_cage *c, const ccn_options *o, lmesh *lm) {
     lm->nrm = NEW(double, 3 * lm->nv);
     lm->cn = NEW(double, 12 * lm->nf);
     lm->fv = NEW(int32_t, 4 * lm->nf);
-    ccn_limit_mesh out = {lm->pos, lm->nrm, lm->fv, NULL, lm->cn};
+    lm->eo = NEW(int32_t, 4 * lm->nf);
+    ccn_limit_mesh out = {.positions = lm->pos, .normals = lm->nrm, .face_verts = lm->fv, .corner_normals = lm->cn,
+                          .corner_edge_origin = lm->eo};
     int rc = ccn_plan_evaluate(p, NULL, &out, &err) ? -1 : 0;
     if (rc) fprintf(stderr, "evaluate: %s\n", err.message);
     ccn_plan_destroy(p);
     return rc;
 }
-static void lm_free(lmesh *l) { free(l->pos); free(l->nrm); free(l->cn); free(l->fv); }
+static void lm_free(lmesh *l) { free(l->pos); free(l->nrm); free(l->cn); free(l->fv); free(l->eo); }
 
 static double bbox(const double *p, int n) {
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
@@ -311,6 +313,22 @@ static void check_two_sides(int M, int N, int torus, int c, int L, ccn_scheme sc
     }
     CHECK(worst_n <= TOL_ANGLE, "%s crease corner normals: worst angle %.3g rad", torus ? "torus" : "grid", worst_n);
     CHECK(lm.s.num_sharp_corners > 0, "crease vertices with two normals: %d", lm.s.num_sharp_corners);
+    /* corner_edge_origin: the output edges on the crease line are exactly the corners whose
+     * cage corner starts a crease edge (2 faces x N 2^L edges, one loop on the torus too) */
+    int on_crease = 0, bad_origin = 0;
+    for (int f = 0; f < lm.nf; f++)
+        for (int k = 0; k < 4; k++) {
+            int j = lm.eo[4 * f + k], a = lm.fv[4 * f + k], b = lm.fv[4 * f + (k + 1) % 4];
+            int both = mt[2 * a + 1] >= 0 && mt[2 * b + 1] >= 0; /* both vertices on the crease */
+            if (j >= 0) {
+                int va = g.fv[j], vb = g.fv[(j % 4 == 3) ? j - 3 : j + 1];
+                int ia = torus ? va / g.N : va / (g.N + 1), ib = torus ? vb / g.N : vb / (g.N + 1);
+                if (ia == c && ib == c) on_crease++;
+                else if (both) bad_origin++;
+            } else if (both) bad_origin++;
+        }
+    CHECK(on_crease == 2 * (g.N << L) && bad_origin == 0, "edge origins: %d corners on the crease (expected %d), %d wrong",
+          on_crease, 2 * (g.N << L), bad_origin);
     printf("#   %s %dx%d crease at %d, level %d, %s: positions %.2e of size, corner normals %.2e rad, %d two-sided vertices\n",
            torus ? "torus" : "grid ", M, N, c, L, scheme == CCN_SCHEME_EIGEN ? "eigen" : "nurss", worst / size, worst_n,
            lm.s.num_sharp_corners);

@@ -64,7 +64,7 @@ static void plan_accepted_means_finite(const ccn_cage *c, ccn_status allowed_err
             ccn_plan_sizes(p, &z);
             double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
             double *N = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
-            ccn_limit_mesh out = {P, N, NULL, NULL, NULL};
+            ccn_limit_mesh out = {.positions = P, .normals = N};
             st = ccn_plan_evaluate(p, NULL, &out, &err);
             CHECK(st == CCN_OK, "plan scheme %d cap %d: evaluate %s", sc, cap, err.message);
             int bad = 0;
@@ -147,7 +147,7 @@ static void kb3_plan_null_positions(void) {
     ccn_plan_sizes(pl, &z);
     double *a = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     double *b = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
-    ccn_limit_mesh oa = {a, NULL, NULL, NULL, NULL}, ob = {b, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh oa = {.positions = a}, ob = {.positions = b};
     ccn_plan_evaluate(pl, NULL, &oa, &err);
     ccn_plan_evaluate(pl, p2, &ob, &err);
     ccn_plan_evaluate(pl, NULL, &ob, &err);
@@ -202,7 +202,7 @@ static void kb4_far_vertex_precision(void) {
         if (ccn_plan_create(&c, &o, &pl, &err) == CCN_OK &&
             ccn_plan_create(&c4, &o, &pl4, &err) == CCN_OK) {
             double P[3 * 25], P4[3 * 25];
-            ccn_limit_mesh lm = {P, NULL, NULL, NULL, NULL}, lm4 = {P4, NULL, NULL, NULL, NULL};
+            ccn_limit_mesh lm = {.positions = P}, lm4 = {.positions = P4};
             ccn_plan_evaluate(pl, NULL, &lm, &err);
             ccn_plan_evaluate(pl4, NULL, &lm4, &err);
             double d = 0;

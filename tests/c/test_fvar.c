@@ -184,7 +184,7 @@ static int run(const grid *g, int linear, ccn_scheme scheme, int L, int corners,
     ccn_plan_fvar_sizes(p, c, &fs);
     double *pos = NEW(double, 3 * s.num_verts), *vals = NEW(double, (size_t)g->W * fs.num_values);
     int32_t *fv = NEW(int32_t, 4 * s.num_faces), *fo = NEW(int32_t, s.num_faces), *fvv = NEW(int32_t, 4 * s.num_faces);
-    ccn_limit_mesh lm = {pos, NULL, fv, fo, NULL};
+    ccn_limit_mesh lm = {.positions = pos, .face_verts = fv, .face_origin = fo};
     int rc = ccn_plan_evaluate(p, NULL, &lm, &err) || ccn_plan_evaluate_fvar(p, c, NULL, vals, fvv, &err) ? -1 : 0;
     if (rc) fprintf(stderr, "evaluate: %s\n", err.message);
     /* the positions' oracle (pinned corners): every refined parameter's point */
@@ -431,7 +431,7 @@ static void test_plan_reuse_and_vertex_data(void) {
     /* per-vertex data: the positions themselves give the limit surface; data with 5
      * components (an affine map of x, y, z) gives the map of it; the plan's geometry stays */
     double *pos = NEW(double, 3 * s.num_verts), *pos2 = NEW(double, 3 * s.num_verts), *vd = NEW(double, 5 * s.num_verts);
-    ccn_limit_mesh lm = {pos, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = pos};
     CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
     double *data = NEW(double, 5 * g.nv);
     for (int v = 0; v < g.nv; v++) {
@@ -448,7 +448,7 @@ static void test_plan_reuse_and_vertex_data(void) {
     }
     CHECK(ev <= 1e-13 * 4, "vertex data: %.3g from the positions' limit", ev);
     /* the plan's geometry is untouched: patches unchanged */
-    ccn_limit_mesh lm2 = {pos2, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh lm2 = {.positions = pos2};
     CHECK(ccn_plan_evaluate_vertex_data(p, 1, data, vd, &err) == CCN_OK, "%s", err.message);
     CHECK(ccn_plan_evaluate(p, NULL, &lm2, &err) == CCN_OK && !memcmp(pos, pos2, sizeof(double) * 3 * s.num_verts),
           "positions changed after vertex data");

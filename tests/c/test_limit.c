@@ -31,7 +31,7 @@ static int evaluate(const ccn_cage *cage, const ccn_options *o, const double *po
     lm->nrm = malloc(sizeof(double) * 3 * lm->nv);
     lm->fv = malloc(sizeof(int32_t) * 4 * lm->nf);
     lm->origin = malloc(sizeof(int32_t) * lm->nf);
-    ccn_limit_mesh out = {lm->pos, lm->nrm, lm->fv, lm->origin, NULL};
+    ccn_limit_mesh out = {.positions = lm->pos, .normals = lm->nrm, .face_verts = lm->fv, .face_origin = lm->origin};
     int rc = ccn_plan_evaluate(p, pos, &out, &err) ? -1 : 0;
     if (rc) fprintf(stderr, "evaluate: %s\n", err.message);
     ccn_plan_destroy(p);
@@ -236,7 +236,7 @@ static void test_plan_reuse(void) {
         ccn_sizes s;
         ccn_plan_sizes(p, &s);
         double *a = malloc(sizeof(double) * 3 * s.num_verts), *na = malloc(sizeof(double) * 3 * s.num_verts);
-        ccn_limit_mesh out = {a, na, NULL, NULL, NULL};
+        ccn_limit_mesh out = {.positions = a, .normals = na};
         CHECK(ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK, "%s", err.message);
         CHECK(ccn_plan_evaluate(p, moved, &out, &err) == CCN_OK, "%s", err.message);
         ccn_cage c2 = cage;

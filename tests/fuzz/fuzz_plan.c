@@ -121,7 +121,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FZ_CHECK(pos && nrm && fv && fo && fv2 && fo2, "harness out of memory");
 
     /* 1: the cage's own positions, every output */
-    ccn_limit_mesh out = {pos, nrm, fv, fo, NULL};
+    ccn_limit_mesh out = {.positions = pos, .normals = nrm, .face_verts = fv, .face_origin = fo};
     fz_err_init(&e);
     st = ccn_plan_evaluate(plan, NULL, &out, &e);
     fz_check_status(st, &e, "ccn_plan_evaluate");
@@ -150,7 +150,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     double maxabs2 = 0;
     for (int32_t k = 0; k < 3 * c.num_verts; k++) maxabs2 = fmax(maxabs2, fabs(p2[k]));
     int strict2 = fz_known_bugs() || maxabs2 <= FZ_HUGE; /* KB2b */
-    ccn_limit_mesh out2 = {pos, NULL, fv2, fo2, NULL};
+    ccn_limit_mesh out2 = {.positions = pos, .face_verts = fv2, .face_origin = fo2};
     fz_err_init(&e);
     ccn_status st2 = ccn_plan_evaluate(plan, p2, &out2, &e);
     fz_check_status(st2, &e, "ccn_plan_evaluate(positions)");
@@ -170,7 +170,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
      * of the previous call instead (KB3, fixed: strict). */
     double *pos3 = malloc(sizeof(double) * nv3);
     FZ_CHECK(pos3 != NULL, "harness out of memory");
-    ccn_limit_mesh out3 = {pos3, NULL, NULL, NULL, NULL};
+    ccn_limit_mesh out3 = {.positions = pos3};
     fz_err_init(&e);
     ccn_status st3 = ccn_plan_evaluate(plan, NULL, &out3, &e);
     fz_check_status(st3, &e, "ccn_plan_evaluate(positions only)");
@@ -180,7 +180,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         FZ_CHECK(memcmp(pos1, pos3, sizeof(double) * nv3) == 0,
                  "KB3: evaluate(NULL) after evaluate(positions) does not use the cage's own");
     free(pos3);
-    ccn_limit_mesh out4 = {NULL, nrm, NULL, NULL, NULL};
+    ccn_limit_mesh out4 = {.normals = nrm};
     fz_err_init(&e);
     st = ccn_plan_evaluate(plan, NULL, &out4, &e);
     fz_check_status(st, &e, "ccn_plan_evaluate(NULL positions)");

@@ -142,7 +142,7 @@ int main(int argc, char **argv) {
     }
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
-    ccn_limit_mesh lm = {malloc(sizeof(double) * 3 * (size_t)sz.num_verts), NULL, NULL, NULL, NULL};
+    ccn_limit_mesh lm = {.positions = malloc(sizeof(double) * 3 * (size_t)sz.num_verts)};
     if (!lm.positions || ccn_plan_evaluate(plan, NULL, &lm, &err)) { fprintf(stderr, "evaluate: %s\n", err.message); return 1; }
     patch_list pl = {0};
     int32_t skipped = 0;
