@@ -455,12 +455,30 @@ def fvar_dependent():
 
 
 def fvar_abab():
-    """2x2 grid whose centre takes values A, B, A, B around it, every inner edge a seam."""
-    V = [(x, y, 0.0) for y in range(3) for x in range(3)]
-    F = [[0, 1, 4, 3], [1, 2, 5, 4], [4, 5, 8, 7], [3, 4, 7, 6]]
-    vt = [(0.5, 0.5), (0.7, 0.3), (0, 0), (1, 0), (0, 1), (0.2, 0.1), (0.9, 0.1), (0.2, 0.9),
-          (1, 1), (0.3, 0.6), (0.1, 0.7), (0.6, 0.2), (0.8, 0.8), (0.4, 0.05)]
-    FT = [[2, 3, 0, 4], [5, 6, 7, 1], [0, 8, 9, 10], [11, 1, 12, 13]]
+    """4x4 grid of four 2x2 charts (seams along the middle row and column) whose centre takes
+    values A, B, A, B around it: the diagonal charts share the centre's value. (4x4, not 2x2,
+    so that the cage has regular faces and a patch set, as tests/oracle/run_cad_patches.sh
+    needs of every cage here.)"""
+    n = 4
+    V = [(x, y, 0.1 * ((x * 3 + y * 5) % 4)) for y in range(n + 1) for x in range(n + 1)]
+    vt, ids, FT, F = [], {}, [], []
+    for y in range(n):
+        for x in range(n):
+            qx, qy = x // 2, y // 2
+            f, ft = [], []
+            for a, b in ((x, y), (x + 1, y), (x + 1, y + 1), (x, y + 1)):
+                key = ("centre", (qx + qy) % 2) if (a, b) == (2, 2) else (a, b, qx, qy)
+                if key not in ids:
+                    ids[key] = len(vt)
+                    if key[0] == "centre":
+                        vt.append((0.5, 0.5) if key[1] == 0 else (0.56, 0.47))
+                    else:
+                        vt.append((a / 4.0 + 0.04 * qx + 0.01 * b * (a % 3),
+                                   b / 4.0 + 0.05 * qy + 0.015 * a * (b % 2)))
+                f.append(b * (n + 1) + a)
+                ft.append(ids[key])
+            F.append(f)
+            FT.append(ft)
     return V, F, vt, FT, []
 
 
