@@ -62,7 +62,8 @@ class ccn_options(ctypes.Structure):
                 ("levels", ctypes.c_int32),
                 ("boundary_corners", ctypes.c_int32),
                 ("threads", ctypes.c_int32),
-                ("crease_method", ctypes.c_int32)]
+                ("crease_method", ctypes.c_int32),
+                ("ev_polyhedron", ctypes.c_int32)]
 
 
 class ccn_sizes(ctypes.Structure):
@@ -80,7 +81,9 @@ class ccn_sizes(ctypes.Structure):
                 ("num_ignored_edges", ctypes.c_int32),
                 ("num_sharp_edges", ctypes.c_int32),
                 ("num_sharp_vertices", ctypes.c_int32),
-                ("num_sharp_corners", ctypes.c_int32)]
+                ("num_sharp_corners", ctypes.c_int32),
+                ("num_ev_verified", ctypes.c_int32),
+                ("num_ev_outside_g1", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):

@@ -81,6 +81,10 @@ def _draw_status(layout, obj):
             notes.append("%d ring conflicts (mean used)" % z["num_ring_conflicts"])
         if z.get("num_ev_fallbacks"):
             notes.append("%d eigen→NURSS fallbacks" % z["num_ev_fallbacks"])
+        if z.get("num_ev_outside_g1"):
+            notes.append("%d extraordinary points outside the verified G1 range (spoke"
+                         " interval ratios too extreme for every eigen polyhedron tried)"
+                         % z["num_ev_outside_g1"])
         if z.get("num_cap_fallbacks"):
             notes.append("%d cap fallbacks (exact limit there: too close to another"
                          " extraordinary point or a boundary, valence > 32, or spoke"

@@ -22,8 +22,8 @@
  * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric). out: patches x 36 x m. */
 static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0,
                             const double *b600, int32_t m, const double *d, const double *kap,
-                            const double complex *taus, const double *pieces, double *out,
-                            ccn_error *err) {
+                            const double complex *taus, const double *pieces, const double *normal,
+                            const double *p12, double *out, ccn_error *err) {
     int32_t n = b->n;
     size_t tsz = (size_t)n * 36 * (size_t)m, psz = 36 * (size_t)m;
     double *To = malloc(sizeof(double) * tsz), *Ti = malloc(sizeof(double) * tsz);
@@ -38,7 +38,10 @@ static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0
         ccn__bi5_tcc(n, X, d, m, Ti);
         ccn__bi5_raise_border(n, Ti, m, To);
     }
-    if ((st = ccn__bi5_guide_fit(b, To, b600, m, gbb, err))) goto done;
+    st = p12 ? ccn__bi5_guide_fit_fixed(b, To, b600, p12, m, gbb, err)
+         : normal && m == 3 ? ccn__bi5_guide_fit_plane(b, To, b600, normal, gbb, err)
+                            : ccn__bi5_guide_fit(b, To, b600, m, gbb, err);
+    if (st) goto done;
     for (int32_t r = 0; r < b->nsig; r++) {
         ccn__bi5_sample_border(n, b->samp[r], gbb, m, Ti);         /* t^{r+1} = [g^{r+1} o chi~] */
         ccn__bi5_c2_rule(n, kap, m, Ti);                           /* t~^{r+1} */
@@ -62,6 +65,7 @@ done:
 void ccn__bi5_destroy(ccn__bi5 *b) {
     if (!b) return;
     free(b->gpar); free(b->qr); free(b->qtau); free(b->s0); free(b->stencil);
+    free(b->qr1); free(b->qtau1); free(b->s12); free(b->stencilF); free(b->w12);
     free(b);
 }
 
@@ -101,6 +105,47 @@ static ccn_status precompute(ccn__bi5 *b, ccn_error *err) {
     return st;
 }
 
+/* [R14] for the stencil path: the plain fit's b_510, b_501 (sector 0) as functionals of net and
+ * centre (w12), and the construction with them given (stencilF, two more input columns). */
+static ccn_status build_stencil_fixed(ccn__bi5 *b, ccn_error *err) {
+    int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, mf = nc + 3, np = ccn__bi5_num_patches(b), nt = 3 * b->nsig + 1;
+    double *X = calloc((size_t)nc * (size_t)mf, sizeof(double)), *c0 = calloc((size_t)mf, sizeof(double));
+    double *p12 = calloc(2 * (size_t)mf, sizeof(double)), *out = malloc(sizeof(double) * (size_t)np * 36 * (size_t)mf);
+    double *Ti = malloc(sizeof(double) * (size_t)n * 36 * (size_t)m), *To = malloc(sizeof(double) * (size_t)n * 36 * (size_t)m);
+    double *gbb = malloc(sizeof(double) * (size_t)n * 28 * (size_t)m), *Xm = calloc((size_t)nc * (size_t)m, sizeof(double));
+    b->stencilF = malloc(sizeof(double) * (size_t)nt * 36 * (size_t)mf);
+    b->w12 = malloc(sizeof(double) * 2 * (size_t)m);
+    ccn_status st = CCN_OK;
+    if (!X || !c0 || !p12 || !out || !Ti || !To || !gbb || !Xm || !b->stencilF || !b->w12)
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (stencil, n = %d)", (int)n);
+    if (!st) { /* w12: the plain fit on the unit nets (columns 0..nc-1) and the unit centre (nc) */
+        double *cm = calloc((size_t)m, sizeof(double));
+        for (int32_t k = 0; k < nc; k++) Xm[(size_t)k * m + k] = 1.0;
+        if (cm) cm[nc] = 1.0;
+        ccn__bi5_tcc(n, Xm, NULL, m, Ti);
+        ccn__bi5_raise_border(n, Ti, m, To);
+        st = cm ? ccn__bi5_guide_fit(b, To, cm, m, gbb, err)
+                : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory");
+        const int32_t t1 = ccn__bi5_tri(5, 1, 0), t2 = ccn__bi5_tri(5, 0, 1);
+        for (int32_t k = 0; !st && k < m; k++) {
+            b->w12[k] = gbb[(size_t)t1 * m + k];
+            b->w12[m + k] = gbb[(size_t)t2 * m + k];
+        }
+        free(cm);
+    }
+    if (!st) {
+        for (int32_t k = 0; k < nc; k++) X[(size_t)k * mf + k] = 1.0;
+        c0[nc] = 1.0;
+        p12[nc + 1] = 1.0;          /* p1 column */
+        p12[mf + nc + 2] = 1.0;     /* p2 column */
+        st = construct(b, X, NULL, c0, mf, NULL, NULL, NULL, NULL, NULL, p12, out, err);
+    }
+    for (int32_t t = 0; !st && t < nt; t++)
+        memcpy(b->stencilF + (size_t)t * 36 * mf, out + (size_t)t * n * 36 * mf, sizeof(double) * 36 * (size_t)mf);
+    free(X); free(c0); free(p12); free(out); free(Ti); free(To); free(gbb); free(Xm);
+    return st;
+}
+
 /* Global stencil of sector 0: run the construction on the unit nets and the unit centre. */
 static ccn_status build_stencil(ccn__bi5 *b, ccn_error *err) {
     int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, np = ccn__bi5_num_patches(b), nt = 3 * b->nsig + 1;
@@ -113,11 +158,12 @@ static ccn_status build_stencil(ccn__bi5 *b, ccn_error *err) {
     if (!st) {
         for (int32_t k = 0; k < nc; k++) X[(size_t)k * m + k] = 1.0;
         c0[nc] = 1.0;
-        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, NULL, out, err);
+        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, NULL, NULL, NULL, out, err);
     }
     for (int32_t t = 0; !st && t < nt; t++) /* sector 0 patch of type t = patch index t*n */
         memcpy(b->stencil + (size_t)t * 36 * m, out + (size_t)t * n * 36 * m, sizeof(double) * 36 * (size_t)m);
     free(X); free(c0); free(out);
+    if (!st) st = build_stencil_fixed(b, err);
     return st;
 }
 
@@ -178,6 +224,38 @@ static void apply_stencil(const ccn__bi5 *b, const double *X, const double ctr[3
             }
 }
 
+/* The uniform operator with the centre normal prescribed ([R14]): per sector, the plain fit's
+ * b_510, b_501 of the relabelled net, projected, then the fixed-parameter stencil. */
+static void apply_stencil_normal(const ccn__bi5 *b, const double *X, const double ctr[3],
+                                 const double N[3], double *patches) {
+    int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, mf = nc + 3, nt = 3 * b->nsig + 1;
+    for (int32_t s = 0; s < n; s++) {
+        double p[6];
+        for (int q = 0; q < 2; q++) {
+            const double *w = b->w12 + (size_t)q * m;
+            for (int c = 0; c < 3; c++) {
+                double acc = w[0] * X[c] + w[nc] * ctr[c];
+                for (int32_t k = 0; k < n; k++)
+                    for (int32_t e = 0; e < 6; e++) acc += w[1 + 6 * k + e] * X[3 * (1 + 6 * ((k + s) % n) + e) + c];
+                p[3 * q + c] = acc;
+            }
+        }
+        ccn__bi5_project_p12(ctr, N, p);
+        for (int32_t t = 0; t < nt; t++)
+            for (int32_t e = 0; e < 36; e++) {
+                const double *row = b->stencilF + ((size_t)t * 36 + e) * mf;
+                double acc[3] = {row[0] * X[0], row[0] * X[1], row[0] * X[2]};
+                for (int32_t k = 0; k < n; k++) {
+                    const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
+                    for (int32_t q = 0; q < 6; q++)
+                        for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
+                }
+                double *o = patches + (((size_t)t * n + s) * 36 + e) * 3;
+                for (int c = 0; c < 3; c++) o[c] = acc[c] + row[nc] * ctr[c] + row[nc + 1] * p[c] + row[nc + 2] * p[3 + c];
+            }
+    }
+}
+
 /* kappa_s = d_{s+1} / d_{s-1} for every spoke (d = NULL: all 1); 1 if some kappa != 1. */
 static int spoke_kappas(int32_t n, const double *d, double *kap) {
     int nu = 0;
@@ -219,8 +297,8 @@ static ccn_status check_apply_args(const ccn__bi5 *b, const double *cnet, int32_
 }
 
 static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
-                             const double complex *taus_in, const double *center, double *patches,
-                             ccn_error *err) {
+                             const double complex *taus_in, const double *center, const double *normal,
+                             double *patches, ccn_error *err) {
     ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
     if (st) return st;
     int32_t n = b->n, bad = -1;
@@ -231,7 +309,8 @@ static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double
     double *kap = n <= 64 ? kap_small : malloc(sizeof(double) * (size_t)n);
     if (!kap) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
     int kind = spoke_knots ? classify_knots(n, spoke_knots, kap, &bad) : 0;
-    if (kind == 0) apply_stencil(b, cnet, ctr, patches);
+    if (kind == 0 && normal) apply_stencil_normal(b, cnet, ctr, normal, patches);
+    else if (kind == 0) apply_stencil(b, cnet, ctr, patches);
     else if (kind < 0)
         st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, bad,
                        "bi5: spoke intervals with kappa != 1 and d_%d != d_%d around spoke %d: the "
@@ -242,7 +321,7 @@ static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double
         if (!taus_in)
             st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
                       : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
-        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus_in ? taus_in : taus, NULL, patches, err);
+        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus_in ? taus_in : taus, NULL, normal, NULL, patches, err);
         free(taus);
     }
     if (kap != kap_small) free(kap);
@@ -252,13 +331,21 @@ static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double
 
 ccn_status ccn__bi5_apply(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
                           const double *center, double *patches, ccn_error *err) {
-    return apply_impl(b, cnet, spoke_knots, NULL, center, patches, err);
+    return apply_impl(b, cnet, spoke_knots, NULL, center, NULL, patches, err);
 }
 
 ccn_status ccn__bi5_apply_cached(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
                                  const double complex *taus, const double *center, double *patches,
                                  ccn_error *err) {
-    return apply_impl(b, cnet, spoke_knots, taus, center, patches, err);
+    return apply_impl(b, cnet, spoke_knots, taus, center, NULL, patches, err);
+}
+
+ccn_status ccn__bi5_apply_normal(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                                 const double complex *taus, const double *center, const double *normal,
+                                 double *patches, ccn_error *err) {
+    if (!center || !normal)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL centre or normal");
+    return apply_impl(b, cnet, spoke_knots, taus, center, normal, patches, err);
 }
 
 ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double complex *taus,
@@ -328,7 +415,7 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
         goto done;
     }
     if (nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
-    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, NULL, patches, err);
+    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, NULL, NULL, NULL, patches, err);
     if (!st) ccn__ok(err);
 done:
     free(T); free(kap); free(taus);
@@ -337,7 +424,8 @@ done:
 
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
                                  const double *spoke_knots, const double complex *taus_in,
-                                 const double *center, double *patches, ccn_error *err) {
+                                 const double *center, const double *normal, double *patches,
+                                 ccn_error *err) {
     ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
     if (st) return st;
     if (!pieces || !center || !spoke_knots)
@@ -363,7 +451,7 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
     if (!st && nu && !taus_in) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
     const double complex *tu = taus_in ? taus_in : taus;
     if (!st) st = construct(b, NULL, T, center, 3, spoke_knots, nu ? kap : NULL, nu ? tu : NULL,
-                            pieces, patches, err);
+                            pieces, normal, NULL, patches, err);
     free(kap); free(taus); free(T);
     if (!st) ccn__ok(err);
     return st;

@@ -91,6 +91,11 @@
  *       spline), as the NU C2-rule [R9] needs. The guide's least-squares target is t_CC with
  *       the [R8] knots, which is only an approximation of the border here (it shapes the
  *       guide, not the joins).
+ *  [R14] With a prescribed centre normal (ccn__bi5_apply_pieces), the guide's first-order
+ *       coefficients b_510, b_501 at the centre are projected onto the plane through the centre
+ *       point with that normal and the remaining parameters refitted with them fixed. The cap's
+ *       centre jet is the guide's, so the cap's tangent plane at the EV is the exact limit's
+ *       (issue 14: the plain fit left it 0.002-0.04 rad off for non-uniform intervals).
  *  Numerics: tau's equality-constrained minimum by the SVD null space of the constraints
  *  (they are redundant) and Cholesky on the reduced normal equations of F_5.
  */
@@ -132,11 +137,13 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
  * ring must have sigma = 1/2. pieces[(s*4 + k)*36*3]: sector s's four surround pieces as full
  * bi-5 polynomials over the hole [0,1]^2 (k = 0: across u = 1, v in [0,1/2]; 1: across u = 1,
  * v in [1/2,1]; 2: across v = 1, u in [0,1/2]; 3: across v = 1, u in [1/2,1]). The guide is
- * fitted to t_CC of cnet with the [R8] knots (any d: a least-squares target only); ring 0 takes
- * its outer layers from the pieces, the other rings and the cap are [R9]-[R12]. */
+ * fitted to the pieces (their least-squares tensor-border); ring 0 takes its outer layers from
+ * the pieces, the other rings and the cap are [R9]-[R12]. normal (may be NULL): the unit
+ * normal of the surface at the centre; the guide's tangent plane there is set to it ([R14]). */
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
                                  const double *spoke_knots, const double complex *taus,
-                                 const double *center, double *patches, ccn_error *err);
+                                 const double *center, const double *normal, double *patches,
+                                 ccn_error *err);
 /* The per-sector taus of non-uniform spoke intervals ([R11]; n x 36, CCN_ERR_KNOTS if tau folds):
  * they depend on the intervals only, so a caller that evaluates repeatedly computes them once
  * and passes them to ccn__bi5_apply_cached / ccn__bi5_apply_pieces (NULL there: computed per
@@ -147,6 +154,12 @@ ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double
 ccn_status ccn__bi5_apply_cached(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
                                  const double complex *taus, const double *center, double *patches,
                                  ccn_error *err);
+/* ccn__bi5_apply_cached with the surface's centre point and unit normal at the EV: the cap's
+ * tangent plane there is set to that normal's ([R14]; the uniform operator: precomputed
+ * stencils, no allocation). */
+ccn_status ccn__bi5_apply_normal(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,
+                                 const double complex *taus, const double *center, const double *normal,
+                                 double *patches, ccn_error *err);
 /* Surface at sector s, hole coordinates (u,v) in [0,1]^2 ((0,0) = EV, u along spoke s, v along
  * spoke s+1): finds the ring / patch (SPEC §1.4, rho_r = 1 - sigma_r) and returns the position
  * and the derivatives with respect to u and v. */

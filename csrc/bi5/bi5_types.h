@@ -31,8 +31,14 @@ struct ccn__bi5 {
     double *qr;     /* QR of the design matrix J (27n x (npar-1)), column-major */
     double *qtau;   /* npar-1 Householder scalars */
     double *s0;     /* 27n: the sampled border of parameter 0 (b_600) */
+    double *qr1;    /* QR of J without parameters 1, 2 (b_510, b_501): 27n x (npar-3) */
+    double *qtau1;  /* its npar-3 Householder scalars */
+    double *s12;    /* 2 x 27n: the sampled borders of parameters 1 and 2 */
     double *stencil;/* (3 nsig + 1)*36 rows (sector 0) x (6n+2) columns, row-major; column
                      * 6n+1 is the weight of the centre point b_600 */
+    double *stencilF; /* the same with the guide's b_510, b_501 given ([R14]): 6n+4 columns,
+                       * the last two their weights */
+    double *w12;    /* 2 x (6n+2): b_510, b_501 of the plain fit (sector 0) from net and centre */
 };
 
 /* omega^k = exp(2 pi i k / n). */

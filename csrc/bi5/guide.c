@@ -152,7 +152,10 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
     ccn__bi5_sample(n, b->chi_half, 3, 1.0, 0xEu, b->samp0); /* corners (1,0),(1,1),(0,1) */
     double *eye = calloc((size_t)P * (size_t)P, sizeof(double));
     double *J = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 1));
-    if (!eye || !J || !b->gpar || !b->qr || !b->qtau || !b->s0) {
+    b->qr1 = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 3));
+    b->qtau1 = malloc(sizeof(double) * (size_t)P);
+    b->s12 = malloc(sizeof(double) * 2 * (size_t)rows);
+    if (!eye || !J || !b->gpar || !b->qr || !b->qtau || !b->s0 || !b->qr1 || !b->qtau1 || !b->s12) {
         free(eye); free(J);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (guide, n = %d)", (int)n);
     }
@@ -168,7 +171,12 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
                 if (p == 0) b->s0[s * 27 + e] = acc;
                 else J[(size_t)(p - 1) * rows + s * 27 + e] = acc;
             }
+    /* parameters 1, 2 (b_510, b_501) apart, and the QR of the other columns */
+    memcpy(b->s12, J, sizeof(double) * 2 * (size_t)rows);
+    memcpy(b->qr1, J + 2 * (size_t)rows, sizeof(double) * (size_t)rows * (size_t)(P - 3));
+    lapack_int info1 = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 3, b->qr1, rows, b->qtau1);
     lapack_int info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 1, J, rows, b->qtau);
+    if (info1 != 0) info = info1;
     double rmin = INFINITY, rmax = 0;
     for (int32_t p = 0; p < P - 1; p++) {
         double r = fabs(J[(size_t)p * rows + p]);
@@ -221,4 +229,66 @@ ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double
     }
     free(tgt); free(par);
     return CCN_OK;
+}
+
+ccn_status ccn__bi5_guide_fit_fixed(const ccn__bi5 *b, const double *tcc, const double *b600,
+                                    const double *p12, int32_t m, double *gbb, ccn_error *err) {
+    int32_t n = b->n, P = b->npar, rows = 27 * n, idx[27];
+    mask_list(idx);
+    double *tgt = malloc(sizeof(double) * (size_t)rows * (size_t)m), *par = malloc(sizeof(double) * (size_t)P * (size_t)m);
+    if (!tgt || !par) {
+        free(tgt); free(par);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (guide fit)");
+    }
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t e = 0; e < 27; e++)
+            for (int32_t c = 0; c < m; c++) {
+                int32_t r = s * 27 + e;
+                tgt[(size_t)c * rows + r] = tcc[((size_t)s * 36 + idx[e]) * m + c] - b->s0[r] * b600[c] -
+                                            b->s12[r] * p12[c] - b->s12[rows + r] * p12[m + c];
+            }
+    lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', rows, m, P - 3, b->qr1, rows,
+                                     b->qtau1, tgt, rows);
+    if (info == 0)
+        info = LAPACKE_dtrtrs(LAPACK_COL_MAJOR, 'U', 'N', 'N', P - 3, m, b->qr1, rows, tgt, rows);
+    if (info != 0) {
+        free(tgt); free(par);
+        return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "bi5: guide QR solve failed (%d)", (int)info);
+    }
+    for (int32_t c = 0; c < m; c++) {
+        par[c] = b600[c];
+        par[m + c] = p12[c];
+        par[2 * m + c] = p12[m + c];
+        for (int32_t q = 3; q < P; q++) par[(size_t)q * m + c] = tgt[(size_t)c * rows + q - 3];
+    }
+    for (int32_t r = 0; r < 28 * n; r++) { /* gbb = gpar * par */
+        double *o = gbb + (size_t)r * m;
+        memset(o, 0, sizeof(double) * (size_t)m);
+        for (int32_t q = 0; q < P; q++) {
+            double w = b->gpar[(size_t)r * P + q];
+            if (w != 0.0) vaxpy(o, w, par + (size_t)q * m, m);
+        }
+    }
+    free(tgt); free(par);
+    return CCN_OK;
+}
+
+void ccn__bi5_project_p12(const double *b600, const double *normal, double p12[6]) {
+    for (int q = 0; q < 2; q++) {
+        double h = 0;
+        for (int c = 0; c < 3; c++) h += (p12[3 * q + c] - b600[c]) * normal[c];
+        for (int c = 0; c < 3; c++) p12[3 * q + c] -= h * normal[c];
+    }
+}
+
+ccn_status ccn__bi5_guide_fit_plane(const ccn__bi5 *b, const double *tcc, const double *b600,
+                                    const double *normal, double *gbb, ccn_error *err) {
+    ccn_status st = ccn__bi5_guide_fit(b, tcc, b600, 3, gbb, err); /* for b_510, b_501 */
+    if (st) return st;
+    const int32_t t1 = ccn__bi5_tri(5, 1, 0), t2 = ccn__bi5_tri(5, 0, 1);
+    double p[6], p12[6];
+    for (int c = 0; c < 3; c++) p[c] = gbb[(size_t)t1 * 3 + c], p[3 + c] = gbb[(size_t)t2 * 3 + c];
+    ccn__bi5_project_p12(b600, normal, p);
+    for (int c = 0; c < 3; c++) p12[c] = p[c], p12[3 + c] = p[3 + c]; /* rows p1, p2 of m = 3 */
+    return ccn__bi5_guide_fit_fixed(b, tcc, b600, p12, 3, gbb, err);
 }

@@ -21,5 +21,16 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err);
 /* Least-squares guide fit: tcc (n x 36 x m, raised t_CC), b600 (m) -> gbb (n x 28 x m). */
 ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double *b600,
                               int32_t m, double *gbb, ccn_error *err);
+/* The same for m = 3 (x, y, z) with the guide's tangent plane at the centre prescribed: the
+ * first-order coefficients b_510, b_501 of the plain fit are projected onto the plane through
+ * b600 with unit normal `normal`, and the other parameters refitted with them fixed. */
+ccn_status ccn__bi5_guide_fit_plane(const ccn__bi5 *b, const double *tcc, const double *b600,
+                                    const double *normal, double *gbb, ccn_error *err);
+/* The fit with b_510, b_501 given: p12 = 2 x m (p1 columns, then p2 columns). */
+ccn_status ccn__bi5_guide_fit_fixed(const ccn__bi5 *b, const double *tcc, const double *b600,
+                                    const double *p12, int32_t m, double *gbb, ccn_error *err);
+/* p12 = (b_510, b_501) as two 3-vectors, projected onto the plane through b600 with that
+ * unit normal. */
+void ccn__bi5_project_p12(const double *b600, const double *normal, double p12[6]);
 
 #endif

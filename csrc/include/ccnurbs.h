@@ -78,6 +78,8 @@ typedef struct {
     int32_t boundary_corners; /* ccn_corners, default SMOOTH */
     int32_t threads;          /* 0 = default */
     int32_t crease_method;    /* ccn_crease_method, default UNIFORM */
+    int32_t ev_polyhedron;    /* scheme EIGEN: CCN_POLY_SELECT (default, the per-vertex choice
+                                 of ccn_ev_matrix) or one fixed candidate CCN_POLY_PAPER.. */
 } ccn_options;
 
 /* ---- control meshes ------------------------------------------------------------ */
@@ -179,12 +181,34 @@ typedef struct {
     double T0[2];     /* translation of the eigen polyhedron, eq (28) */
     int32_t fallback; /* 1 if the eigen rules failed and NURSS rules were used */
     double residual;  /* max |M P0 - lambda P0 - 1 T0| on the eigen polyhedron */
+    int32_t polyhedron; /* EIGEN without fallback: the eigen polyhedron M is built from
+                           (CCN_POLY_PAPER..CCN_POLY_COUNT); 0 otherwise */
+    int32_t verified;   /* candidates the per-vertex choice verified (0: accepted unchecked) */
+    int32_t outside_g1; /* 1: no candidate passed the verification; the paper's M is used and
+                           the vertex is outside the range where G1 is verified */
 } ccn_ev_info;
 
+/* Eigen polyhedra (scheme EIGEN; the list with reasons: csrc/rules/eigen_shape.h):
+ * CCN_POLY_PAPER = Li 2016 section 5's spoke lengths; 2..11 = l_i^(1-e) d_i^e with
+ * e = 0.1, 0.2, -0.1, 0.05, -0.05, 0.15, -0.2, 0.3, -0.3, 0.4; 12 = lengths in the ratio of the
+ * transverse Greville abscissae (least squares); 13..28 = interval-dependent sector angles. */
+#define CCN_POLY_SELECT 0
+#define CCN_POLY_PAPER 1
+#define CCN_POLY_COUNT 28
+
 /* M ((2n+1) x (2n+1), row-major; rows F_0..F_{n-1}, E_0..E_{n-1}, V) for valence n >= 3
- * and spoke intervals d[0..n-1] > 0. info may be NULL. */
+ * and spoke intervals d[0..n-1] > 0. info may be NULL. Scheme EIGEN: the per-vertex choice of
+ * the eigen polyhedron (README "Eigen rules"): the paper's if max/min d <= 5, else the first
+ * candidate that passes the single-maximum (level 5) and characteristic-map checks (a few ms
+ * per candidate), else the paper's with info->outside_g1 = 1. */
 ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
                          ccn_ev_info *info, ccn_error *err);
+
+/* ccn_ev_matrix with a given polyhedron: CCN_POLY_SELECT (= ccn_ev_matrix) or a fixed
+ * candidate 1..CCN_POLY_COUNT (no verification). */
+ccn_status ccn_ev_matrix_polyhedron(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                                    int32_t polyhedron, double *M, ccn_ev_info *info,
+                                    ccn_error *err);
 
 /* ---- limit surface: plan once, evaluate many times ------------------------------ */
 
@@ -205,6 +229,8 @@ typedef struct {
     int32_t num_sharp_vertices;
     int32_t num_sharp_corners;/* output vertices whose faces see more than one tangent plane
                                  (creases, corners): corner_normals differ from normals */
+    int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 5) */
+    int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
 } ccn_sizes;
 
 /* Caller-owned output buffers; sizes from ccn_plan_sizes. */

@@ -288,8 +288,9 @@ done:
 /* ---- refinement ----------------------------------------------------------------------- */
 
 ccn_status ccn__fvar_prepare(ccn__level *c, const ccn__fvar_level *f, int scheme,
-                             int crease_method, ccn_error *err) {
-    ccn_status st = ccn__level_prepare(c, f->m, scheme, 0, crease_method, err);
+                             int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                             ccn_error *err) {
+    ccn_status st = ccn__level_prepare_ev(c, f->m, scheme, 0, crease_method, ev_poly, cache, err);
     if (!st) c->partner = f->partner;
     return st;
 }

@@ -26,10 +26,11 @@ typedef struct {
  * in [0, num_values). */
 ccn_status ccn__fvar_build(const ccn_mesh *vm, const int32_t *corner_values, int linear,
                            int pinned, ccn__fvar_level *out, int32_t **value_of, ccn_error *err);
-/* The rules of one level of f (scheme, crease method as for the vertex mesh; corners by
- * sharpness, so no pinned flag). c->partner points into f. */
+/* The rules of one level of f (scheme, crease method, eigen polyhedron option and choice cache
+ * as for the vertex mesh; corners by sharpness, so no pinned flag). c->partner points into f. */
 ccn_status ccn__fvar_prepare(ccn__level *c, const ccn__fvar_level *f, int scheme,
-                             int crease_method, ccn_error *err);
+                             int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                             ccn_error *err);
 /* The next level of f (topology only): vm is f's vertex mesh, vchild vm's next level. */
 ccn_status ccn__fvar_child(const ccn__fvar_level *f, const ccn__level *c, const ccn_mesh *vm,
                            const ccn_mesh *vchild, ccn__fvar_level *out, ccn_error *err);

@@ -184,13 +184,16 @@ static ccn_status build_ev_matrices(ccn__level *c, ccn_error *err) {
         int32_t v = c->ev_list[i], n = ccn__valence(m, v);
         for (int32_t k = 0; k < n; k++) d[k] = m->eknot[ccn__fan_edge(m, v, k)];
         ccn_ev_info info;
-        ccn_status st = ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, c->M + c->Moff[i], &info, NULL);
+        ccn_status st = ccn__ev_matrix_cached(n, d, CCN_SCHEME_EIGEN, c->ev_poly, c->ev_cache,
+                                              c->M + c->Moff[i], &info, NULL);
         if (st) {
             free(d);
             return ccn__fail(err, st, CCN_ELEM_VERTEX, v,
                              "extraordinary vertex %d: refinement matrix failed", (int)v);
         }
         c->fallbacks += info.fallback != 0;
+        c->ev_verified += info.verified > 0;
+        c->ev_outside += info.outside_g1 != 0;
     }
     free(d);
     return CCN_OK;
@@ -355,7 +358,15 @@ void ccn__level_free(ccn__level *c) {
 
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                               int crease_method, ccn_error *err) {
+    return ccn__level_prepare_ev(c, m, scheme, pinned, crease_method, CCN_POLY_SELECT, NULL, err);
+}
+
+ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                                 int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                                 ccn_error *err) {
     memset(c, 0, sizeof *c);
+    c->ev_poly = ev_poly;
+    c->ev_cache = cache;
     c->m = m;
     c->pinned = pinned;
     c->crease_method = crease_method;

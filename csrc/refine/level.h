@@ -3,6 +3,7 @@
 #ifndef CCN_REFINE_LEVEL_H
 #define CCN_REFINE_LEVEL_H
 
+#include "rules/eigen_select.h"
 #include "topology/halfedge.h"
 
 #include <stddef.h>
@@ -24,9 +25,16 @@ typedef struct {
      * corner, and the fractional weight where it changes) follows the sharpness of vertex
      * partner[v] >= 0 (OpenSubdiv's dependent sharpness), its crease along its own edges. */
     const int32_t *partner;
+    ccn__ev_cache *ev_cache; /* the owner's cache of eigen polyhedron choices (may be NULL) */
+    int32_t ev_poly;     /* ccn_options.ev_polyhedron */
+    int32_t ev_verified, ev_outside; /* EVs of this level verified / outside the G1 range */
 } ccn__level;
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                               int crease_method, ccn_error *err);
+/* ccn__level_prepare with the eigen polyhedron option and the owner's choice cache. */
+ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                                 int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                                 ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
 void ccn__level_points(const ccn__level *c, double *out);
 /* Next-level points around the listed vertices only (see refine/level.c). */

@@ -13,10 +13,12 @@
 #include <math.h>
 #include <string.h>
 
-static ccn_status refine_level(const ccn_mesh *m, int scheme, int pinned, int crease_method,
-                               int threads, ccn_mesh **out, ccn_error *err) {
+static ccn_status refine_level(const ccn_mesh *m, const ccn_options *o, ccn__ev_cache *cache,
+                               ccn_mesh **out, ccn_error *err) {
     ccn__level c;
-    ccn_status st = ccn__level_prepare(&c, m, scheme, pinned, crease_method, err);
+    ccn_status st = ccn__level_prepare_ev(&c, m, o->scheme, o->boundary_corners == CCN_CORNERS_PINNED,
+                                          o->crease_method, o->ev_polyhedron, cache, err);
+    int threads = ccn__thread_count(o->threads);
     if (st) return st;
     c.threads = threads;
     st = ccn__level_topology(&c, out, err);
@@ -70,6 +72,9 @@ static ccn_status check_refine(const ccn_mesh *in, int32_t levels, const ccn_opt
                          "levels must be in [0, 16], got %d", (int)levels);
     if (o->scheme < CCN_SCHEME_EIGEN || o->scheme > CCN_SCHEME_CATMULL_CLARK)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown scheme %d", (int)o->scheme);
+    if (o->ev_polyhedron < CCN_POLY_SELECT || o->ev_polyhedron > CCN_POLY_COUNT)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "ev_polyhedron %d outside [0, %d]",
+                         (int)o->ev_polyhedron, CCN_POLY_COUNT);
     int64_t corners = in->nh; /* face corners quadruple per level: fail before any work */
     for (int32_t l = 0; l < levels; l++)
         if ((corners *= 4) > INT32_MAX / 8)
@@ -88,19 +93,20 @@ ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opt
     if (opts) o = *opts;
     ccn_status cst = check_refine(in, levels, &o, err);
     if (cst) return cst;
-    int pinned = o.boundary_corners == CCN_CORNERS_PINNED;
     ccn_mesh *cur = o.scheme == CCN_SCHEME_CATMULL_CLARK ? uniform_copy(in) : mesh_clone(in);
     if (!cur) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     double centre[3], scale; /* unit box: huge coordinates cannot overflow */
     ccn__normalize(cur, centre, &scale);
+    ccn__ev_cache *cache = ccn__ev_cache_create(); /* the levels share the polyhedron choices */
+    if (!cache) { ccn_mesh_destroy(cur); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     for (int32_t l = 0; l < levels; l++) {
         ccn_mesh *next = NULL;
-        ccn_status st = refine_level(cur, o.scheme, pinned, o.crease_method, ccn__thread_count(o.threads),
-                                     &next, err);
+        ccn_status st = refine_level(cur, &o, cache, &next, err);
         ccn_mesh_destroy(cur);
-        if (st) return st;
+        if (st) { ccn__ev_cache_destroy(cache); return st; }
         cur = next;
     }
+    ccn__ev_cache_destroy(cache);
     ccn__denormalize(cur, centre, scale);
     *out = cur;
     return CCN_OK;
@@ -151,7 +157,8 @@ ccn_status ccn_fvar_refine(const ccn_mesh *in, const ccn_fvar_channel *ch, int32
     memset(&fn, 0, sizeof fn);
     int32_t *value_of = NULL;
     double *vals = NULL;
-    if (!r || !cur) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto done; }
+    ccn__ev_cache *cache = ccn__ev_cache_create(); /* the levels share the polyhedron choices */
+    if (!r || !cur || !cache) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto done; }
     if ((st = ccn__fvar_build(cur, ch->indices, ch->linear, pinned, &fl, &value_of, err))) goto done;
     r->width = w;
     r->num_seams = fl.num_seams;
@@ -170,10 +177,12 @@ ccn_status ccn_fvar_refine(const ccn_mesh *in, const ccn_fvar_channel *ch, int32
         ccn__level vc, fc;
         ccn_mesh *vnext = NULL;
         double *nv = NULL;
-        if ((st = ccn__level_prepare(&vc, cur, o.scheme, pinned, o.crease_method, err))) break;
+        if ((st = ccn__level_prepare_ev(&vc, cur, o.scheme, pinned, o.crease_method, o.ev_polyhedron,
+                                        cache, err)))
+            break;
         st = ccn__level_topology(&vc, &vnext, err);
         ccn__level_free(&vc);
-        if (!st && !(st = ccn__fvar_prepare(&fc, &fl, o.scheme, o.crease_method, err))) {
+        if (!st && !(st = ccn__fvar_prepare(&fc, &fl, o.scheme, o.crease_method, o.ev_polyhedron, cache, err))) {
             fc.threads = threads;
             st = ccn__fvar_child(&fl, &fc, cur, vnext, &fn, err);
             if (!st && !(nv = malloc(sizeof(double) * (size_t)w * (size_t)fn.m->nv)))
@@ -206,6 +215,7 @@ done:
     ccn_mesh_destroy(cur);
     free(value_of);
     free(vals);
+    ccn__ev_cache_destroy(cache);
     ccn_fvar_destroy(r);
     return st;
 }

@@ -25,6 +25,7 @@
 #include "rules/eigen.h"
 
 #include "rules/bilinear.h"
+#include "rules/eigen_shape.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -197,8 +198,10 @@ static void build_nurss(int32_t n, const double *d, double *g, double *f, double
 
 typedef struct {
     int32_t n;
+    const ccn__poly_design *des; /* the polyhedron's design (rules/eigen_shape.h) */
     const double *d;          /* normalised intervals */
     double *c, *s;            /* cos, sin of 2 pi i / n (eq (25)) */
+    double *sc, *ss;          /* the spokes' directions (= c, s but for the angle designs) */
     double *dp;               /* d_i^+ (section 5) */
     double *ex, *ey, *fx, *fy; /* eigen polyhedron E_i^0, F_i^0 (eqs (26), (13)) */
     double *g, *f, *m;        /* vertex-rule weights (27) */
@@ -208,28 +211,37 @@ typedef struct {
 
 /* Section 5 (SPEC 2.2): d_i^+- = sum over j = i..i+n-1 (j = i included) of d_j max(+-cos, 0),
  * l_i = (d_i + d_i^+ + d_i^-)/3, E_i = l_i (cos, sin)(2 pi i/n) (26), F_i = gamma (E_i +
- * E_{i+1}) (13). */
-static void eigen_polyhedron(eigen_work *w) {
+ * E_{i+1}) (13). Another candidate design (w->des, rules/eigen_shape.h) replaces the lengths
+ * l_i and, for the angle designs, the spoke directions; d_i^+ (the vertex rule's f_i) is the
+ * paper's in every case. Returns -1 if the candidate could not be built. */
+static int eigen_polyhedron(eigen_work *w) {
     int32_t n = w->n, i, k;
     double gamma = ccn__ev_gamma(n);
     for (i = 0; i < n; i++) ccn__cos_sin_2pi(i, n, &w->c[i], &w->s[i]);
     for (i = 0; i < n; i++) {
-        double plus = 0, minus = 0, l;
+        double plus = 0, minus = 0;
         for (k = 0; k < n; k++) {
             double dj = w->d[wrap((int64_t)i + k, n)], ck = w->c[k];
             if (ck > 0) plus += dj * ck;
             else if (ck < 0) minus -= dj * ck;
         }
         w->dp[i] = plus;
-        l = (w->d[i] + plus + minus) / 3.0;
-        w->ex[i] = l * w->c[i];
-        w->ey[i] = l * w->s[i];
+        w->ex[i] = (w->d[i] + plus + minus) / 3.0; /* l_i, scaled below */
+        w->sc[i] = w->c[i];
+        w->ss[i] = w->s[i];
+    }
+    if (ccn__poly_apply(w->des, n, w->d, w->ex, w->sc, w->ss)) return -1;
+    for (i = 0; i < n; i++) {
+        double l = w->ex[i];
+        w->ex[i] = l * w->sc[i];
+        w->ey[i] = l * w->ss[i];
     }
     for (i = 0; i < n; i++) {
         int32_t j = wrap(i + 1, n);
         w->fx[i] = gamma * (w->ex[i] + w->ex[j]);
         w->fy[i] = gamma * (w->ey[i] + w->ey[j]);
     }
+    return 0;
 }
 
 /* (M P0)_r for one row (V^0 = 0, so the V column does not contribute). */
@@ -361,7 +373,10 @@ static int build_eigen(eigen_work *w, double *M, double *residual, char *why, si
     int32_t n = w->n;
     zero_matrix(M, n);
     w->lambda = ccn__ev_lambda(n);
-    eigen_polyhedron(w);
+    if (eigen_polyhedron(w)) {
+        snprintf(why, whylen, "the candidate polyhedron could not be built");
+        return 1;
+    }
     eigen_vertex(w, M);
     if (!isfinite(w->T0[0]) || !isfinite(w->T0[1])) {
         snprintf(why, whylen, "vertex rule (27) is not finite");
@@ -403,9 +418,9 @@ static double cc_residual(const double *M, int32_t n, double *scratch) {
 
 /* ---- public entry ---------------------------------------------------------------------- */
 
-#define SCRATCH_PER_N 13
+#define SCRATCH_PER_N 15
 
-static ccn_status validate(int32_t n, const double *d, ccn_scheme scheme, const double *M,
+ccn_status ccn__ev_validate(int32_t n, const double *d, ccn_scheme scheme, const double *M,
                            ccn_error *err) {
     int32_t i;
     if (n < 3 || n > CCN__EV_MAX_VALENCE) {
@@ -433,8 +448,7 @@ static ccn_status validate(int32_t n, const double *d, ccn_scheme scheme, const 
     return CCN_OK;
 }
 
-/* d / max(d), clamped to >= CCN__EV_MIN_INTERVAL. Returns max(d). */
-static double normalise(int32_t n, const double *d, double *out) {
+double ccn__ev_normalise(int32_t n, const double *d, double *out) {
     double mx = 0;
     int32_t i;
     for (i = 0; i < n; i++) mx = fmax(mx, d[i]);
@@ -442,22 +456,26 @@ static double normalise(int32_t n, const double *d, double *out) {
     return mx;
 }
 
-/* Points the eigen work arrays into scratch (12 n doubles). */
-static void work_init(eigen_work *w, int32_t n, const double *d, double *scratch) {
-    double **arrays[12];
+/* Points the eigen work arrays into scratch (14 n doubles). */
+static void work_init(eigen_work *w, int32_t n, const double *d, const ccn__poly_design *des,
+                      double *scratch) {
+    double **arrays[14];
     int k;
     memset(w, 0, sizeof *w);
     w->n = n;
+    w->des = des;
     w->d = d;
     arrays[0] = &w->c, arrays[1] = &w->s, arrays[2] = &w->dp, arrays[3] = &w->ex;
     arrays[4] = &w->ey, arrays[5] = &w->fx, arrays[6] = &w->fy, arrays[7] = &w->g;
     arrays[8] = &w->f, arrays[9] = &w->m, arrays[10] = &w->a1, arrays[11] = &w->a2;
-    for (k = 0; k < 12; k++) *arrays[k] = scratch + (size_t)k * (size_t)n;
+    arrays[12] = &w->sc, arrays[13] = &w->ss;
+    for (k = 0; k < 14; k++) *arrays[k] = scratch + (size_t)k * (size_t)n;
 }
 
 /* Fills M and info for a validated call; buf holds SCRATCH_PER_N * n doubles. */
-static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme, double *M,
-                             ccn_ev_info *info, ccn_error *err, double *buf) {
+static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme,
+                             const ccn__poly_design *des, int32_t poly, double *M,
+                             ccn_ev_info *info, double *P, ccn_error *err, double *buf) {
     double *nd = buf, *rest = buf + n, dmax, residual = 0;
     char why[200];
     eigen_work w;
@@ -467,13 +485,19 @@ static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme, doub
         info->residual = cc_residual(M, n, rest);
         return CCN_OK;
     }
-    dmax = normalise(n, d, nd);
+    dmax = ccn__ev_normalise(n, d, nd);
     if (scheme == CCN_SCHEME_EIGEN) {
-        work_init(&w, n, nd, rest);
+        work_init(&w, n, nd, des, rest);
         if (!build_eigen(&w, M, &residual, why, sizeof why)) {
             info->T0[0] = w.T0[0] * dmax;
             info->T0[1] = w.T0[1] * dmax;
             info->residual = residual;
+            info->polyhedron = poly;
+            for (int32_t i = 0; P && i < n; i++) {
+                P[2 * col_f(i, n)] = w.fx[i], P[2 * col_f(i, n) + 1] = w.fy[i];
+                P[2 * col_e(i, n)] = w.ex[i], P[2 * col_e(i, n) + 1] = w.ey[i];
+            }
+            if (P) P[2 * col_v(n)] = P[2 * col_v(n) + 1] = 0;
             return CCN_OK;
         }
         info->fallback = 1;
@@ -487,11 +511,12 @@ static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme, doub
     return CCN_OK;
 }
 
-ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
-                         ccn_ev_info *info, ccn_error *err) {
+ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                                 const ccn__poly_design *des, int32_t poly, double *M,
+                                 ccn_ev_info *info, double *P, ccn_error *err) {
     double stack[SCRATCH_PER_N * CCN__EV_STACK_VALENCE], *buf = stack;
     ccn_ev_info local;
-    ccn_status st = validate(n, spoke_knots, scheme, M, err);
+    ccn_status st = ccn__ev_validate(n, spoke_knots, scheme, M, err);
     if (st != CCN_OK) return st;
     if (n > CCN__EV_STACK_VALENCE) {
         buf = malloc(sizeof(double) * SCRATCH_PER_N * (size_t)n);
@@ -503,7 +528,20 @@ ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme
     if (!info) info = &local;
     memset(info, 0, sizeof *info);
     set_error(err, CCN_OK, "%s", "");
-    st = run_scheme(n, spoke_knots, scheme, M, info, err, buf);
+    st = run_scheme(n, spoke_knots, scheme, des, poly, M, info, P, err, buf);
     if (buf != stack) free(buf);
     return st;
+}
+
+ccn_status ccn__ev_matrix_poly(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                               int32_t poly, double *M, ccn_ev_info *info, double *P,
+                               ccn_error *err) {
+    const ccn__poly_design *des = ccn__poly_design_of(poly);
+    if (!des) {
+        if (info) memset(info, 0, sizeof *info);
+        set_error(err, CCN_ERR_ARGUMENT, "ev matrix: polyhedron %d outside [1, %d]", (int)poly,
+                  CCN__POLY_COUNT);
+        return CCN_ERR_ARGUMENT;
+    }
+    return ccn__ev_matrix_design(n, spoke_knots, scheme, des, poly, M, info, P, err);
 }

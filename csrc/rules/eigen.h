@@ -8,6 +8,7 @@
 #define CCN_RULES_EIGEN_H
 
 #include "ccnurbs.h"
+#include "rules/eigen_shape.h"
 
 /* Largest valence ccn_ev_matrix accepts. The eigen polyhedron costs O(n^2) and M itself has
  * (2n+1)^2 entries (n = 65536 would already be a 34 GB matrix). */
@@ -32,5 +33,25 @@ void ccn__cos_sin_2pi(int64_t k, int64_t n, double *c, double *s);
  * c = cos(2 pi / n); and gamma of eq (14) (F_i = gamma (E_i + E_{i+1}), eq (13)). n >= 3. */
 double ccn__ev_lambda(int32_t n);
 double ccn__ev_gamma(int32_t n);
+
+/* d / max(d), clamped to >= CCN__EV_MIN_INTERVAL (every rule set is invariant under a common
+ * scale of the intervals). Returns max(d). */
+double ccn__ev_normalise(int32_t n, const double *d, double *out);
+
+/* The argument checks of ccn_ev_matrix (valence, NULL pointers, scheme, intervals > 0). */
+ccn_status ccn__ev_validate(int32_t n, const double *d, ccn_scheme scheme, const double *M,
+                            ccn_error *err);
+
+/* ccn_ev_matrix with a given eigen polyhedron poly (1..CCN__POLY_COUNT, rules/eigen_shape.h;
+ * ignored by the NURSS and Catmull-Clark schemes), no selection. P (may be NULL): the
+ * polyhedron of the normalised intervals, 2 (2n+1) doubles in M's ring order (F_i, E_i, V = 0);
+ * written only when M is the eigen M (no fallback). info->polyhedron = poly then, else 0. */
+ccn_status ccn__ev_matrix_poly(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                               int32_t poly, double *M, ccn_ev_info *info, double *P,
+                               ccn_error *err);
+/* The same for any design (research and tests); info->polyhedron = poly. */
+ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                                 const ccn__poly_design *des, int32_t poly, double *M,
+                                 ccn_ev_info *info, double *P, ccn_error *err);
 
 #endif

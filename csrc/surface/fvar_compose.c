@@ -148,6 +148,7 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
+    ccn__ring_work_set_ev(work, p->opts.ev_polyhedron, p->ev_cache);
     c->st_start[0] = 0;
     float dep;
     for (int32_t v = 0; v < m->nv; v++)
@@ -204,7 +205,8 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
     if (st) return st;
     for (int32_t l = 0; l < c->L; l++) {
-        if ((st = ccn__fvar_prepare(&c->prep[l], &c->lev[l], p->opts.scheme, p->opts.crease_method, err))) {
+        if ((st = ccn__fvar_prepare(&c->prep[l], &c->lev[l], p->opts.scheme, p->opts.crease_method,
+                                      p->opts.ev_polyhedron, p->ev_cache, err))) {
             memset(&c->prep[l], 0, sizeof c->prep[l]);
             return st;
         }
@@ -215,7 +217,8 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     const ccn_mesh *mL = c->lev[c->L].m;
     if (!c->bilinear && (st = limit_stencils(p, c, err))) return st;
     if (c->nnear) {
-        if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method, err)))
+        if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method,
+                                      p->opts.ev_polyhedron, p->ev_cache, err)))
             return st;
         c->has_sub = 1;
         c->posS = malloc(sizeof(double) * 3 * ((size_t)mL->nf + mL->ne + mL->nv));

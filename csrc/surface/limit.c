@@ -245,16 +245,19 @@ static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *
 }
 
 static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
-                               ccn__stencil *s, ccn_error *err);
+                               int32_t ev_poly, ccn__ev_cache *cache, ccn__stencil *s,
+                               ccn_error *err);
 
-ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
-                         ccn_error *err) {
-    return ev_limit_ring(m, v, scheme, 0, s, err);
+ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, int32_t ev_poly,
+                         ccn__ev_cache *cache, ccn__stencil *s, ccn_error *err) {
+    return ev_limit_ring(m, v, scheme, 0, ev_poly, cache, s, err);
 }
 
-/* child: the ring is that of v's vertex point one level finer (same spoke ratios). */
+/* child: the ring is that of v's vertex point one level finer (same spoke ratios). M is the
+ * refinement's own (the same polyhedron choice, from the owner's cache). */
 static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int child,
-                               ccn__stencil *s, ccn_error *err) {
+                               int32_t ev_poly, ccn__ev_cache *cache, ccn__stencil *s,
+                               ccn_error *err) {
     int32_t n = ccn__valence(m, v), sz = 2 * n + 1;
     if (sz > CCN_STENCIL_MAX)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
@@ -265,7 +268,7 @@ static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int ch
     if (!buf) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
     double *M = buf, *d = M + (size_t)sz * sz, *l0 = d + sz, *l1 = l0 + sz, *l2 = l1 + sz;
     for (int32_t k = 0; k < n; k++) d[k] = m->eknot[ccn__fan_edge(m, v, k)];
-    ccn_status st = ccn_ev_matrix(n, d, (ccn_scheme)scheme, M, NULL, err);
+    ccn_status st = ccn__ev_matrix_cached(n, d, (ccn_scheme)scheme, ev_poly, cache, M, NULL, err);
     if (!st) st = left_eigvecs(M, sz, l0, l1, l2, err);
     if (!st) {
         ccn__ev_ring(m, v, ring);
@@ -342,7 +345,12 @@ ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, in
     if (ring) ring->nsec = 0;
     if (kind == CCN_LIMIT_REGULAR) child_regular(m, v, s);
     else if (kind == CCN_LIMIT_ISOLATED) stencil_add(s, m->nf + m->ne + v, 1, 0, 0);
-    else if (kind == CCN_LIMIT_EV) return ev_limit_ring(m, v, scheme, 1, s, err);
+    else if (kind == CCN_LIMIT_EV) {
+        int32_t ev_poly;
+        ccn__ev_cache *cache;
+        ccn__ring_work_ev(w, &ev_poly, &cache);
+        return ev_limit_ring(m, v, scheme, 1, ev_poly, cache, s, err);
+    }
     else if (ccn__valence(m, v) > CCN_RING_MAX_VALENCE || !w || !ring) {
         if (kind == CCN_LIMIT_BOUNDARY_CURVE) child_boundary_curve(m, v, s);
         else stencil_add(s, m->nf + m->ne + v, 1, 0, 0); /* huge creased valence: the point */

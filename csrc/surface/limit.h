@@ -41,8 +41,8 @@ int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s
 int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring);
 /* Limit point and tangent directions of an interior EV from the left eigenvectors of M
  * (scheme's matrix); wu x wv is the outward normal (oriented by the characteristic map). */
-ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, ccn__stencil *s,
-                         ccn_error *err);
+ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, int32_t ev_poly,
+                         ccn__ev_cache *cache, ccn__stencil *s, ccn_error *err);
 /* Limit stencil of the vertex point of v one level finer, in level-(l+1) numbering (face
  * point f -> f, edge point e -> nf+e, vertex point v -> nf+ne+v), built from this level's
  * topology; wu x wv is the outward normal. For BOUNDARY_CURVE and RING vertices (w and ring

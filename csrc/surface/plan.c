@@ -43,6 +43,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
     for (int32_t c = 0; c < p->nfv; c++) ccn__fvchan_free(p->fv[c]);
     free(p->fv); free(p->vd_buf);
+    ccn__ev_cache_destroy(p->ev_cache);
     free(p);
 }
 
@@ -57,6 +58,9 @@ static ccn_status check_options(const ccn_options *o, ccn_error *err) {
     if (o->crease_method < CCN_CREASE_UNIFORM || o->crease_method > CCN_CREASE_CHAIKIN)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown crease_method %d",
                          (int)o->crease_method);
+    if (o->ev_polyhedron < CCN_POLY_SELECT || o->ev_polyhedron > CCN_POLY_COUNT)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "ev_polyhedron %d outside [0, %d]",
+                         (int)o->ev_polyhedron, CCN_POLY_COUNT);
     if (o->levels < 0 || o->levels > CCN_MAX_LEVELS)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "levels must be in [0, %d], got %d",
                          CCN_MAX_LEVELS, (int)o->levels);
@@ -71,7 +75,8 @@ static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
     if (p->R > p->L) { p->posS = p->lev[p->L + 1]->pos; return CCN_OK; }
     const ccn_mesh *m = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
-    ccn_status st = ccn__level_prepare(&p->sub, m, p->opts.scheme, pinned, p->opts.crease_method, err);
+    ccn_status st = ccn__level_prepare_ev(&p->sub, m, p->opts.scheme, pinned, p->opts.crease_method,
+                                          p->opts.ev_polyhedron, p->ev_cache, err);
     if (st) return st;
     p->has_sub = 1;
     p->sub.threads = 1; /* a few points only */
@@ -102,6 +107,10 @@ static void fill_sizes(ccn_plan *p) {
     s->num_sharp_edges = c->num_sharp_edges;
     s->num_sharp_vertices = c->num_sharp_vertices;
     s->num_sharp_corners = p->nsv;
+    for (int32_t l = 0; l < p->R; l++) { /* every EV gets M once per level from level 1 on */
+        if (p->prep[l].ev_verified > s->num_ev_verified) s->num_ev_verified = p->prep[l].ev_verified;
+        if (p->prep[l].ev_outside > s->num_ev_outside_g1) s->num_ev_outside_g1 = p->prep[l].ev_outside;
+    }
 }
 
 ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
@@ -118,7 +127,8 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     p->opts = o;
     p->threads = ccn__thread_count(o.threads);
     p->lev = calloc(1, sizeof(ccn_mesh *));
-    if (!p->lev) { free(p); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
+    p->ev_cache = ccn__ev_cache_create();
+    if (!p->lev || !p->ev_cache) { free(p->lev); ccn__ev_cache_destroy(p->ev_cache); free(p); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     ccn_mesh *cage_mesh = NULL;
     if ((st = ccn_mesh_create(cage, &cage_mesh, err))) { ccn_plan_destroy(p); return st; }
     if (o.scheme == CCN_SCHEME_CATMULL_CLARK) {

@@ -83,6 +83,7 @@ struct ccn_plan {
     /* per-vertex data (ccn_plan_evaluate_vertex_data): scratch positions of levels 0..L (and
      * L+1 when built) and of the level-(L+1) subset, allocated on first use */
     double *vd_buf;
+    ccn__ev_cache *ev_cache; /* eigen polyhedron choices, shared by every level and limit */
 };
 
 #endif

@@ -65,7 +65,19 @@ struct ccn__ring_work {
     int32_t ncache, capcache;
     int32_t *slot;              /* open-addressing index into cache, nslot entries, -1 = free */
     int32_t nslot;
+    int32_t ev_poly;            /* eigen polyhedron option and the owner's choice cache, for */
+    ccn__ev_cache *ev_cache;    /* the EV limits computed with this work (surface/limit.c) */
 };
+
+void ccn__ring_work_set_ev(ccn__ring_work *w, int32_t ev_poly, ccn__ev_cache *cache) {
+    w->ev_poly = ev_poly;
+    w->ev_cache = cache;
+}
+
+void ccn__ring_work_ev(const ccn__ring_work *w, int32_t *ev_poly, ccn__ev_cache **cache) {
+    *ev_poly = w ? w->ev_poly : CCN_POLY_SELECT;
+    *cache = w ? w->ev_cache : NULL;
+}
 
 ccn__ring_work *ccn__ring_work_create(void) {
     ccn__ring_work *w = calloc(1, sizeof *w);

@@ -6,6 +6,7 @@
 #ifndef CCN_SURFACE_RING_LIMIT_H
 #define CCN_SURFACE_RING_LIMIT_H
 
+#include "rules/eigen_select.h"
 #include "topology/halfedge.h"
 
 #define CCN_RING_MAX_VALENCE 256
@@ -29,6 +30,10 @@ typedef struct {
 typedef struct ccn__ring_work ccn__ring_work; /* scratch and a cache of solved 1-rings */
 ccn__ring_work *ccn__ring_work_create(void);
 void ccn__ring_work_destroy(ccn__ring_work *w);
+/* The eigen polyhedron option (ccn_options.ev_polyhedron) and the owner's cache of polyhedron
+ * choices used by the EV limits computed with w (default: the choice, no cache). */
+void ccn__ring_work_set_ev(ccn__ring_work *w, int32_t ev_poly, ccn__ev_cache *cache);
+void ccn__ring_work_ev(const ccn__ring_work *w, int32_t *ev_poly, ccn__ev_cache **cache);
 
 /* Fills out for vertex v of mesh m (valence <= CCN_RING_MAX_VALENCE, not isolated). The
  * rules are the refinement's own (refine/level.c run on a synthetic 1-ring mesh), so the

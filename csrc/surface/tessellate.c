@@ -154,6 +154,7 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     ccn__stencil *s = malloc(sizeof *s);
     ccn__ring_limit *ring = malloc(sizeof *ring);
     ccn__ring_work *work = ccn__ring_work_create();
+    if (work) ccn__ring_work_set_ev(work, p->opts.ev_polyhedron, p->ev_cache);
     csr_buf b = {0, 0, NULL, NULL, NULL, NULL}, sb = {0, 0, NULL, NULL, NULL, NULL};
     int32_t cap_sv = 0, cap_sec = 0;
     p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));

@@ -239,6 +239,12 @@ int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_o
             else if (strcmp(val, "chaikin") == 0) o->crease_method = CCN_CREASE_CHAIKIN;
             else { fprintf(stderr, "ccnurbs: bad --crease-method '%s'\n", val); return 2; }
             i++;
+        } else if (strcmp(a, "--polyhedron") == 0 && val) {
+            if (ccn_cli_int(val, CCN_POLY_SELECT, CCN_POLY_COUNT, &o->ev_polyhedron)) {
+                fprintf(stderr, "ccnurbs: --polyhedron must be 0 (the per-vertex choice) .. %d\n", CCN_POLY_COUNT);
+                return 2;
+            }
+            i++;
         } else if (fvar_linear && strcmp(a, "--fvar-linear") == 0 && val) {
             if ((*fvar_linear = ccn_cli_fvar_linear(val)) < 0) {
                 fprintf(stderr, "ccnurbs: bad --fvar-linear '%s' (none, corners-only, corners-plus1, "

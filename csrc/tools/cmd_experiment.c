@@ -79,7 +79,7 @@ static void run_case(exp_run *run, long i) {
     ccn_error err;
     ccn_status st;
     if (a->kind == EXP_MAXIMA) st = exp_maxima_case(c, d, a, NULL, &run->mres[i], &err);
-    else st = exp_charmap_case(c, d, a->scheme, a->charlevels, &run->cres[i], &err);
+    else st = exp_charmap_case(c, d, a->scheme, a->poly, a->charlevels, &run->cres[i], &err);
     run->status[i] = (unsigned char)st;
 }
 

@@ -105,6 +105,8 @@ static void matrix_print(long n, const double *d, ccn_scheme scheme, const doubl
     printf("\n# lambda %.17g\n# T0 %.17g %.17g\n# fallback %d\n# residual %.3g\n",
            info->lambda, info->T0[0], info->T0[1], (int)info->fallback, info->residual);
     if (err->message[0]) printf("# note %s\n", err->message);
+    printf("# polyhedron %d\n# verified %d\n# outside_g1 %d\n", (int)info->polyhedron,
+           (int)info->verified, (int)info->outside_g1);
     for (r = 0; r < N; r++) {
         for (c = 0; c < N; c++) printf(c ? " %.17g" : "%.17g", M[r * N + c]);
         putchar('\n');

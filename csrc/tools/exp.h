@@ -27,6 +27,7 @@ typedef struct {
     exp_kind kind;
     ccn_scheme scheme;
     int levels, rings, threads, list, persist, charlevels, dist_log, start;
+    int poly; /* --polyhedron: ccn_options.ev_polyhedron (0 = the per-vertex choice) */
     long cases, offset;
     uint64_t seed;
     double lo;
@@ -122,7 +123,7 @@ double exp_edge_knot(const quad_mesh *q, int32_t a, int32_t b);
 /* The G-ring grid of valence-n EV `ev` whose spoke-0 neighbour is s0, in exp_fan_vid order. */
 int exp_ring_grid(const quad_mesh *q, int32_t ev, int32_t s0, int n, int G, int32_t *idx);
 /* Refines m one level, following the EV and its spoke-0 neighbour. */
-ccn_status exp_track_refine(const ccn_mesh *m, ccn_scheme scheme, int32_t *ev, int32_t *s0,
+ccn_status exp_track_refine(const ccn_mesh *m, ccn_scheme scheme, int poly, int32_t *ev, int32_t *s0,
                             ccn_mesh **out, ccn_error *err);
 
 /* ---- exp_maxima.c ---- */
@@ -140,7 +141,7 @@ ccn_status exp_net_test(const ccn_mesh *m, int n, int32_t ev, int32_t s0, int G,
 
 /* ---- exp_charmap.c ---- */
 /* One charmap case; k = --charlevels. */
-ccn_status exp_charmap_case(const fan_cage *cage, const double *d, ccn_scheme scheme, int k,
+ccn_status exp_charmap_case(const fan_cage *cage, const double *d, ccn_scheme scheme, int poly, int k,
                             cm_result *r, ccn_error *err);
 
 /* ---- exp_report.c ---- */

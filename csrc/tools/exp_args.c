@@ -16,8 +16,11 @@ int exp_usage(void) {
             "  ccnurbs experiment charmap --cases N --seed S [--scheme eigen|nurss|cc] [--dist ...]\n"
             "        [--lo 1e-6] [--valences ...] [--knots ...] [--threads T] [--charlevels k] [--list K]\n"
             "        [--offset K]\n"
+            "  Both: [--polyhedron P] the eigen polyhedron (0: the per-vertex choice, default;\n"
+            "        1: the paper's spoke lengths; 2..%d: one fixed candidate, ccnurbs.h CCN_POLY_*)\n"
             "  Case i (i = K .. K+N-1) has valence valences[i mod count] and intervals drawn from a\n"
-            "  generator seeded by (S, i): results do not depend on --threads or on how a run is split.\n");
+            "  generator seeded by (S, i): results do not depend on --threads or on how a run is split.\n",
+            CCN_POLY_COUNT);
     return 2;
 }
 
@@ -96,6 +99,7 @@ static int parse_number_opt(const char *opt, const char *val, exp_args *o) {
         {"--levels", 0, 9, &o->levels},     {"--threads", 1, 256, &o->threads},
         {"--rings", 3, 8, &o->rings},       {"--list", 0, 1000000, &o->list},
         {"--persist", 0, 12, &o->persist},   {"--charlevels", 2, 7, &o->charlevels},
+        {"--polyhedron", 0, CCN_POLY_COUNT, &o->poly},
     };
     for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++) {
         if (strcmp(opt, tab[i].name)) continue;

@@ -13,6 +13,7 @@
 typedef struct {
     int n, N;
     ccn_scheme scheme;
+    int poly;
     ccn_mesh *L1;
     int32_t ev1, s01;
     int32_t *idx1, *idx2; /* 3-ring of L1 and of L1 refined once */
@@ -50,7 +51,7 @@ static ccn_status cm_setup(cm_ctx *c, const fan_cage *cage, const double *d, ccn
     ccn_status st = exp_fan_mesh(cage, d, &m0, err);
     c->ev1 = 0;
     c->s01 = exp_fan_vid(c->n, 3, 0, 1, 0);
-    if (!st) st = exp_track_refine(m0, c->scheme, &c->ev1, &c->s01, &c->L1, err);
+    if (!st) st = exp_track_refine(m0, c->scheme, c->poly, &c->ev1, &c->s01, &c->L1, err);
     ccn_mesh_destroy(m0);
     if (!st) st = ring_of(c->L1, c->ev1, c->s01, c->n, c->idx1, err);
     return st;
@@ -63,7 +64,7 @@ static ccn_status cm_columns(cm_ctx *c, int c0, double *pos, int32_t nv, ccn_err
     ccn_status st = ccn_mesh_set_positions(c->L1, pos, err);
     int32_t ev = c->ev1, s0 = c->s01;
     ccn_mesh *L2 = NULL;
-    if (!st) st = exp_track_refine(c->L1, c->scheme, &ev, &s0, &L2, err);
+    if (!st) st = exp_track_refine(c->L1, c->scheme, c->poly, &ev, &s0, &L2, err);
     if (!st && c0 == 0) st = ring_of(L2, ev, s0, c->n, c->idx2, err);
     if (!st) {
         ccn_mesh_info in;
@@ -101,7 +102,7 @@ static void cm_matrix_checks(const cm_ctx *c, const double *d, cm_result *r) {
     }
     map[2 * n] = 0;
     r->m_err = INFINITY;
-    if (!M || ccn_ev_matrix(n, d, c->scheme, M, NULL, NULL)) {
+    if (!M || ccn_ev_matrix_polyhedron(n, d, c->scheme, c->poly, M, NULL, NULL)) {
         free(M);
         return;
     }
@@ -245,7 +246,7 @@ static ccn_status cm_charring(cm_ctx *c, int k, const double *x, const double *y
     int32_t ev = c->ev1, s0 = c->s01;
     for (int l = 1; l <= k && !st; l++) {
         next = NULL;
-        st = exp_track_refine(l > 1 ? cur : c->L1, c->scheme, &ev, &s0, &next, err);
+        st = exp_track_refine(l > 1 ? cur : c->L1, c->scheme, c->poly, &ev, &s0, &next, err);
         ccn_mesh_destroy(cur);
         cur = next;
         if (!st && l == EXP_SURFACE_LEVEL)
@@ -257,10 +258,21 @@ static ccn_status cm_charring(cm_ctx *c, int k, const double *x, const double *y
     return st;
 }
 
-ccn_status exp_charmap_case(const fan_cage *cage, const double *d, ccn_scheme scheme, int k,
+ccn_status exp_charmap_case(const fan_cage *cage, const double *d, ccn_scheme scheme, int poly, int k,
                             cm_result *r, ccn_error *err) {
-    cm_ctx c = {.n = cage->n, .scheme = scheme};
+    cm_ctx c = {.n = cage->n, .scheme = scheme, .poly = poly};
     memset(r, 0, sizeof *r);
+    if (scheme == CCN_SCHEME_EIGEN && poly == CCN_POLY_SELECT) {
+        /* the library's choice for these intervals, once: the matrix is built column by column
+         * (one ccn_refine per three columns), each call would repeat the verification */
+        double *M1 = malloc(sizeof(double) * (2 * (size_t)cage->n + 1) * (2 * (size_t)cage->n + 1));
+        ccn_ev_info info;
+        if (!M1) return exp_fail_memory(err);
+        if (ccn_ev_matrix(cage->n, d, scheme, M1, &info, NULL) == CCN_OK && info.polyhedron)
+            c.poly = info.polyhedron;
+        else c.poly = CCN_POLY_PAPER;
+        free(M1);
+    }
     double x[12 * EXP_MAX_N + 1], y[12 * EXP_MAX_N + 1];
     ccn_status st = cm_setup(&c, cage, d, err);
     if (!st) st = cm_matrix(&c, d, r, err);

@@ -86,9 +86,9 @@ static ccn_status start_level1(const double *d, const fan_cage *c, ccn_mesh **ou
     return st;
 }
 
-static ccn_status refine_in_place(ccn_mesh **cur, int k, ccn_scheme scheme, ccn_error *err) {
+static ccn_status refine_in_place(ccn_mesh **cur, int k, const exp_args *a, ccn_error *err) {
     ccn_mesh *next = NULL;
-    ccn_options o = {.scheme = scheme, .threads = 1}; /* cases run in parallel */
+    ccn_options o = {.scheme = a->scheme, .threads = 1, .ev_polyhedron = a->poly}; /* cases run in parallel */
     ccn_status st = ccn_refine(*cur, k, &o, &next, err);
     ccn_mesh_destroy(*cur);
     *cur = next;
@@ -100,7 +100,7 @@ static ccn_status maxima_later(ccn_mesh **cur, const exp_args *a, max_result *r,
     ccn_status st = CCN_OK;
     for (int l = a->levels; l < a->persist && !st && r->nlater < EXP_MAX_LATER; l++) {
         max_result t = {0};
-        st = refine_in_place(cur, 1, a->scheme, err);
+        st = refine_in_place(cur, 1, a, err);
         if (!st) st = count_maxima(*cur, &t, err);
         if (!st) r->later[r->nlater++] = (signed char)(t.maxima > 127 ? 127 : t.maxima);
     }
@@ -116,7 +116,7 @@ ccn_status exp_maxima_case(const fan_cage *c, const double *d, const exp_args *a
     ccn_status st = a->start ? start_level1(d, c, &cur, err) : exp_fan_mesh(c, d, &cur, err);
     int step = per_level ? 1 : a->levels;
     for (int l = 0; l < a->levels && !st; l += step) {
-        st = refine_in_place(&cur, step, a->scheme, err);
+        st = refine_in_place(&cur, step, a, err);
         if (!st && (per_level || l + step == a->levels)) st = count_maxima(cur, r, err);
         if (!st && per_level) per_level[l] = r->maxima;
     }

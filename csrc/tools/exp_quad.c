@@ -141,7 +141,7 @@ int exp_ring_grid(const quad_mesh *q, int32_t ev, int32_t s0, int n, int G, int3
 
 /* Refines m one level with `scheme`, following the EV and its spoke-0 neighbour: in the refined
  * mesh they are the vertex point of ev (nf + ne + ev) and the edge point of edge (ev, s0). */
-ccn_status exp_track_refine(const ccn_mesh *m, ccn_scheme scheme, int32_t *ev, int32_t *s0,
+ccn_status exp_track_refine(const ccn_mesh *m, ccn_scheme scheme, int poly, int32_t *ev, int32_t *s0,
                             ccn_mesh **out, ccn_error *err) {
     quad_mesh q;
     if (exp_quad_load(m, &q)) {
@@ -156,7 +156,7 @@ ccn_status exp_track_refine(const ccn_mesh *m, ccn_scheme scheme, int32_t *ev, i
         snprintf(err->message, sizeof err->message, "EV spoke edge not found");
         return CCN_ERR_INTERNAL;
     }
-    ccn_options o = {.scheme = scheme, .threads = 1}; /* cases run in parallel */
+    ccn_options o = {.scheme = scheme, .threads = 1, .ev_polyhedron = poly}; /* cases run in parallel */
     ccn_status st = ccn_refine(m, 1, &o, out, err);
     if (st) return st;
     *ev = nf + ne + *ev;

@@ -24,7 +24,7 @@ void exp_print_header(const exp_args *a, const char *what) {
         for (int i = 0; i < a->nval; i++) printf("%s%d", i ? "," : " ", a->val[i]);
         printf(", seed %llu, offset %ld", (unsigned long long)a->seed, a->offset);
     }
-    printf(", threads %d\n", a->threads);
+    printf(", polyhedron %d%s, threads %d\n", a->poly, a->poly ? "" : " (per-vertex choice)", a->threads);
 }
 
 /* " [levels L+1..P: 1 1 2]" for a failing case followed by --persist. */

@@ -28,8 +28,8 @@ static const command commands[] = {
 static int usage(void) {
     fprintf(stderr,
             "usage:\n"
-            "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] [--crease-method uniform|chaikin] [--fvar-linear M] in.obj out.obj\n"
-            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--fvar-linear M] in.obj out.obj\n"
+            "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] [--crease-method uniform|chaikin] [--polyhedron P] [--fvar-linear M] in.obj out.obj\n"
+            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--polyhedron P] [--fvar-linear M] in.obj out.obj\n"
             "  ccnurbs patches [--scheme ...] [--corners ...] in.obj out.bv\n"
             "  ccnurbs matrix --valence N [--knots d0,d1,...] [--scheme eigen|nurss|cc]\n"
             "  ccnurbs experiment maxima|charmap --cases N --seed S [...] (experiment --help)\n"

@@ -36,10 +36,11 @@ static char *slurp(const char *path, size_t *len) {
 }
 
 int main(int argc, char **argv) {
-    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats]\n"); return 2; }
+    if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron]\n"); return 2; }
     int levels = atoi(argv[2]), reps = argc > 4 ? atoi(argv[4]) : 5;
     ccn_options o = {0};
     o.levels = levels;
+    o.ev_polyhedron = argc > 5 ? atoi(argv[5]) : CCN_POLY_SELECT;
     o.cap = argc > 3 && strcmp(argv[3], "refine") == 0 ? CCN_CAP_REFINE : CCN_CAP_GUIDED_BI5;
     size_t len;
     char *text = slurp(argv[1], &len);
@@ -82,9 +83,10 @@ int main(int argc, char **argv) {
         ccn_mesh_destroy(out);
     }
     ccn_mesh_destroy(cm);
-    printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s\n",
+    printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s; "
+           "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d\n",
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,
-           tplan, teval, tref);
+           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1);
     ccn_plan_destroy(plan);
     ccn_fvar_channel uv;
     ccn_obj_fvar(obj, &uv);

@@ -21,6 +21,20 @@ for cage in sphere8k carlike carlike_knots; do
   done
 done
 echo "refine ratio = ccn_refine (topology + points) / OSD uniform refinement (topology + points);"
+# issue 14: the per-vertex eigen polyhedron choice (0 for spoke ratios <= 5) and the cap's cost
+num() { sed -n "s/.*$1 \([0-9]*\).*/\1/p"; }
+for cage in $D/carlike.obj $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj tests/data/fig18_v8.obj; do
+  s=$(build/bench/ccn_bench "$cage" 2 refine 5 0) || exit 2
+  q=$(build/bench/ccn_bench "$cage" 2 refine 5 1) || exit 2
+  ts=$(echo "$s" | field plan); tq=$(echo "$q" | field plan); nv=$(echo "$s" | num "EVs verified")
+  per=$(awk -v a="$ts" -v b="$tq" -v n="$nv" 'BEGIN { printf "%.1f", n > 0 ? 1000 * (a - b) / n : 0 }')
+  echo "eigen polyhedron choice, $(basename "$cage" .obj) L2: plan $ts s (paper's polyhedron only: $tq s); $nv EVs verified (spoke ratio > 5), $per ms per verified EV, outside G1 $(echo "$s" | num "outside G1")"
+done
+for L in 2 3; do
+  b=$(build/bench/ccn_bench "$D/carlike.obj" "$L" bi5 3) || exit 2
+  r=$(build/bench/ccn_bench "$D/carlike.obj" "$L" refine 3) || exit 2
+  echo "cap carlike L$L: bi5 plan $(echo "$b" | field plan) s, evaluate $(echo "$b" | field evaluate) s ($(echo "$b" | num caps) caps); refine plan $(echo "$r" | field plan) s, evaluate $(echo "$r" | field evaluate) s"
+done
 echo "evaluate ratio = plan evaluate (positions + normals) / OSD re-interpolation + Limit with tangents;"
 echo "plan ratio = plan creation / OSD topology + points + limit."
 echo "One UV channel (the cages' box unwrap, --cap refine; target: <= 1.5x the plan without):"

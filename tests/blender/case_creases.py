@@ -2,13 +2,17 @@
 valence-2 vertices) and a cube with edge creases 0.5 and 1.0 and a vertex crease give, with equal
 intervals, scheme Catmull-Clark and cap Refine, the same limit as Blender's own Subdivision
 Surface (Use Creases, Use Limit Surface, quality 10) at levels 1-3 (<= 1e-5 of the bounding box,
-matched as point sets) — except where Blender's own limit is not the exact one: next to
-infinitely sharp creases that end or turn at an extraordinary vertex Blender's patch evaluation
-is off the exact limit (OpenSubdiv's refinement, tests/oracle/osd_refine) by 2.3e-5 of the
-bounding box, and there the test checks that CCNURBS equals the exact limit (<= 1e-9) and
-differs from Blender by exactly Blender's own error. Each side of a crease gets its own normal;
-creases follow onto the limit mesh and through Apply; Use Creases off ignores them; a cage error
-selects its element."""
+matched as point sets) — except where Blender's own limit is not the exact one. Blender evaluates
+OpenSubdiv's adaptive patch table (isolation = Quality, infinitely sharp patches, Gregory basis
+end caps); at a dart (an infinitely sharp crease ending at a vertex) the end cap's corner is the
+smooth limit mask applied after Quality levels, 2.3e-5 of the bounding box off the exact limit
+on the creased cube. Every comparison also evaluates that patch table independently
+(tests/oracle/osd_refine --patch-limit) and checks that it is Blender's result (<= 1e-6: float
+precision); where Blender is more than 1e-5 from CCNURBS the test checks that CCNURBS equals the
+exact limit (osd_refine --limit, <= 1e-7) and prints the three distances; Quality 1-10 are the
+isolation levels 1-10, each closer to the exact limit at the darts. Each side of a crease
+gets its own normal; creases follow onto the limit mesh and through Apply; Use Creases off
+ignores them; a cage error selects its element."""
 import subprocess
 import tempfile
 
@@ -16,7 +20,10 @@ from bltest import *  # noqa: F401,F403
 
 from mathutils import kdtree
 
-TOL = 1e-5
+TOL = 1e-5             # CCNURBS vs Blender's Subdivision Surface
+QUALITY = 10           # Subdivision Surface's Quality = OpenSubdiv's isolation level
+PATCH_TOL = 1e-6       # Blender (float) vs its patch table evaluated in double
+EXACT_TOL = 1e-7       # CCNURBS vs the exact limit
 
 
 def set_crease(ob, edge_values, vert_values=()):
@@ -33,7 +40,7 @@ def set_crease(ob, edge_values, vert_values=()):
     me.update()
 
 
-def subsurf_positions(ob, levels):
+def subsurf_positions(ob, levels, quality=QUALITY):
     """Blender's own limit: a copy of ob with Subdivision Surface."""
     cp = ob.copy()
     cp.data = ob.data.copy()
@@ -43,7 +50,7 @@ def subsurf_positions(ob, levels):
     m = cp.modifiers.new("Subsurf", 'SUBSURF')
     m.levels = m.render_levels = levels
     m.use_limit_surface = True
-    m.quality = 10
+    m.quality = quality
     m.use_creases = True
     m.boundary_smooth = 'ALL'
     P = evaluated_positions(cp)
@@ -62,9 +69,10 @@ def max_set_distance(A, B):
 OSD = os.path.join(os.path.dirname(CLI), "osd_refine")
 
 
-def exact_limit(ob, L):
-    """OpenSubdiv's exact limit of the cage (tests/oracle/osd_refine --limit: refines around each
-    vertex until no semi-sharp value is left), with Blender's crease mapping 10 c^2."""
+def osd_refine(ob, L, *mode):
+    """The level-L vertices of tests/oracle/osd_refine for the cage, with Blender's crease
+    mapping 10 c^2: `--limit` is the exact limit (refines around each vertex until no
+    semi-sharp value is left), `--patch-limit --isolation N` Blender's adaptive patch table."""
     me = ob.data
     with tempfile.TemporaryDirectory() as d:
         path, out = os.path.join(d, "cage.obj"), os.path.join(d, "ref.obj")
@@ -81,16 +89,22 @@ def exact_limit(ob, L):
             for i, c in enumerate(vc if vc is not None else []):
                 if c > 0:
                     f.write("# corner %d %.17g\n" % (i + 1, 10 * float(c) ** 2))
-        subprocess.run([OSD, "--levels", str(L), "--limit", path, out], check=True,
+        subprocess.run([OSD, "--levels", str(L)] + list(mode) + [path, out], check=True,
                        capture_output=True)
         return np.array([list(map(float, l.split()[1:4])) for l in open(out) if l.startswith("v ")])
 
 
+def set_distance(A, B):
+    return max(max_set_distance(A, B), max_set_distance(B, A))
+
+
 def compare_with_subsurf(test, ob, levels=(1, 2, 3)):
-    """Returns the worst distance to Blender's Subdivision Surface (relative to the bounding
-    box), and Blender's own worst distance to the exact limit."""
+    """Returns the worst distance (relative to the bounding box) of CCNURBS to Blender's
+    Subdivision Surface, of Blender to OpenSubdiv's patch table (checked <= PATCH_TOL at every
+    level), of Blender to the exact limit and of CCNURBS to the exact limit (checked <=
+    EXACT_TOL; these two only where CCNURBS is more than TOL from Blender, 0 elsewhere)."""
     add_modifier(ob, scheme='CATMULL_CLARK', cap='REFINE')
-    worst = blender_err = 0.0
+    worst = blender_err = patch_err = ours_err = 0.0
     for L in levels:
         ob.ccnurbs.levels = L
         ours = evaluated_positions(ob)
@@ -99,17 +113,25 @@ def compare_with_subsurf(test, ob, levels=(1, 2, 3)):
         ref = subsurf_positions(ob, L)
         size = float(np.linalg.norm(ref.max(0) - ref.min(0)))
         test.assertEqual(len(ours), len(ref), "level %d: vertex counts" % L)
-        d = max(max_set_distance(ours, ref), max_set_distance(ref, ours)) / size
+        d = set_distance(ours, ref) / size
         worst = max(worst, d)
-        if d > TOL:  # is it Blender's own error? compare both with the exact limit
-            ex = exact_limit(ob, L)
-            ours_ex = max(max_set_distance(ours, ex), max_set_distance(ex, ours)) / size
-            blender_ex = max(max_set_distance(ref, ex), max_set_distance(ex, ref)) / size
+        patch = osd_refine(ob, L, "--patch-limit", "--isolation", str(QUALITY))
+        blender_patch = set_distance(ref, patch) / size
+        patch_err = max(patch_err, blender_patch)
+        test.assertLessEqual(blender_patch, PATCH_TOL, "level %d: Blender %.3g from OpenSubdiv's "
+                             "patch table" % (L, blender_patch))
+        if d > TOL:  # Blender's patch approximation? compare both with the exact limit
+            ex = osd_refine(ob, L, "--limit")
+            ours_ex = set_distance(ours, ex) / size
+            blender_ex = set_distance(ref, ex) / size
             blender_err = max(blender_err, blender_ex)
-            test.assertLessEqual(ours_ex, 1e-7, "level %d: %.3g from the exact limit" % (L, ours_ex))
-            test.assertLessEqual(abs(d - blender_ex), 1e-6, "level %d: off Blender by %.3g, Blender "
-                                 "off the exact limit by %.3g" % (L, d, blender_ex))
-    return worst, blender_err
+            ours_err = max(ours_err, ours_ex)
+            print("measure creases %s L%d: CCNURBS-Blender %.2e, Blender-patch table %.2e, "
+                  "Blender-exact %.2e, CCNURBS-exact %.2e" % (ob.name, L, d, blender_patch,
+                                                             blender_ex, ours_ex))
+            test.assertLessEqual(ours_ex, EXACT_TOL,
+                                 "level %d: %.3g from the exact limit" % (L, ours_ex))
+    return worst, patch_err, blender_err, ours_err
 
 
 class TestCreases(AddonTestCase):
@@ -118,27 +140,55 @@ class TestCreases(AddonTestCase):
         ob = bpy.context.object
         n2 = sum(1 for v in ob.data.vertices if len([e for e in ob.data.edges if v.index in e.vertices]) == 2)
         self.assertGreater(n2, 0, "Suzanne has interior valence-2 vertices")
-        d, b = compare_with_subsurf(self, ob)
+        d, p, _, _ = compare_with_subsurf(self, ob)
         self.assertLessEqual(d, TOL)
-        print("  Suzanne (%d valence-2 vertices) vs Subdivision Surface, levels 1-3: %.2e of size" % (n2, d))
+        print("measure creases: Suzanne (%d valence-2 vertices) vs Subdivision Surface, levels "
+              "1-3: %.2e of size (Blender vs OpenSubdiv's patch table: %.2e)" % (n2, d, p))
 
     def test_creased_cube_equals_subsurf(self):
         ob = cube()
         me = ob.data
         # two creased edges (0.5 and 1.0) and one vertex crease
         set_crease(ob, [(0, 0.5), (1, 1.0), (5, 1.0)], [(3, 0.7)])
-        d, b = compare_with_subsurf(self, ob)
-        print("  cube with creases 0.5 / 1.0 and a vertex crease vs Subdivision Surface, levels 1-3: "
-              "%.2e of size (Blender's own distance to the exact limit: %.2e; CCNURBS <= 1e-7)" % (d, b))
-        # semi-sharp creases and the vertex crease alone: Blender is exact there, so equal
+        d, p, b, e = compare_with_subsurf(self, ob)
+        print("measure creases: cube with creases 0.5 / 1.0 and a vertex crease vs Subdivision "
+              "Surface, levels 1-3: %.2e of size; Blender vs OpenSubdiv's patch table %.2e, "
+              "Blender vs the exact limit %.2e (at the darts), CCNURBS vs the exact limit %.2e"
+              % (d, p, b, e))
+        # semi-sharp creases and the vertex crease alone: no dart is left at level 10, so
+        # Blender's patch table is exact there and equals CCNURBS
         ob2 = cube("Semi")
         set_crease(ob2, [(0, 0.5), (2, 0.8)], [(3, 0.7)])
-        d2, _ = compare_with_subsurf(self, ob2)
+        d2, p2, _, _ = compare_with_subsurf(self, ob2)
         self.assertLessEqual(d2, TOL)
+        print("measure creases: cube with semi-sharp creases only: %.2e of size (Blender vs "
+              "OpenSubdiv's patch table: %.2e)" % (d2, p2))
         st = ccn.sync.status(ob, 'VIEW')
         self.assertGreater(st.sizes.get("num_sharp_edges", 0), 0)
         self.assertGreater(st.sizes.get("num_sharp_corners", 0), 0)
         self.assertEqual(len(me.edges), 12)
+
+    def test_subsurf_quality_is_the_patch_isolation_level(self):
+        # Quality q is OpenSubdiv's isolation level: at every q Blender is the patch table of
+        # isolation q, which comes closer to the exact limit at the darts with each level
+        ob = cube()
+        set_crease(ob, [(0, 0.5), (1, 1.0), (5, 1.0)], [(3, 0.7)])
+        ex = osd_refine(ob, 2, "--limit")
+        row, prev = [], 1.0
+        for q in range(1, 11):
+            ref = subsurf_positions(ob, 2, q)
+            size = float(np.linalg.norm(ref.max(0) - ref.min(0)))
+            patch = osd_refine(ob, 2, "--patch-limit", "--isolation", str(q))
+            d = set_distance(ref, patch) / size
+            self.assertLessEqual(d, PATCH_TOL,
+                                 "quality %d: Blender %.3g from the patch table" % (q, d))
+            e = set_distance(ref, ex) / size
+            if q >= 5:
+                self.assertLess(e, prev, "quality %d: no closer to the exact limit" % q)
+            prev = e
+            row.append("q%d %.2e" % (q, e))
+        print("measure creases: creased cube level 2, Blender = patch table of isolation q (<= %g); "
+              "Blender vs the exact limit: %s" % (PATCH_TOL, ", ".join(row)))
 
     def test_sides_of_a_crease_have_their_own_normals(self):
         ob = cube()

@@ -197,7 +197,7 @@ static void row_valence_200(void) {
     ccn_cage c = soup_cage(&s);
     accept_plan(&c, 2);
     ccn_options o = {0};
-    o.levels = 2;
+    o.levels = 3; /* above the cap level (K = 2) */
     ccn_plan *p = NULL;
     ccn_error err;
     CHECK(ccn_plan_create(&c, &o, &p, &err) == CCN_OK, "%s", err.message);

@@ -69,6 +69,13 @@ static double effective_d(int n, const double *d, double *out) {
     return mx;
 }
 
+/* The paper's polyhedron (section 5) without the per-vertex choice: the tests of the paper's
+ * construction; the choice and the other candidates have tests of their own below. */
+static ccn_status paper_matrix(int n, const double *d, ccn_scheme sc, double *M, ccn_ev_info *info,
+                               ccn_error *err) {
+    return ccn_ev_matrix_polyhedron(n, d, sc, CCN_POLY_PAPER, M, info, err);
+}
+
 /* ---- oracle: Catmull-Clark eqs (2)-(4) ---------------------------------------------------- */
 
 static void cc_oracle(int n, double *M) {
@@ -334,7 +341,7 @@ static void test_rows_and_eigen_identity(void) {
                 ccn_ev_info info;
                 double lam, T0[2], e, dmax;
                 for (i = 0; i < n; i++) d[i] = dist ? logunif(1e-6, 1) : unif(1e-3, 1);
-                CHECK(ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "n %d", n);
+                CHECK(paper_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "n %d", n);
                 CHECK(matrix_finite(M, n), "n %d: non-finite M", n);
                 rows = fmax(rows, max_row_sum_error(M, n));
                 dmax = effective_d(n, d, de);
@@ -388,7 +395,7 @@ static void test_spectrum(void) {
                 double lam, e;
                 int ok;
                 for (i = 0; i < n; i++) d[i] = dist ? logunif(1e-6, 1) : unif(1e-3, 1);
-                ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL);
+                paper_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL);
                 if (info.fallback) { skipped++; continue; }
                 lam = info.lambda;
                 if (spectrum(n, M, wr, wi)) { CHECK(0, "dgeev failed"); continue; }
@@ -443,7 +450,7 @@ static void test_fallback(void) {
             int n = VALENCES[v];
             ccn_ev_info info;
             for (i = 0; i < n; i++) d[i] = logunif(1e-12, 1); /* beyond the clamp */
-            CHECK(ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, &err) == CCN_OK, "ok");
+            CHECK(paper_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, &err) == CCN_OK, "ok");
             CHECK(matrix_finite(M, n), "n %d: NaN", n);
             CHECK(isfinite(info.T0[0]) && isfinite(info.T0[1]) && isfinite(info.residual), "info");
             CHECK(max_row_sum_error(M, n) <= 1e-12, "rows");
@@ -470,8 +477,8 @@ static void test_scale_invariance(void) {
         ccn_ev_info a, b;
         double s = logunif(1e-3, 1e3);
         for (i = 0; i < n; i++) d[i] = unif(1e-3, 1), d2[i] = s * d[i];
-        ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &a, NULL);
-        ccn_ev_matrix(n, d2, CCN_SCHEME_EIGEN, R, &b, NULL);
+        paper_matrix(n, d, CCN_SCHEME_EIGEN, M, &a, NULL);
+        paper_matrix(n, d2, CCN_SCHEME_EIGEN, R, &b, NULL);
         worst = fmax(worst, max_abs_diff(M, R, n));
         CHECK(fabs(b.T0[0] - s * a.T0[0]) <= 1e-12 * s && fabs(b.T0[1] - s * a.T0[1]) <= 1e-12 * s,
               "T0 scale");
@@ -494,7 +501,7 @@ static void test_large_valence(void) {
             double e = -1, lam;
             for (i = 0; i < n; i++) d[i] = c == 0 ? 2.5 : unif(1e-3, 1);
             if (c == 2) for (i = 0; i < n; i++) d[i] = 0.5 + 0.5 * sin(TWO_PI * 3 * i / n) + 1e-3;
-            CHECK(ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "n %d", n);
+            CHECK(paper_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "n %d", n);
             CHECK(matrix_finite(M, n), "n %d finite", n);
             CHECK(max_row_sum_error(M, n) <= 1e-12, "n %d rows %g", n, max_row_sum_error(M, n));
             if (!info.fallback) {
@@ -510,6 +517,169 @@ static void test_large_valence(void) {
         }
     }
     free(M);
+}
+
+/* ---- candidate polyhedra and the per-vertex choice (issue 14) ------------------------------ */
+
+/* The candidate list as documented (ccnurbs.h CCN_POLY_*, rules/eigen_shape.h): lengths rule
+ * (0 paper, 1 l^(1-e) d^e, 2 Greville least squares, then ^(1-e) d^e), angle exponent a and
+ * sector weight w_s (0: (d_s d_{s+1})^a, 1: (d_s + d_{s+1})^a, 3: max(d_s, d_{s+1})^a). */
+static const struct { int len; double e, a; int fn; } CAND[CCN_POLY_COUNT] = {
+    {0, 0, 0, 0},    {1, 0.1, 0, 0},   {1, 0.2, 0, 0},     {1, -0.1, 0, 0}, {1, 0.05, 0, 0},
+    {1, -0.05, 0, 0}, {1, 0.15, 0, 0}, {1, -0.2, 0, 0},  {1, 0.3, 0, 0},     {1, -0.3, 0, 0},
+    {1, 0.4, 0, 0},   {2, 0, 0, 0},
+    {2, 0, -0.08, 0}, {2, 0, -0.12, 0}, {0, 0, -0.08, 0},  {2, 0, -0.05, 0}, {1, 0.1, -0.12, 0},
+    {2, 0, -0.2, 0},  {0, 0, -0.12, 0}, {2, 0, -0.03, 0}, {1, 0.1, -0.08, 0}, {2, 0, -0.15, 0},
+    {2, -0.1, -0.1, 3}, {2, 0.1, -0.06, 0}, {2, 0.1, -0.2, 0}, {2, 0.1, -0.03, 0},
+    {2, -0.1, -0.06, 0}, {0, 0, -0.15, 1},
+};
+
+static double sector_weight(int k, double a, double b) {
+    double x = CAND[k - 1].fn == 1 ? a + b : CAND[k - 1].fn == 3 ? (a > b ? a : b) : a * b;
+    return pow(x, CAND[k - 1].a);
+}
+
+/* Greville lengths, written independently of eigen_shape.c's Fourier solution: x = log l closest
+ * (min-norm correction, LAPACK dgelsd) to the paper's x_p with x_{s+1} - x_{s-1} = b_s in the
+ * least-squares sense. */
+static void greville_oracle(int n, const double *d, double *l) {
+    static double A[64 * 64], b[64];
+    int s, r;
+    lapack_int rank;
+    double sv[64];
+    memset(A, 0, sizeof(double) * (size_t)(n * n));
+    for (s = 0; s < n; s++) {
+        A[s * n + md(s + 1, n)] += 1;
+        A[s * n + md(s - 1, n)] -= 1;
+        b[s] = log((2 * d[md(s + 1, n)] + d[md(s - 1, n)]) / (2 * d[md(s - 1, n)] + d[md(s + 1, n)])) -
+               (log(l[md(s + 1, n)]) - log(l[md(s - 1, n)]));
+    }
+    r = LAPACKE_dgelsd(LAPACK_ROW_MAJOR, n, n, 1, A, n, b, 1, sv, 1e-9, &rank);
+    CHECK(r == 0, "dgelsd %d", r);
+    for (s = 0; s < n; s++) l[s] *= exp(b[s]);
+}
+
+/* Candidate k's polyhedron (rows F, E, V) for normalised d; returns lambda. */
+static double candidate_polyhedron(int k, int n, const double *d, double *P) {
+    double c = cos(TWO_PI / n), gamma = 4.0 / (c + 1 + sqrt((c + 9) * (c + 1)));
+    double l[64], ang[64], sum = 0, phi = 0;
+    int i, j;
+    eigen_polyhedron(n, d, P); /* the paper's: read its lengths back */
+    for (i = 0; i < n; i++) l[i] = hypot(P[2 * iE(i, n)], P[2 * iE(i, n) + 1]);
+    if (CAND[k - 1].len == 2) greville_oracle(n, d, l);
+    if (CAND[k - 1].len >= 1)
+        for (i = 0; i < n; i++) l[i] = pow(l[i], 1 - CAND[k - 1].e) * pow(d[i], CAND[k - 1].e);
+    for (i = 0; i < n; i++) sum += sector_weight(k, d[i], d[md(i + 1, n)]);
+    for (i = 0; i < n; i++) {
+        ang[i] = CAND[k - 1].a == 0 ? TWO_PI * i / n : phi;
+        phi += TWO_PI * sector_weight(k, d[i], d[md(i + 1, n)]) / sum;
+    }
+    for (i = 0; i < n; i++) {
+        P[2 * iE(i, n)] = l[i] * cos(ang[i]);
+        P[2 * iE(i, n) + 1] = l[i] * sin(ang[i]);
+    }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < 2; j++) P[2 * iF(i, n) + j] = gamma * (P[2 * iE(i, n) + j] + P[2 * iE(i + 1, n) + j]);
+    P[2 * iV(n)] = P[2 * iV(n) + 1] = 0;
+    return (1 + gamma) / (4 * gamma);
+}
+
+/* Every candidate: rows sum to 1 and M P0 = lambda P0 + 1 T0 with the test's own polyhedron of
+ * that candidate; at equal intervals every candidate is Catmull-Clark. */
+static void test_candidate_identity(void) {
+    static const int ns[] = {3, 5, 6, 7, 8, 12};
+    double M[SZ(12) * SZ(12)], R[SZ(12) * SZ(12)], P[2 * SZ(12)], d[12], de[12], T0[2];
+    int k, v, c, i, fallbacks = 0, total = 0;
+    double worst = 0, cc = 0;
+    for (k = 1; k <= CCN_POLY_COUNT; k++)
+        for (v = 0; v < 6; v++) {
+            int n = ns[v];
+            for (i = 0; i < n; i++) d[i] = 0.7;
+            CHECK(ccn_ev_matrix_polyhedron(n, d, CCN_SCHEME_EIGEN, k, M, NULL, NULL) == CCN_OK, "ok");
+            cc_oracle(n, R);
+            cc = fmax(cc, max_abs_diff(M, R, n));
+            for (c = 0; c < 60; c++) {
+                ccn_ev_info info;
+                double lam, e;
+                for (i = 0; i < n; i++) d[i] = c & 1 ? logunif(1e-3, 1) : unif(1e-3, 1);
+                CHECK(ccn_ev_matrix_polyhedron(n, d, CCN_SCHEME_EIGEN, k, M, &info, NULL) == CCN_OK, "ok");
+                CHECK(matrix_finite(M, n) && max_row_sum_error(M, n) <= 1e-12, "rows");
+                total++;
+                if (info.fallback) { fallbacks++; CHECK(info.polyhedron == 0, "fallback names a polyhedron"); continue; }
+                CHECK(info.polyhedron == k, "info.polyhedron %d for %d", info.polyhedron, k);
+                effective_d(n, d, de);
+                lam = candidate_polyhedron(k, n, de, P);
+                e = eigen_identity_error(n, M, P, lam, T0);
+                worst = fmax(worst, e);
+                CHECK(e <= 1e-10, "candidate %d n %d: identity %g", k, n, e);
+            }
+        }
+    CHECK(cc <= 1e-14, "equal intervals: candidate vs CC %g", cc);
+    printf("# %d candidates x n = 3,5,6,7,8,12 x 60 (uniform / log-uniform [1e-3,1]): identity with the "
+           "test's polyhedron <= %.2g (%d of %d fell back); equal d vs CC %.2g\n",
+           CCN_POLY_COUNT, worst, fallbacks, total, cc);
+}
+
+/* n = 4: the Greville candidate is the paper's (its equations hold for the paper's lengths), and
+ * the choice never leaves knot insertion (no candidate is admissible that breaks it). */
+static void test_candidates_at_valence4(void) {
+    double M[81], R[81], d[4], de[4], worst = 0, grev = 0;
+    int k, i;
+    for (k = 0; k < 500; k++) {
+        ccn_ev_info info;
+        for (i = 0; i < 4; i++) d[i] = k & 1 ? logunif(1e-6, 1) : unif(1e-3, 1);
+        effective_d(4, d, de);
+        tensor_oracle(de, R);
+        CHECK(ccn_ev_matrix(4, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "ok");
+        CHECK(info.polyhedron == CCN_POLY_PAPER && info.verified == 0, "n = 4 chose %d", info.polyhedron);
+        worst = fmax(worst, max_abs_diff(M, R, 4));
+        CHECK(ccn_ev_matrix_polyhedron(4, d, CCN_SCHEME_EIGEN, 12, M, &info, NULL) == CCN_OK, "ok");
+        grev = fmax(grev, max_abs_diff(M, R, 4));
+    }
+    CHECK(worst <= 1e-14 && grev <= 1e-13, "n = 4: choice %g, Greville %g vs tensor", worst, grev);
+    printf("# n = 4: the choice vs tensor knot insertion %.2g, the Greville candidate %.2g\n", worst, grev);
+}
+
+/* The choice: ratio <= 5 -> the paper's, unchecked; otherwise a verified candidate whose M is
+ * exactly ccn_ev_matrix_polyhedron's, or the paper's flagged outside_g1; invariant under
+ * rotation and reflection of the spoke order. */
+static void test_selection(void) {
+    static const int ns[] = {3, 5, 6, 7, 8};
+    double M[SZ(8) * SZ(8)], R[SZ(8) * SZ(8)], P[2 * SZ(8)], d[8], d2[8], de[8], T0[2];
+    int c, i, trusted = 0, verified = 0, other = 0, outside = 0;
+    for (c = 0; c < 400; c++) {
+        int n = ns[c % 5], sh = c % n, refl = (c / 5) & 1;
+        ccn_ev_info info, info2;
+        double mn = 1, mx = 0;
+        for (i = 0; i < n; i++) d[i] = c % 3 == 0 ? unif(0.25, 1) : c % 3 == 1 ? unif(1e-6, 1) : logunif(1e-3, 1);
+        for (i = 0; i < n; i++) mn = fmin(mn, d[i]), mx = fmax(mx, d[i]);
+        CHECK(ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "ok");
+        if (mx <= 5 * mn) {
+            trusted++;
+            CHECK(info.polyhedron == CCN_POLY_PAPER && info.verified == 0 && !info.outside_g1,
+                  "ratio %.3g: polyhedron %d verified %d", mx / mn, info.polyhedron, info.verified);
+        } else {
+            verified++;
+            CHECK(info.verified >= 1, "ratio %.3g not verified", mx / mn);
+            other += info.polyhedron > CCN_POLY_PAPER;
+        }
+        outside += info.outside_g1;
+        if (info.outside_g1) CHECK(info.polyhedron == CCN_POLY_PAPER || info.fallback, "outside: the paper's");
+        if (info.fallback) { CHECK(info.outside_g1, "a fallback M is never chosen"); continue; }
+        CHECK(ccn_ev_matrix_polyhedron(n, d, CCN_SCHEME_EIGEN, info.polyhedron, R, NULL, NULL) == CCN_OK, "ok");
+        CHECK(max_abs_diff(M, R, n) == 0, "M is not candidate %d's", info.polyhedron);
+        effective_d(n, d, de);
+        double lam = candidate_polyhedron(info.polyhedron, n, de, P);
+        CHECK(eigen_identity_error(n, M, P, lam, T0) <= 1e-10, "identity of the chosen polyhedron");
+        for (i = 0; i < n; i++) d2[i] = d[refl ? (sh - i + 2 * n) % n : (sh + i) % n];
+        CHECK(ccn_ev_matrix(n, d2, CCN_SCHEME_EIGEN, R, &info2, NULL) == CCN_OK, "ok");
+        CHECK(info2.polyhedron == info.polyhedron && info2.outside_g1 == info.outside_g1,
+              "rotated %d reflected %d: polyhedron %d vs %d", sh, refl, info2.polyhedron, info.polyhedron);
+    }
+    CHECK(trusted > 50 && verified > 100 && other > 0, "sample: %d trusted %d verified %d other", trusted,
+          verified, other);
+    printf("# choice on 400 cases: %d accepted unchecked (ratio <= 5), %d verified, %d of them another "
+           "candidate, %d outside the G1 range\n", trusted, verified, other, outside);
 }
 
 static void test_bilinear_inverse(void) {
@@ -558,5 +728,8 @@ int main(void) {
     RUN(test_fallback);
     RUN(test_scale_invariance);
     RUN(test_large_valence);
+    RUN(test_candidate_identity);
+    RUN(test_candidates_at_valence4);
+    RUN(test_selection);
     return TEST_SUMMARY();
 }

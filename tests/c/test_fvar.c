@@ -167,7 +167,8 @@ static double dist3(const double *a, const double *b) {
 
 static int run(const grid *g, int linear, ccn_scheme scheme, int L, int corners, result *r) {
     ccn_cage cage = grid_cage(g);
-    ccn_options o = {scheme, CCN_CAP_REFINE, L, corners, 1, CCN_CREASE_UNIFORM};
+    ccn_options o = {.scheme = scheme, .cap = CCN_CAP_REFINE, .levels = L, .boundary_corners = corners,
+                     .threads = 1, .crease_method = CCN_CREASE_UNIFORM};
     ccn_fvar_channel ch = grid_channel(g, linear);
     ccn_plan *p = NULL;
     ccn_error err;
@@ -330,7 +331,8 @@ static void test_uv_corners_follow_mode(void) {
     double *uv[4];
     int nf = 0;
     for (int t = 0; t < 4; t++) {
-        ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, 2, t % 2 ? CCN_CORNERS_SMOOTH : CCN_CORNERS_PINNED, 1, 0};
+        ccn_options o = {.scheme = CCN_SCHEME_EIGEN, .cap = CCN_CAP_REFINE, .levels = 2,
+                         .boundary_corners = t % 2 ? CCN_CORNERS_SMOOTH : CCN_CORNERS_PINNED, .threads = 1};
         ccn_fvar_channel ch = grid_channel(&g, t < 2 ? CCN_FVAR_LINEAR_CORNERS_ONLY : CCN_FVAR_LINEAR_NONE);
         ccn_plan *p = NULL;
         ccn_error err;
@@ -396,7 +398,8 @@ static void test_uv_linear_modes(void) {
 static void test_plan_reuse_and_vertex_data(void) {
     grid g = grid_make(6, 6, 1, 2, 5);
     ccn_cage cage = grid_cage(&g);
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, 2, CCN_CORNERS_SMOOTH, 2, 0};
+    ccn_options o = {.scheme = CCN_SCHEME_EIGEN, .cap = CCN_CAP_REFINE, .levels = 2,
+                     .boundary_corners = CCN_CORNERS_SMOOTH, .threads = 2};
     ccn_plan *p = NULL;
     ccn_error err;
     CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
@@ -504,7 +507,7 @@ static void test_refine_and_obj(void) {
           "UV map: width %d, %d values, mode %d", (int)ch.width, (int)ch.num_values, (int)ch.linear);
     ccn_mesh *m = NULL;
     ccn_fvar *fv = NULL;
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, 1, 0, 1, 0};
+    ccn_options o = {.scheme = CCN_SCHEME_EIGEN, .cap = CCN_CAP_REFINE, .levels = 1, .threads = 1};
     CHECK(ccn_mesh_create(&cage, &m, &err) == CCN_OK && ccn_fvar_refine(m, &ch, 1, &o, &fv, &err) == CCN_OK, "%s", err.message);
     if (fv) {
         ccn_fvar_info in;

@@ -45,6 +45,8 @@ expect_error "empty OBJ"          "no faces"                      refine --level
 expect_error "missing file"       "cannot open"                   refine --levels 1 "$T/none.obj" "$T/out.obj"
 expect_error "bad scheme"         "bad --scheme"                  refine --scheme foo tests/data/cube.obj "$T/out.obj"
 expect_error "bad levels"         "levels"                        refine --levels -2 tests/data/cube.obj "$T/out.obj"
+expect_error "bad polyhedron"     "--polyhedron must be"          limit --levels 1 --polyhedron 99 tests/data/cube.obj "$T/out.obj"
+expect_error "bad exp polyhedron" "polyhedron"                    experiment maxima --cases 1 --polyhedron -1
 expect_error "unknown command"    "unknown command"               frobnicate
 expect_error "matrix valence"     "valence"                       matrix --valence 2
 

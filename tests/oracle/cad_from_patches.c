@@ -142,6 +142,16 @@ int main(int argc, char **argv) {
     }
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
+    /* Issue 14: a plan whose output level is not above the cap level K builds no caps (they
+     * would not change the limit mesh), so the finite patch set with the bi-5 caps needs a
+     * plan one level above K: raise the level until the caps (or their fallbacks) are there. */
+    while (opts.cap == CCN_CAP_GUIDED_BI5 && sz.num_extraordinary > 0 && sz.num_caps + sz.num_cap_fallbacks == 0 &&
+           opts.levels < 5) {
+        ccn_plan_destroy(plan);
+        opts.levels = (opts.levels > sz.levels ? opts.levels : sz.levels) + 1;
+        if (ccn_plan_create(&cage, &opts, &plan, &err)) { fprintf(stderr, "cad_from_patches: %s\n", err.message); return 1; }
+        ccn_plan_sizes(plan, &sz);
+    }
     ccn_limit_mesh lm = {.positions = malloc(sizeof(double) * 3 * (size_t)sz.num_verts)};
     if (!lm.positions || ccn_plan_evaluate(plan, NULL, &lm, &err)) { fprintf(stderr, "evaluate: %s\n", err.message); return 1; }
     patch_list pl = {0};

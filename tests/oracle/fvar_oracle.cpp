@@ -4,23 +4,79 @@
 //
 // For every shape with a UV map (`vt`, every corner `f v/vt`), every level K and each of the six
 // FVarLinearInterpolation modes: OpenSubdiv's values at level K (InterpolateFaceVarying) and
-// their exact limits (osd_oracle.h: limitFaceVaryingExact at level K, localLimitFVar where the
+// their exact limits (osd_limit.cpp: limitFaceVaryingExact at level K, localLimitFVar where the
 // limit masks are not exact), per face corner, against ccnurbs' ccn_fvar_refine (refined) and
 // ccn_plan_evaluate_fvar on a plan with --cap refine (limit), for each scheme (cc; eigen, with
 // the shapes' equal intervals). ccnurbs reads the file with its own OBJ reader (ccn_obj_parse,
 // ccn_obj_fvar); options as the CLI resolves them (interpolateboundary 1 pins corners,
-// creasemethod). Corners are matched through OpenSubdiv's topology (osd_oracle.h,
-// ccnurbsFaceOrder), and the corner positions (refined, limit) must agree too (<= T of the
-// bounding box), so a wrong match cannot pass. Error: the largest component difference over the
-// diagonal of the cage's UV bounding box. One line per shape, level and scheme (all modes, refined
-// and limit), then "N passed, N failed"; exit 1 on any failure.
+// creasemethod). Corners are matched through OpenSubdiv's topology (ccnurbsFaceOrder below),
+// and the corner positions (refined, limit) must agree too (<= T of the bounding box), so a
+// wrong match cannot pass. Error: the largest component difference over the diagonal of the
+// cage's UV bounding box. One line per shape, level and scheme (all modes, refined and limit),
+// then "N passed, N failed"; exit 1 on any failure.
 #include "osd_oracle.h"
+
+#include <opensubdiv/far/primvarRefiner.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
 
 extern "C" {
 #include "ccnurbs.h"
 }
 
+using namespace OpenSubdiv;
+using namespace osd_oracle;
+
 namespace {
+
+// OpenSubdiv's level-K faces in ccnurbs' order (ccnurbs.h: "faces: each old face's sub-quads
+// in corner order", the sub-quad of corner j starting at the vertex's child): ours[f] is the
+// ccnurbs index of OpenSubdiv face f, rot[f] the OpenSubdiv corner of ccnurbs corner 0
+// (OpenSubdiv corner k = ccnurbs corner (k - rot) mod n). From the topology only.
+void ccnurbsFaceOrder(Far::TopologyRefiner const &r, int K, std::vector<int> &ours,
+                      std::vector<int> &rot) {
+    Far::TopologyLevel const &b = r.GetLevel(0);
+    ours.resize((size_t)b.GetNumFaces());
+    rot.assign((size_t)b.GetNumFaces(), 0);
+    std::vector<int> start((size_t)b.GetNumFaces());
+    int acc = 0;
+    for (int f = 0; f < b.GetNumFaces(); f++) {
+        ours[(size_t)f] = f;
+        start[(size_t)f] = acc;
+        acc += b.GetFaceVertices(f).size();
+    }
+    for (int l = 0; l < K; l++) {
+        Far::TopologyLevel const &p = r.GetLevel(l), &c = r.GetLevel(l + 1);
+        std::vector<int> nours((size_t)c.GetNumFaces(), -1), nrot((size_t)c.GetNumFaces(), 0);
+        for (int f = 0; f < p.GetNumFaces(); f++) {
+            Far::ConstIndexArray kids = p.GetFaceChildFaces(f);
+            Far::ConstIndexArray pv = p.GetFaceVertices(f);
+            const int n = pv.size();
+            for (int i = 0; i < kids.size(); i++) {
+                const int vc = p.GetVertexChildVertex(pv[i]);
+                Far::ConstIndexArray cv = c.GetFaceVertices(kids[i]);
+                int a = 0;
+                while (a < cv.size() && cv[a] != vc) a++;
+                if (a == cv.size()) die("child face i does not hold the child of corner i");
+                const int j = ((i - rot[(size_t)f]) % n + n) % n;
+                nours[(size_t)kids[i]] = (l == 0 ? start[(size_t)ours[(size_t)f]] : 4 * ours[(size_t)f]) + j;
+                nrot[(size_t)kids[i]] = a;
+            }
+        }
+        ours.swap(nours);
+        rot.swap(nrot);
+    }
+}
+
 
 struct Result {
     double fv = 0.0, pos = 0.0;  // worst relative errors

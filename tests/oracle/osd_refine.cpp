@@ -1,37 +1,10 @@
 // osd_refine: reference Catmull-Clark refinement with OpenSubdiv (test oracle).
 //
-//   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd]
-//              in.obj out.obj
+//   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd |
+//              --patch-limit [--isolation N] [--inf-sharp-patch 0|1] [--single-crease-patch 0|1]
+//              [--endcap gregory|bspline]] [--fvar-linear M] in.obj out.obj
 //
-// Input. `v x y z` and `f a b c ...` lines (1-based, negative = relative, `a/b/c` tolerated),
-// plus sharpness and options in either of two forms:
-//   OpenSubdiv shape tags (regression/common/shape_utils.cpp Shape::tag::parseTag, applied as
-//   in regression/common/far_utils.h GetSdcOptions / assignComponentTags):
-//     t NAME nints/nfloats/nstrings int... float... string...
-//     t crease 2k/1/0 a0 b0 ... a(k-1) b(k-1) s       k edges (0-based vertex pairs), one
-//     t crease 2k/k/0 a0 b0 ... s0 ... s(k-1)          sharpness for all or one per edge
-//     t corner k/1/0 v0 ... s  |  t corner k/k/0 v0 ... s0 ...   vertex sharpness
-//     t interpolateboundary 1/0/0 m      m = 0 VTX_BOUNDARY_NONE, 1 EDGE_AND_CORNER,
-//                                        2 EDGE_ONLY (far_utils.h; RenderMan's numbering)
-//     t creasemethod 0/0/1 normal|chaikin   CREASE_UNIFORM | CREASE_CHAIKIN ("uniform" is
-//                                        accepted as a synonym of "normal")
-//     t facevaryinginterpolateboundary 1/0/0 m   m = 0..5: FVAR_LINEAR_NONE, CORNERS_ONLY,
-//                                        CORNERS_PLUS1, CORNERS_PLUS2, BOUNDARIES, ALL; stored
-//                                        in Sdc::Options (no effect on vertex data)
-//     t smoothtriangles 0/0/1 catmark|smooth   TRI_SUB_CATMARK | TRI_SUB_SMOOTH
-//   Other tags (hole, vertexedit, ...) are ignored with a warning on stderr. Sharpness is
-//   clamped to >= 0 as OpenSubdiv does (std::max(0.0f, s)); a malformed tag is an error.
-//   Differences from far_utils.h: with several sharpness values far_utils.h reads
-//   floatargs[j] for the pair starting at int j (0, 2, 4, ...), which runs past the array;
-//   here value k goes with pair k. No OpenSubdiv shape has more than one value per tag.
-//   (RenderMan's crease tag lists a chain of vertices; OpenSubdiv's shapes use pairs.)
-//   CCNURBS comments (1-based vertex indices, OpenSubdiv sharpness):
-//     # crease i j s      edge i-j has sharpness s
-//     # corner i s        vertex i has sharpness s
-//   A comment whose word after crease/corner is not an integer is prose (OpenSubdiv's shapes
-//   have "#  crease tags for perimeter:") and is ignored.
-//   A later value for the same edge or vertex replaces an earlier one (as in OpenSubdiv).
-//   A crease on a pair of vertices that is not an edge of a face is an error.
+// Input: OBJ with OpenSubdiv shape tags or CCNURBS sharpness comments and UV maps (osd_obj.cpp).
 // Options. Boundary interpolation is EDGE_ONLY (--corners smooth, the default) or
 // EDGE_AND_CORNER (--corners pinned) unless the file has an interpolateboundary tag, which
 // then wins over --corners. Creasing is CREASE_UNIFORM unless creasemethod says chaikin.
@@ -68,6 +41,12 @@
 //     vertices under interpolateboundary 0.
 //   --limit-osd: plain PrimvarRefiner::Limit at level K (OpenSubdiv's own approximation
 //     described above), for comparison.
+//   --patch-limit: the level-K vertices evaluated on OpenSubdiv's adaptive patch table
+//     (Far::PatchTableFactory, Far::PatchMap, PatchTable::EvaluateBasis at each vertex's
+//     ptex face (u, v)) as Blender's Subdivision Surface does with Use Limit Surface; the
+//     defaults are Blender's (isolation 10 = Quality 10, infinitely sharp patches, no
+//     single-crease patches, Gregory basis end caps). Not the exact limit near irregular
+//     features: see osd_patch.cpp.
 //   --fvar-linear M (0..5 or none, corners-only, corners-plus1, corners-plus2, boundaries,
 //     all): the face-varying interpolation (wins over the file's facevaryinginterpolateboundary
 //     tag; neither: OpenSubdiv's default, all).
@@ -76,21 +55,102 @@
 // `f v/vt` (`f v/vt/vn` with --limit-normals), in OpenSubdiv's order: InterpolateFaceVarying
 // level by level; with --limit (levels >= 1), the exact limit of each value: LimitFaceVarying
 // at level K where it is exact, with its crease weights in double precision, and where Limit is
-// not (see above) the one-ring refinement, carrying the values (osd_oracle.h, localLimitFVar,
-// limitFaceVaryingExact).
+// not (see above) the one-ring refinement, carrying the values (osd_limit.cpp, localLimitFVar,
+// limitFaceVaryingExact). --patch-limit writes no UV map (positions only).
 // Level-K vertex order: OpenSubdiv "orderVerticesFromFacesFirst" (at each level face
 // points, then edge points, then vertex points). Errors: message on stderr, exit 2.
 #include "osd_oracle.h"
 
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+using namespace OpenSubdiv;
+using namespace osd_oracle;
+
+namespace {
+
+void usage() {
+    die("usage: osd_refine [--levels K] [--corners smooth|pinned] "
+        "[--limit | --limit-normals | --limit-osd | --patch-limit [--isolation N] "
+        "[--inf-sharp-patch 0|1] [--single-crease-patch 0|1] [--endcap gregory|bspline]] "
+        "[--fvar-linear M] in.obj out.obj");
+}
+
+Vertex3 unitNormal(Vertex3 const &a, Vertex3 const &b) {
+    Vertex3 n;
+    n.p[0] = a.p[1] * b.p[2] - a.p[2] * b.p[1];
+    n.p[1] = a.p[2] * b.p[0] - a.p[0] * b.p[2];
+    n.p[2] = a.p[0] * b.p[1] - a.p[1] * b.p[0];
+    const double len = std::sqrt(n.p[0] * n.p[0] + n.p[1] * n.p[1] + n.p[2] * n.p[2]);
+    if (!(len > 0.0) || !std::isfinite(len)) {
+        n.Clear();
+        return n;
+    }
+    for (int k = 0; k < 3; k++) n.p[k] /= len;
+    return n;
+}
+
+const char *boundaryName(Sdc::Options::VtxBoundaryInterpolation b) {
+    switch (b) {
+    case Sdc::Options::VTX_BOUNDARY_NONE: return "none";
+    case Sdc::Options::VTX_BOUNDARY_EDGE_ONLY: return "edge-only";
+    case Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER: return "edge-and-corner";
+    }
+    return "?";
+}
+
+}  // namespace
 
 int main(int argc, char **argv) {
     int levels = 1;
-    bool pinned = false, limit = false, normals = false, limitOsd = false;
+    bool pinned = false, limit = false, normals = false, limitOsd = false, patch = false;
+    bool patchOpt = false;  // a --patch-limit setting was given
     int fvarLinear = -1;
+    PatchOptions po;
     const char *inPath = nullptr, *outPath = nullptr;
+    auto flag = [&](const char *name, const char *v) {
+        const std::string s = v;
+        if (s != "0" && s != "1") die(std::string(name) + " must be 0 or 1");
+        patchOpt = true;
+        return s == "1";
+    };
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        if (a == "--levels" && i + 1 < argc) {
+        if (a == "--isolation" && i + 1 < argc) {
+            char *end = nullptr;
+            long k = std::strtol(argv[++i], &end, 10);
+            if (*argv[i] == '\0' || *end != '\0' || k < 1 || k > 10)
+                die("--isolation must be 1..10");
+            po.isolation = (int)k;
+            patchOpt = true;
+        } else if (a == "--inf-sharp-patch" && i + 1 < argc) {
+            po.infSharpPatch = flag("--inf-sharp-patch", argv[++i]);
+        } else if (a == "--single-crease-patch" && i + 1 < argc) {
+            po.singleCreasePatch = flag("--single-crease-patch", argv[++i]);
+        } else if (a == "--endcap" && i + 1 < argc) {
+            const std::string c = argv[++i];
+            if (c != "gregory" && c != "bspline") die("--endcap must be gregory or bspline");
+            po.bsplineEndCaps = c == "bspline";
+            patchOpt = true;
+        } else if (a == "--patch-limit") {
+            patch = true;
+        } else if (a == "--levels" && i + 1 < argc) {
             char *end = nullptr;
             long k = std::strtol(argv[++i], &end, 10);
             if (*argv[i] == '\0' || *end != '\0' || k < 0 || k > 10) die("--levels must be 0..10");
@@ -125,6 +185,9 @@ int main(int argc, char **argv) {
     }
     if (!inPath || !outPath) usage();
     if (limitOsd && normals) die("--limit-osd and --limit-normals exclude each other");
+    if (patch && limit) die("--patch-limit excludes --limit, --limit-normals and --limit-osd");
+    if (patchOpt && !patch) die("--isolation, --inf-sharp-patch, --single-crease-patch and "
+                                "--endcap need --patch-limit");
 
     if (const char *e = std::getenv("OSD_REFINE_SETTLE")) g_settle = std::atof(e);
     Far::SetErrorCallback(osdError);
@@ -134,7 +197,7 @@ int main(int argc, char **argv) {
     std::string msg;
     if (!readObj(inPath, m, msg)) die(msg);
     if (fvarLinear >= 0) m.fvarInterpolateBoundary = fvarLinear;
-    const bool uv = m.hasUV();
+    const bool uv = m.hasUV() && !patch;
 
     Sdc::Options sdcOpts;
     sdcOpts.SetVtxBoundaryInterpolation(pinned ? Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER
@@ -245,6 +308,12 @@ int main(int argc, char **argv) {
         }
         cur.swap(pos);
     }
+    PatchStats ps;
+    if (patch) {
+        std::unique_ptr<Far::TopologyRefiner> adaptive(createRefiner(base, sdcOpts));
+        if (!adaptive || g_osdErrors) die("OpenSubdiv rejected the topology");
+        cur = patchLimit(*refiner, levels, *adaptive, m.verts, po, ps);
+    }
     if (g_osdErrors) die("OpenSubdiv interpolation failed");
 
     FILE *out = std::fopen(outPath, "w");
@@ -261,6 +330,15 @@ int main(int argc, char **argv) {
     if (limitOsd) std::fprintf(out, ", PrimvarRefiner::Limit positions");
     else if (limit) std::fprintf(out, ", limit positions (%d by one-ring refinement)", nLocal);
     if (normals) std::fprintf(out, ", normals (%d undefined: 0 0 0)", nNoNormal);
+    if (patch)
+        std::fprintf(out,
+                     ", patch-table limit (isolation %d, inf-sharp patches %s, single-crease "
+                     "patches %s, %s end caps; %d levels, %d regular, %d Gregory basis, %d other "
+                     "patches, %d local points)",
+                     po.isolation, po.infSharpPatch ? "on" : "off",
+                     po.singleCreasePatch ? "on" : "off",
+                     po.bsplineEndCaps ? "B-spline basis" : "Gregory basis", ps.maxLevel,
+                     ps.regular, ps.gregoryBasis, ps.other, ps.localPoints);
     std::fputc('\n', out);
     for (size_t i = 0; i < cur.size(); i++)
         std::fprintf(out, "v %.17g %.17g %.17g\n", cur[i].p[0], cur[i].p[1], cur[i].p[2]);
