@@ -20,6 +20,10 @@
  *     several channels and widths, per-vertex data interpolated like the positions (the limit
  *     of the positions themselves is the limit surface) without disturbing the plan's geometry,
  *     ccn_fvar_refine, the OBJ reader's UV map, and every refusal naming its element.
+ *  4. A UV map equal to the positions (one value per vertex, mode NONE: no seam, nothing
+ *     sharpened) refines and has its limit exactly as the positions do, here for each fixed
+ *     eigen polyhedron (ccn_options.ev_polyhedron) on a cage with non-uniform intervals at its
+ *     extraordinary vertices, where the polyhedron changes the surface.
  */
 #include "ccnurbs.h"
 #include "testlib.h"
@@ -540,6 +544,75 @@ static void test_refine_and_obj(void) {
     CHECK(ccn_obj_parse(badvt, strlen(badvt), &obj, &err) == CCN_ERR_IO && err.element == 2, "bad vt: %s", err.message);
 }
 
+/* ==== 4. a UV map that is the positions follows the positions' rules ====================== */
+
+static void test_uv_follows_polyhedron(void) {
+    size_t len = 0;
+    char *t = tl_slurp("tests/data/fig17_v7.obj", &len);
+    CHECK(t != NULL, "tests/data/fig17_v7.obj");
+    if (!t) return;
+    ccn_obj *obj = NULL;
+    ccn_error err;
+    CHECK(ccn_obj_parse(t, len, &obj, &err) == CCN_OK, "%s", err.message);
+    free(t);
+    if (!obj) return;
+    ccn_cage cage;
+    ccn_obj_cage(obj, &cage);
+    ccn_fvar_channel ch = {.width = 3, .num_values = cage.num_verts, .values = cage.positions,
+                           .indices = cage.face_verts, .linear = CCN_FVAR_LINEAR_NONE};
+    ccn_mesh *m = NULL;
+    CHECK(ccn_mesh_create(&cage, &m, &err) == CCN_OK, "%s", err.message);
+    for (int32_t poly = CCN_POLY_SELECT; m && poly <= 3; poly++) {
+        ccn_options o = {.scheme = CCN_SCHEME_EIGEN, .cap = CCN_CAP_REFINE, .levels = 2, .threads = 1,
+                         .ev_polyhedron = poly};
+        /* refined: each face corner's value is its vertex's refined position */
+        ccn_mesh *r = NULL;
+        ccn_fvar *fv = NULL;
+        double rerr = INFINITY, lerr = INFINITY;
+        if (ccn_refine(m, 2, &o, &r, &err) == CCN_OK && ccn_fvar_refine(m, &ch, 2, &o, &fv, &err) == CCN_OK) {
+            ccn_mesh_info mi;
+            ccn_fvar_info fi;
+            ccn_mesh_info_get(r, &mi);
+            ccn_fvar_info_get(fv, &fi);
+            double *P = NEW(double, 3 * mi.num_verts), *V = NEW(double, 3 * fi.num_values);
+            int32_t *pf = NEW(int32_t, mi.num_face_verts), *vf = NEW(int32_t, fi.num_face_verts);
+            ccn_mesh_copy(r, P, NULL, pf, NULL, NULL);
+            ccn_fvar_copy(fv, V, vf);
+            rerr = fi.num_face_verts == mi.num_face_verts ? 0.0 : INFINITY;
+            for (int32_t q = 0; q < mi.num_face_verts && rerr == 0.0; q++)
+                for (int k = 0; k < 3; k++) rerr = fmax(rerr, fabs(P[3 * pf[q] + k] - V[3 * vf[q] + k]));
+            free(P); free(V); free(pf); free(vf);
+        }
+        ccn_fvar_destroy(fv);
+        ccn_mesh_destroy(r);
+        /* limit: each output face corner's value is its vertex's limit position */
+        ccn_plan *p = NULL;
+        int32_t idx = -1;
+        if (ccn_plan_create(&cage, &o, &p, &err) == CCN_OK && ccn_plan_add_fvar(p, &ch, &idx, &err) == CCN_OK) {
+            ccn_sizes sz;
+            ccn_fvar_sizes fs;
+            ccn_plan_sizes(p, &sz);
+            ccn_plan_fvar_sizes(p, idx, &fs);
+            double *X = NEW(double, 3 * sz.num_verts), *U = NEW(double, 3 * fs.num_values);
+            int32_t *q4 = NEW(int32_t, 4 * sz.num_faces), *u4 = NEW(int32_t, 4 * sz.num_faces);
+            ccn_limit_mesh lm = {.positions = X, .face_verts = q4};
+            if (ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK &&
+                ccn_plan_evaluate_fvar(p, idx, NULL, U, u4, &err) == CCN_OK) {
+                lerr = 0.0;
+                for (int32_t q = 0; q < 4 * sz.num_faces; q++)
+                    for (int k = 0; k < 3; k++) lerr = fmax(lerr, fabs(X[3 * q4[q] + k] - U[3 * u4[q] + k]));
+            }
+            free(X); free(U); free(q4); free(u4);
+        }
+        ccn_plan_destroy(p);
+        CHECK(rerr <= TOL && lerr <= TOL, "polyhedron %d: UVs = positions off by %.3g refined, %.3g limit (%s)",
+              (int)poly, rerr, lerr, err.message);
+        printf("#   fig17_v7 L2 ev_polyhedron %d: UV map = positions, refined %.2e, limit %.2e\n", (int)poly, rerr, lerr);
+    }
+    ccn_mesh_destroy(m);
+    ccn_obj_destroy(obj);
+}
+
 int main(void) {
     RUN(test_uv_bspline_no_seam);
     RUN(test_uv_bspline_seam);
@@ -547,5 +620,6 @@ int main(void) {
     RUN(test_uv_linear_modes);
     RUN(test_plan_reuse_and_vertex_data);
     RUN(test_refine_and_obj);
+    RUN(test_uv_follows_polyhedron);
     return TEST_SUMMARY();
 }
