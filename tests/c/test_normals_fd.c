@@ -6,10 +6,10 @@
  * orientation of the cage's faces. Plus the two concrete cases of item 3 (a closed cylinder
  * with n-gon caps and a valence-3 star fan, scheme NURSS).
  *
- * The oracle: vertex v of level L is the vertex point of v at every finer level (index
- * nf_l + ne_l + v, ccnurbs.h's numbering), so the fine plan samples the same surface point; its
- * fine faces around that point give the finite-difference normal (sum of the faces' diagonal
- * cross products, oriented by the faces). The positions must agree too (a check of the mapping).
+ * The oracle: vertex v of level L is the vertex point of v at every finer level (found through
+ * the output faces, which keep the refinement's order), so the fine plan samples the same
+ * surface point; its fine faces around that point give the finite-difference normal (sum of the
+ * faces' diagonal cross products, oriented by the faces). The positions must agree too (a check of the mapping).
  * The finite difference converges O(h) at boundaries and EVs, so it is taken at two fine levels
  * and the tolerance is 1e-3 plus three times their difference; a flipped normal is off by pi. */
 #include "testlib.h"
@@ -215,15 +215,29 @@ static int run_plan(const cage_t *c, const ccn_options *o, outmesh *m) {
 
 static void free_out(outmesh *m) { free(m->pos); free(m->nrm); free(m->fv); }
 
-/* Index of cage-level-L vertex v at level Lf (vertex points keep their vertex). */
-static int32_t descend(const cage_t *c, int32_t v, int L, int Lf) {
-    int64_t nf = c->nf, ne = c->ne, nfv = corner_start(c, c->nf);
-    for (int l = 0; l < Lf; l++) {
-        if (l >= L) v = (int32_t)(nf + ne + v);
-        int64_t nf2 = l == 0 ? nfv : 4 * nf, ne2 = 2 * ne + (l == 0 ? nfv : 4 * nf);
-        nf = nf2, ne = ne2;
-    }
-    return v;
+/* Output vertex numbers are not the refinement's (the plan numbers them in first use order),
+ * but output faces are: face F of level L has its sub-quads 4F..4F+3 at level L+1 (level 0 ->
+ * 1: face f's at corner_start(f)...), sub-quad k starting at corner k's vertex point. So the
+ * vertex at corner k of face F of level L (L >= 1) is corner 0 of face (4F + k) 4^(Lf-L-1) at
+ * level Lf > L, and corner j of cage face f is corner 0 of face (corner_start(f) + j) 4^(Lf-1). */
+static int32_t descend_corner(int64_t face, int L, int Lf, const outmesh *fine) {
+    for (int l = L + 1; l < Lf; l++) face *= 4;
+    return fine->fv[4 * face];
+}
+
+/* For every output vertex of m (level L >= 1), one face corner at it (4 F + k). */
+static int32_t *corner_of(const outmesh *m) {
+    int32_t *at = malloc(sizeof(int32_t) * (size_t)m->nv);
+    for (int32_t v = 0; v < m->nv; v++) at[v] = -1;
+    for (int32_t q = 0; q < 4 * m->nf; q++)
+        if (at[m->fv[q]] < 0) at[m->fv[q]] = q;
+    return at;
+}
+
+/* The level-Lf vertex of output vertex v of level L (at[v] = one of v's face corners). */
+static int32_t descend(const int32_t *at, int32_t v, int L, const outmesh *fine, int Lf) {
+    int32_t q = at[v];
+    return descend_corner(4 * (int64_t)(q / 4) + q % 4, L, Lf, fine);
 }
 
 /* Sum of the diagonal cross products of the faces around every vertex (oriented by them). */
@@ -291,10 +305,11 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
     o.levels = L;
     if (run_plan(c, &o, &m)) { CHECK(0, "%s L%d plan", what, L); return; }
     double *am = face_normals(&m), pos_err = 0;
+    int32_t *at = corner_of(&m);
     for (int32_t v = 0; v < m.nv; v++) {
         double n[NFINE][3];
         for (int i = 0; i < NFINE; i++) {
-            int32_t w = descend(c, v, L, fs->Lf + i);
+            int32_t w = descend(at, v, L, &fs->m[i], fs->Lf + i);
             memcpy(n[i], fs->acc[i] + 3 * w, sizeof n[i]);
             unit(n[i]);
             if (i == NFINE - 1)
@@ -303,7 +318,7 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
         double d1 = angle(n[0], n[1]), d2 = angle(n[1], n[2]);
         double r = d1 > 1e-14 ? d2 / d1 : 0.5;
         if (r < 0.5) r = 0.5; /* a face normal converges O(h) at best where the surface is only C1 */
-        int32_t w2 = descend(c, v, L, fs->Lf + NFINE - 1);
+        int32_t w2 = descend(at, v, L, &fs->m[NFINE - 1], fs->Lf + NFINE - 1);
         int faces = (int)fs->acc[NFINE - 1][3 * (size_t)fs->m[NFINE - 1].nv + w2];
         if (faces != 2 && faces != 4) r = fmax(r, 0.9); /* EVs, corners: see above */
         if (r > 0.95) r = 0.95, st->slow++;
@@ -320,6 +335,7 @@ static void check_level(const cage_t *c, ccn_options o, int L, const fine_set *f
         CHECK(angle(m.nrm + 3 * v, am + 3 * v) < PI / 2, "%s L%d vertex %d: against the faces", what, L, v);
     }
     CHECK(pos_err <= 1e-9, "%s L%d: positions differ from the fine plan's by %g (mapping)", what, L, pos_err);
+    free(at);
     free(am);
     free_out(&m);
 }
@@ -413,14 +429,18 @@ static void test_corners(void) {
             outmesh m;
             o.levels = 1;
             if (run_plan(c, &o, &m)) { CHECK(0, "plan"); continue; }
-            int32_t v1 = descend(c, cv, 0, 1);
+            int64_t cf = -1; /* cage face and corner at cv: level-1 face corner_start(f) + j */
+            for (int32_t f = 0; f < c->nf && cf < 0; f++)
+                for (int32_t j = 0; j < c->fsize[f]; j++)
+                    if (c->fverts[corner_start(c, f) + j] == cv) cf = corner_start(c, f) + j;
+            int32_t v1 = descend_corner(cf, 0, 1, &m);
             double prev = 10, last = 10;
             int mono = 1;
             for (int Lf = 6; Lf <= 9; Lf++) {
                 outmesh f;
                 o.levels = Lf;
                 if (run_plan(c, &o, &f)) { CHECK(0, "plan"); break; }
-                int32_t w = descend(c, cv, 0, Lf), nb = -1;
+                int32_t w = descend_corner(cf, 0, Lf, &f), nb = -1;
                 for (int32_t q = 0; q < f.nf && nb < 0; q++)
                     for (int j = 0; j < 4; j++)
                         if (f.fv[4 * q + j] == w) {
