@@ -16,7 +16,7 @@ import bmesh
 import bpy
 import numpy as np
 
-from . import compat
+from . import attrs, compat
 
 KNOT_ATTR = "knot_interval"
 SCRATCH_NAME = ".ccnurbs_scratch"
@@ -25,7 +25,7 @@ SCRATCH_NAME = ".ccnurbs_scratch"
 class Cage:
     __slots__ = ("positions", "face_sizes", "face_verts", "loop_edges", "edge_verts", "knots",
                  "material_index", "edge_select", "num_materials", "edge_creases",
-                 "vertex_creases")
+                 "vertex_creases", "extras")
 
     @property
     def num_verts(self):
@@ -113,8 +113,9 @@ def _positions(me, position_attr):
     return co.reshape(nv, 3).astype(np.float64)
 
 
-def read_mesh(me, selection=False, position_attr=None, attributes=True):
-    """attributes=False: positions and topology only (knots, creases None; material 0)."""
+def read_mesh(me, selection=False, position_attr=None, attributes=True, extras=False):
+    """attributes=False: positions and topology only (knots, creases None; material 0).
+    extras: also the UV maps and point / face attributes the limit mesh carries (attrs.py)."""
     c = Cage()
     ne, nl, nf = len(me.edges), len(me.loops), len(me.polygons)
     c.positions = _positions(me, position_attr)
@@ -127,9 +128,11 @@ def read_mesh(me, selection=False, position_attr=None, attributes=True):
     starts = np.empty(nf, np.int32)
     me.polygons.foreach_get("loop_start", starts)
     packed = np.cumsum(c.face_sizes, dtype=np.int64) - c.face_sizes
+    idx = None
     if not np.array_equal(starts, packed):  # corners not stored face by face: gather them
         idx = np.repeat(starts - packed, c.face_sizes) + np.arange(nl)
         c.face_verts, c.loop_edges = c.face_verts[idx], c.loop_edges[idx]
+    c.extras = attrs.read(me, idx) if extras and attributes else None
     ev = np.empty(2 * ne, np.int32)
     me.edges.foreach_get("vertices", ev)
     c.edge_verts = ev.reshape(ne, 2)

@@ -21,8 +21,8 @@ import numpy as np
 
 from . import compat, modifier, proxies
 
-SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "normals",
-            "use_creases", "store_render_mesh")
+SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "uv_smooth",
+            "normals", "use_creases", "store_render_mesh")
 PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
 
 

@@ -1,8 +1,9 @@
 """ctypes binding to libccnurbs.so, shipped inside this package.
 
 Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) /
-ccn_plan_sizes / ccn_plan_evaluate /
-ccn_plan_destroy. Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
+ccn_plan_sizes / ccn_plan_evaluate / ccn_plan_destroy, and its face-varying channels and
+per-vertex data (ccn_plan_add_fvar / ccn_plan_fvar_sizes / ccn_plan_evaluate_fvar /
+ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
 buffers passed by pointer; a failing call raises CCNError carrying the library's message.
 """
 import ctypes
@@ -20,6 +21,9 @@ SCHEMES = {"EIGEN": 0, "NURSS": 1, "CATMULL_CLARK": 2}
 CAPS = {"GUIDED_BI5": 0, "REFINE": 1}
 CORNERS = {"ALL": 0, "PRESERVE_CORNERS": 1}
 CREASE_METHODS = {"UNIFORM": 0, "CHAIKIN": 1}
+# ccn_fvar_linear from Blender's UV Smooth (Subdivision Surface's names): OpenSubdiv's modes
+FVAR_LINEAR = {"SMOOTH_ALL": 0, "PRESERVE_CORNERS": 1, "PRESERVE_CORNERS_AND_JUNCTIONS": 2,
+               "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": 3, "PRESERVE_BOUNDARIES": 4, "NONE": 5}
 
 
 class CCNError(Exception):
@@ -92,6 +96,22 @@ class ccn_limit_mesh(ctypes.Structure):
                 ("corner_edge_origin", c_int32_p)]
 
 
+class ccn_fvar_channel(ctypes.Structure):
+    _fields_ = [("width", ctypes.c_int32),
+                ("num_values", ctypes.c_int32),
+                ("values", c_double_p),
+                ("indices", c_int32_p),
+                ("linear", ctypes.c_int32)]
+
+
+class ccn_fvar_sizes(ctypes.Structure):
+    _fields_ = [("width", ctypes.c_int32),
+                ("num_values", ctypes.c_int32),
+                ("num_cage_values", ctypes.c_int32),
+                ("num_seam_edges", ctypes.c_int32),
+                ("num_sharp_values", ctypes.c_int32)]
+
+
 _lib = None
 _load_error = None
 
@@ -118,6 +138,17 @@ def _bind(lib):
     lib.ccn_plan_evaluate.restype = ctypes.c_int
     lib.ccn_plan_destroy.argtypes = [P]
     lib.ccn_plan_destroy.restype = None
+    lib.ccn_plan_add_fvar.argtypes = [P, ctypes.POINTER(ccn_fvar_channel), c_int32_p,
+                                      ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_add_fvar.restype = ctypes.c_int
+    lib.ccn_plan_fvar_sizes.argtypes = [P, ctypes.c_int32, ctypes.POINTER(ccn_fvar_sizes)]
+    lib.ccn_plan_fvar_sizes.restype = ctypes.c_int
+    lib.ccn_plan_evaluate_fvar.argtypes = [P, ctypes.c_int32, c_double_p, c_double_p, c_int32_p,
+                                           ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_evaluate_fvar.restype = ctypes.c_int
+    lib.ccn_plan_evaluate_vertex_data.argtypes = [P, ctypes.c_int32, c_double_p, c_double_p,
+                                                  ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_evaluate_vertex_data.restype = ctypes.c_int
     lib.ccn_status_name.argtypes = [ctypes.c_int]
     lib.ccn_status_name.restype = ctypes.c_char_p
 
@@ -277,6 +308,66 @@ class Plan:
         err = ccn_error()
         st = self._lib.ccn_plan_evaluate(self._handle, _ptr(pos, ctypes.c_double),
                                          ctypes.byref(lm), ctypes.byref(err))
+        if st != 0:
+            _raise(st, err)
+        return out
+
+    def add_fvar(self, values, indices, linear="PRESERVE_CORNERS"):
+        """A face-varying channel: values (N, W), one value index per cage face corner (in
+        face_verts order), linear = a UV Smooth identifier. Returns the channel index."""
+        if self._handle is None:
+            raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
+        vals = np.ascontiguousarray(values, dtype=np.float64)
+        vals = vals.reshape(len(vals), -1) if vals.ndim != 2 else vals
+        idx = np.ascontiguousarray(indices, dtype=np.int32).reshape(-1)
+        ch = ccn_fvar_channel(width=vals.shape[1], num_values=vals.shape[0],
+                              values=_ptr(vals, ctypes.c_double), indices=_ptr(idx, ctypes.c_int32),
+                              linear=FVAR_LINEAR[linear])
+        out = ctypes.c_int32(-1)
+        err = ccn_error()
+        st = self._lib.ccn_plan_add_fvar(self._handle, ctypes.byref(ch), ctypes.byref(out),
+                                         ctypes.byref(err))
+        if st != 0:
+            _raise(st, err)
+        return out.value
+
+    def fvar_sizes(self, channel):
+        s = ccn_fvar_sizes()
+        st = self._lib.ccn_plan_fvar_sizes(self._handle, channel, ctypes.byref(s))
+        if st != 0:
+            _raise(st, ccn_error())
+        return {name: int(getattr(s, name)) for name, _ in ccn_fvar_sizes._fields_}
+
+    def evaluate_fvar(self, channel, values=None):
+        """Limit values of a channel for new values (N, W) of its cage values (None: those
+        given): (values (M, W) f64, face_values (F, 4) int32 per output face corner)."""
+        z = self.fvar_sizes(channel)
+        out = np.empty((z["num_values"], z["width"]), np.float64)
+        fv = np.empty((self.sizes["num_faces"], 4), np.int32)
+        v = None
+        if values is not None:
+            v = np.ascontiguousarray(values, dtype=np.float64).reshape(-1)
+            if v.size != z["width"] * z["num_cage_values"]:
+                raise CCNError("CCN_ERR_ARGUMENT", "expected %d values of width %d"
+                               % (z["num_cage_values"], z["width"]))
+        err = ccn_error()
+        st = self._lib.ccn_plan_evaluate_fvar(self._handle, channel, _ptr(v, ctypes.c_double),
+                                              _ptr(out, ctypes.c_double), _ptr(fv, ctypes.c_int32),
+                                              ctypes.byref(err))
+        if st != 0:
+            _raise(st, err)
+        return out, fv
+
+    def evaluate_vertex_data(self, data):
+        """Per-vertex data (cage vertices, W) interpolated like the positions: (output
+        vertices, W) f64."""
+        d = np.ascontiguousarray(data, dtype=np.float64)
+        d = d.reshape(self.sizes["num_cage_verts"], -1)
+        out = np.empty((self.sizes["num_verts"], d.shape[1]), np.float64)
+        err = ccn_error()
+        st = self._lib.ccn_plan_evaluate_vertex_data(self._handle, d.shape[1],
+                                                     _ptr(d, ctypes.c_double),
+                                                     _ptr(out, ctypes.c_double), ctypes.byref(err))
         if st != 0:
             _raise(st, err)
         return out

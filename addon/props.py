@@ -23,6 +23,20 @@ BOUNDARY_ITEMS = (
     ('PRESERVE_CORNERS', "Keep Corners", "Pin valence-2 boundary corners (like Subdivision "
      "Surface 'Keep Corners')"),
 )
+# Subdivision Surface's UV Smooth, same identifiers, names, descriptions and default (what a new
+# Subdivision Surface modifier gets in 3.4, 4.5 and 5.0: Keep Boundaries; tests/blender/case_uv.py)
+UV_SMOOTH_ITEMS = (
+    ('NONE', "None", "UVs are not smoothed, boundaries are kept sharp"),
+    ('PRESERVE_CORNERS', "Keep Corners", "UVs are smoothed, corners on discontinuous boundary "
+     "are kept sharp"),
+    ('PRESERVE_CORNERS_AND_JUNCTIONS', "Keep Corners, Junctions", "UVs are smoothed, corners "
+     "on discontinuous boundary and junctions of 3 or more regions are kept sharp"),
+    ('PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE', "Keep Corners, Junctions, Concave", "UVs are "
+     "smoothed, corners on discontinuous boundary, junctions of 3 or more regions and darts "
+     "and concave corners are kept sharp"),
+    ('PRESERVE_BOUNDARIES', "Keep Boundaries", "UVs are smoothed, boundaries are kept sharp"),
+    ('SMOOTH_ALL', "All", "UVs and boundaries are smoothed"),
+)
 NORMALS_ITEMS = (
     ('EXACT', "Exact", "Exact surface normals from the derivatives, as custom split normals "
      "(in Blender 3.x custom normals make each update several times slower)"),
@@ -60,6 +74,9 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     cap: EnumProperty(name="Cap", items=CAP_ITEMS, default='GUIDED_BI5', update=_tag)
     boundary_smooth: EnumProperty(name="Boundary Smooth", items=BOUNDARY_ITEMS, default='ALL',
                                   update=_tag)
+    uv_smooth: EnumProperty(name="UV Smooth", items=UV_SMOOTH_ITEMS, default='PRESERVE_BOUNDARIES',
+                            description="Controls how smoothing is applied to UVs (as in "
+                            "Subdivision Surface)", update=_tag)
     normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
     use_creases: BoolProperty(
         name="Use Creases", default=True, update=_tag,
@@ -75,7 +92,8 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
     owner_name: StringProperty(options={'HIDDEN'})  # on proxies: the cage's name (no user)
 
     def option_tuple(self):
-        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.use_creases)
+        return (self.scheme, self.cap, self.boundary_smooth, self.normals, self.uv_smooth,
+                self.use_creases)
 
 
 def _overlay_toggled(self, context):

@@ -15,6 +15,7 @@ EMPTY_NAME = ".CCNURBS empty"
 KEY_PROP = "ccnurbs_key"
 LIMIT_ATTR = "ccn_limit"  # FACE bool on every limit face: tells an applied limit from a cage
 TOPO_PROP = "ccnurbs_topology"
+PLAN_PROP = "ccnurbs_plan"  # the plan (intervals included) its UV maps and attributes come from
 
 _detached = []  # (proxy name, mesh name) swapped out for a save
 
@@ -98,7 +99,7 @@ def clear(p):
         return False
     me = own_mesh(p)
     me.clear_geometry()
-    for k in (KEY_PROP, TOPO_PROP):
+    for k in (KEY_PROP, TOPO_PROP, PLAN_PROP):
         if k in me:
             del me[k]
     return True

@@ -20,8 +20,8 @@ evaluation (measured in README "Design notes").
 import time
 import traceback
 
+from . import attrs, modifier, native, proxies
 from . import cage as cagemod
-from . import modifier, native, proxies
 
 # Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
 # ccn_cage.edge_creases / vertex_creases when the cage's Use Creases is on (the default).
@@ -59,6 +59,7 @@ def rename(old, new):
 
 
 def forget(name, kinds=('VIEW', 'RENDER')):
+    attrs.forget(name)
     for kind in kinds:
         entry = _plans.pop((name, kind), None)
         if entry is not None:
@@ -78,7 +79,7 @@ def free_render_plans():
         _plans.pop(key)[1].close()
 
 
-def _plan_for(key_name, topo, cage, s, levels):
+def _plan_for(key_name, topo, cage, s, levels, uv_chans):
     cached = _plans.get(key_name)
     if cached is not None and cached[0] == topo:
         return cached[1]
@@ -90,8 +91,20 @@ def _plan_for(key_name, topo, cage, s, levels):
     plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
                        cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
                        levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
+    plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
+    plan.face_origin = None
     _plans[key_name] = (topo, plan)
     return plan
+
+
+def _write_extras(me, plan, cage, uv_chans, ekey, rebuilt):
+    """UV maps and attributes (attrs.py), when they or the topology changed."""
+    if not rebuilt and me.get(attrs.KEY_PROP) == ekey:
+        return
+    if plan.face_origin is None and cage.extras is not None and cage.extras.face:
+        plan.face_origin = plan.evaluate(cage.positions, topology=True)["face_origin"]
+    attrs.write(me, cage.extras, plan, uv_chans, plan.uv_channels, plan.face_origin)
+    me[attrs.KEY_PROP] = ekey
 
 
 def sync_object(obj, kind, cage, force=False):
@@ -108,9 +121,12 @@ def sync_object(obj, kind, cage, force=False):
         p = modifier.proxy(obj, kind)
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
-        topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases)
-        faces = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases, knots=False)
-        key = topo + ":" + cage.position_key()
+        uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
+        topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases) + uv_topo
+        faces = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases,
+                                  knots=False) + uv_topo
+        ekey = attrs.data_key(cage.extras, s.uv_smooth)
+        key = topo + ":" + cage.position_key() + ":" + ekey
         proxies.sync_materials(obj.data, p)
         old = _status.get(key_name)
         me = p.data
@@ -123,7 +139,7 @@ def sync_object(obj, kind, cage, force=False):
                 _status[key_name] = old
             return old
         stats["syncs"] += 1
-        plan = _plan_for(key_name, topo, cage, s, levels)
+        plan = _plan_for(key_name, topo, cage, s, levels, uv_chans)
         me = proxies.own_mesh(p)
         # an interval edit changes the plan, not the output faces: positions (and normals)
         # are rewritten in place, the proxy keeps its topology (issue 15 item 4)
@@ -135,12 +151,18 @@ def sync_object(obj, kind, cage, force=False):
             pass  # forced: the proxy is already right
         elif same_topology:
             proxies.write_positions(me, plan.evaluate(cage.positions, topology=False), exact)
+            # a new plan (an interval edit) changes the limit UVs and attributes too
+            _write_extras(me, plan, cage, uv_chans, ekey, me.get(proxies.PLAN_PROP) != topo)
             stats["position_updates"] += 1
         else:
-            proxies.write_topology(me, plan.evaluate(cage.positions, topology=True), cage, exact)
+            res = plan.evaluate(cage.positions, topology=True)
+            plan.face_origin = res["face_origin"]
+            proxies.write_topology(me, res, cage, exact)
+            _write_extras(me, plan, cage, uv_chans, ekey, True)
             stats["rebuilds"] += 1
         me[proxies.KEY_PROP] = key
         me[proxies.TOPO_PROP] = faces
+        me[proxies.PLAN_PROP] = topo
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:

@@ -25,7 +25,8 @@ from . import cage as cagemod
 from . import compat
 from .modifier import TAP_ATTR
 
-_object_mode = {}  # object name -> (edge_verts bytes, knots, edge creases, vertex creases)
+_object_mode = {}  # object name -> (edge_verts bytes, knots, edge creases, vertex creases,
+#                                    material indices, face_verts bytes, UV maps and attributes)
 edit_note = {}     # object name -> note shown in the panel
 
 
@@ -37,13 +38,16 @@ def _is_tap(me):
 
 def _read(obj, me):
     name = obj.name_full
-    c = cagemod.read_mesh(me, attributes=not getattr(me, "is_editmode", False))
+    c = cagemod.read_mesh(me, attributes=not getattr(me, "is_editmode", False), extras=True)
     edit_note.pop(name, None)
     if not getattr(me, "is_editmode", False):
         _object_mode[name] = (c.edge_verts.tobytes(), c.knots, c.edge_creases, c.vertex_creases,
-                              c.material_index)
+                              c.material_index, c.face_verts.tobytes(), c.extras)
         return c
-    own = cagemod.read(obj)  # the edit mesh itself: right when the stack keeps its edges
+    own = cagemod.read_mesh(cagemod.source_mesh(obj), extras=True)  # the edit mesh itself:
+    # right when the stack keeps its edges (UVs and attributes: its corners)
+    if np.array_equal(own.face_verts, c.face_verts):
+        c.extras = own.extras
     if len(own.edge_verts) == len(c.edge_verts) and np.array_equal(own.edge_verts, c.edge_verts):
         c.knots, c.edge_creases, c.vertex_creases = own.knots, own.edge_creases, \
             own.vertex_creases
@@ -51,6 +55,8 @@ def _read(obj, me):
             c.material_index = own.material_index
         return c
     cached = _object_mode.get(name)
+    if cached is not None and cached[5] == c.face_verts.tobytes() and c.extras is None:
+        c.extras = cached[6]
     if cached is not None and cached[0] == c.edge_verts.tobytes():
         c.knots, c.edge_creases, c.vertex_creases = cached[1:4]
         if len(cached[4]) == len(c.material_index):

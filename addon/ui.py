@@ -175,6 +175,7 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         layout.prop(s, "scheme")
         layout.prop(s, "cap")
         layout.prop(s, "boundary_smooth")
+        layout.prop(s, "uv_smooth")
         layout.prop(s, "use_creases")
         layout.prop(s, "normals")
         layout.prop(s, "store_render_mesh")

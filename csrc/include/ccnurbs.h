@@ -43,7 +43,8 @@ typedef enum { CCN_CREASE_UNIFORM = 0, CCN_CREASE_CHAIKIN } ccn_crease_method;
 
 /* Which kind of element an error names (ccn_error.element_kind). */
 typedef enum {
-    CCN_ELEM_NONE = 0, CCN_ELEM_VERTEX, CCN_ELEM_EDGE, CCN_ELEM_FACE, CCN_ELEM_LINE
+    CCN_ELEM_NONE = 0, CCN_ELEM_VERTEX, CCN_ELEM_EDGE, CCN_ELEM_FACE, CCN_ELEM_LINE,
+    CCN_ELEM_VALUE /* a value of a face-varying channel (or of per-vertex data) */
 } ccn_element_kind;
 
 typedef struct {
@@ -122,6 +123,56 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *mesh, const double *positions, ccn_e
  * in corner order. Level 0 -> 1 splits non-quads. */
 ccn_status ccn_refine(const ccn_mesh *in, int32_t levels, const ccn_options *opts,
                       ccn_mesh **out, ccn_error *err);
+
+/* ---- face-varying data (UV maps): OpenSubdiv's face-varying channels --------------- */
+
+/* How face-varying values are interpolated where they are discontinuous (seams) and at the
+ * mesh boundary: OpenSubdiv's Sdc::Options::FVarLinearInterpolation, same numbers (the OBJ tag
+ * `t facevaryinginterpolateboundary`), Blender's UV Smooth names in brackets. OpenSubdiv's
+ * default is ALL. */
+typedef enum {
+    CCN_FVAR_LINEAR_NONE = 0,      /* smooth everywhere, seams are smooth boundaries ("All") */
+    CCN_FVAR_LINEAR_CORNERS_ONLY,  /* sharpen corners ("Keep Corners") */
+    CCN_FVAR_LINEAR_CORNERS_PLUS1, /* and junctions of 3+ values ("Keep Corners, Junctions") */
+    CCN_FVAR_LINEAR_CORNERS_PLUS2, /* and darts, corners of 2 values ("..., Concave") */
+    CCN_FVAR_LINEAR_BOUNDARIES,    /* linear along seams and boundaries ("Keep Boundaries",
+                                      what a new Subdivision Surface modifier gets) */
+    CCN_FVAR_LINEAR_ALL            /* bilinear everywhere ("None") */
+} ccn_fvar_linear;
+
+/* A face-varying channel of a cage: a value index per face corner (cage face order,
+ * sum(face_sizes) entries) into `values` (width doubles each). Faces that share an edge and
+ * give it the same values at both ends are smooth across it; elsewhere the edge is a seam.
+ * Inside a chart values refine with the same rules, intervals and creases as positions; on
+ * seams and boundaries with the mode's boundary rules and the seam edges' intervals. */
+typedef struct {
+    int32_t width;          /* doubles per value, 1..CCN_FVAR_MAX_WIDTH */
+    int32_t num_values;
+    const double *values;   /* width * num_values, finite */
+    const int32_t *indices; /* one per face corner, in [0, num_values) */
+    int32_t linear;         /* ccn_fvar_linear */
+} ccn_fvar_channel;
+#define CCN_FVAR_MAX_WIDTH 64
+
+typedef struct ccn_fvar ccn_fvar; /* opaque: a refined face-varying channel */
+typedef struct {
+    int32_t width;
+    int32_t level;
+    int32_t num_values;      /* distinct refined values */
+    int32_t num_face_verts;  /* face corners of the refined mesh (its value indices) */
+    int32_t num_seam_edges;  /* cage edges whose values differ between their faces */
+    int32_t num_sharp_values;/* values the mode keeps sharp (corners) at this level */
+} ccn_fvar_info;
+
+/* The channel after `levels` levels of ccn_refine of `cage` with the same options: the faces
+ * and corners of ccn_refine's output, in its order. */
+ccn_status ccn_fvar_refine(const ccn_mesh *cage, const ccn_fvar_channel *channel,
+                           int32_t levels, const ccn_options *opts, ccn_fvar **out,
+                           ccn_error *err);
+ccn_status ccn_fvar_info_get(const ccn_fvar *fvar, ccn_fvar_info *info);
+/* values: width * num_values; face_values: num_face_verts value indices; either may be NULL. */
+ccn_status ccn_fvar_copy(const ccn_fvar *fvar, double *values, int32_t *face_values);
+void ccn_fvar_destroy(ccn_fvar *fvar);
 
 /* ---- extraordinary-vertex refinement matrix (Li, Finnigan, Sederberg 2016) ------ */
 
@@ -228,6 +279,35 @@ ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_
                              ccn_error *err);
 void ccn_plan_destroy(ccn_plan *plan);
 
+/* Face-varying channels on the plan's output: ccn_plan_add_fvar refines the channel's value
+ * topology with the plan's levels and composes its exact limit stencils into weights over the
+ * channel's values, so each evaluation of new values (same indices) is one sparse product, no
+ * rebuild. The output values are limit values at the output vertices
+ * (per value vertex: the corners of faces meeting at an output vertex on one side of a seam
+ * share one value); face_values gives each output face corner (4 * num_faces, the order of
+ * ccn_limit_mesh.face_verts) its value. In guided-cap holes the values are the exact limit of
+ * the refinement (the geometry there is the bi-5 cap). */
+typedef struct {
+    int32_t width;
+    int32_t num_values;       /* output values */
+    int32_t num_cage_values;  /* the channel's num_values (the length ccn_plan_evaluate_fvar reads) */
+    int32_t num_seam_edges;   /* cage edges that are seams of this channel */
+    int32_t num_sharp_values; /* output values the mode keeps sharp */
+} ccn_fvar_sizes;
+/* Adds a channel; *channel receives its index (0, 1, ...). */
+ccn_status ccn_plan_add_fvar(ccn_plan *plan, const ccn_fvar_channel *ch, int32_t *channel,
+                             ccn_error *err);
+ccn_status ccn_plan_fvar_sizes(const ccn_plan *plan, int32_t channel, ccn_fvar_sizes *sizes);
+/* values: width * num_cage_values, or NULL for the values given to ccn_plan_add_fvar;
+ * out_values: width * num_values (required); face_values: 4 * num_faces, may be NULL. */
+ccn_status ccn_plan_evaluate_fvar(ccn_plan *plan, int32_t channel, const double *values,
+                                  double *out_values, int32_t *face_values, ccn_error *err);
+/* Per-vertex data (colours, weights, any float attribute): width doubles per cage vertex
+ * (1..CCN_FVAR_MAX_WIDTH), interpolated by the rules of the positions (their exact limit, in
+ * cap holes too) through the same plan; out: width * num_verts, in output vertex order. */
+ccn_status ccn_plan_evaluate_vertex_data(ccn_plan *plan, int32_t width, const double *data,
+                                         double *out, ccn_error *err);
+
 /* The finite patch set for the positions of the last ccn_plan_evaluate (call it first):
  * bicubic patches of the regular faces of the cap level (or of the deepest level without
  * caps) and the bi-5 rings and caps. fn receives the degree (3 or 5), (degree+1)^2 control
@@ -262,6 +342,11 @@ typedef struct {
     int32_t fvar_boundary;    /* t facevaryinginterpolateboundary 0..5 */
 } ccn_obj_tags;
 ccn_status ccn_obj_get_tags(const ccn_obj *obj, ccn_obj_tags *tags);
+/* The file's UV map (`vt u [v [w]]` lines, `f v/vt` corners) as a face-varying channel view
+ * (valid while obj lives): width = the most components a `vt` line has, linear = the
+ * facevaryinginterpolateboundary tag or ALL. num_values = 0 and NULL arrays when the file has
+ * no `vt` or a face without texture indices (then a warning says so). */
+ccn_status ccn_obj_fvar(const ccn_obj *obj, ccn_fvar_channel *channel);
 /* Statements the reader skipped with a reason (unknown tags): count and text. */
 int32_t ccn_obj_num_warnings(const ccn_obj *obj);
 const char *ccn_obj_warning(const ccn_obj *obj, int32_t i);

@@ -1,4 +1,5 @@
-/* OBJ reader: `v x y z`, `f a b c ...` (a, a/b, a/b/c, a//c; negative = relative), the
+/* OBJ reader: `v x y z`, `vt u [v [w]]`, `f a b c ...` (a, a/b, a/b/c, a//c; negative =
+ * relative; the texture index b of every corner makes the UV map, ccn_obj_fvar), the
  * comment statements `# knot i j d`, `# crease i j s`, `# corner i s` (1-based vertex indices;
  * other readers skip them), and OpenSubdiv's shape tags `t name nints/nfloats/nstrings ...`
  * (regression/common/shape_utils.cpp: crease, corner with 0-based indices, interpolateboundary,
@@ -29,6 +30,12 @@ struct ccn_obj {
     int has_crease;
     /* vertex sharpness by vertex index (grown on demand; 0 = none) */
     double *vcrease; int32_t cap_vc, nvc;
+    /* UV map: vt values (3 per line, padded with 0), the texture index of each face corner
+     * (-1: none), the most components a vt line had, the largest index used and its line */
+    double *vt;    int32_t nvt, cap_vt, vt_width;
+    int32_t *fvt;  int32_t cap_fvt, nfvt_missing;
+    int32_t vt_max; long vt_max_line;
+    int fvar_ok;   /* every corner has a texture index and there are vt lines */
     ccn_obj_tags tags;
     int32_t nwarn;
     char warn[OBJ_MAX_WARNINGS][128];
@@ -101,6 +108,38 @@ static ccn_status parse_v(ccn_obj *o, cursor *c, long line, ccn_error *err) {
     return CCN_OK;
 }
 
+static ccn_status parse_vt(ccn_obj *o, cursor *c, long line, ccn_error *err) {
+    char t[64];
+    if (grow((void **)&o->vt, &o->cap_vt, 3 * (o->nvt + 1), sizeof(double)))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_LINE, (int32_t)line, "out of memory");
+    int k = 0, len;
+    for (; k < 3 && (len = token(c, t)) > 0; k++)
+        if (parse_double(t, &o->vt[3 * o->nvt + k]) || !isfinite(o->vt[3 * o->nvt + k]))
+            return bad(err, line, "texture coordinate needs finite numbers");
+    if (k == 0) return bad(err, line, "texture coordinate needs a number");
+    for (int j = k; j < 3; j++) o->vt[3 * o->nvt + j] = 0.0;
+    if (k > o->vt_width) o->vt_width = k;
+    o->nvt++;
+    return CCN_OK;
+}
+
+/* Texture index of a face token "a/b[/c]": 0-based, -1 when there is none. */
+static ccn_status texture_index(ccn_obj *o, const char *t, long line, int32_t *out, ccn_error *err) {
+    const char *s = strchr(t, '/');
+    *out = -1;
+    if (!s || s[1] == '/' || s[1] == '\0') return CCN_OK;
+    char *e;
+    errno = 0;
+    long b = strtol(s + 1, &e, 10);
+    if (e == s + 1 || (*e != '\0' && *e != '/') || errno == ERANGE || b == 0)
+        return bad(err, line, "bad texture index");
+    if (b < 0) b = o->nvt + b + 1; /* relative index */
+    if (b < 1 || b > INT32_MAX) return bad(err, line, "texture index out of range");
+    *out = (int32_t)(b - 1);
+    if (*out > o->vt_max) { o->vt_max = *out; o->vt_max_line = line; }
+    return CCN_OK;
+}
+
 static ccn_status parse_f(ccn_obj *o, cursor *c, long line, ccn_error *err) {
     char t[64];
     int32_t n = 0;
@@ -110,8 +149,12 @@ static ccn_status parse_f(ccn_obj *o, cursor *c, long line, ccn_error *err) {
         if (len < 0 || parse_int(t, &idx) || idx == 0) return bad(err, line, "bad face index");
         if (idx < 0) idx = o->nv + idx + 1; /* relative index */
         if (idx < 1 || idx > INT32_MAX) return bad(err, line, "face index out of range");
-        if (grow((void **)&o->fv, &o->cap_fv, o->nfv + n + 1, sizeof(int32_t)))
+        if (grow((void **)&o->fv, &o->cap_fv, o->nfv + n + 1, sizeof(int32_t)) ||
+            grow((void **)&o->fvt, &o->cap_fvt, o->nfv + n + 1, sizeof(int32_t)))
             return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_LINE, (int32_t)line, "out of memory");
+        ccn_status st = texture_index(o, t, line, &o->fvt[o->nfv + n], err);
+        if (st) return st;
+        o->nfvt_missing += o->fvt[o->nfv + n] < 0;
         o->fv[o->nfv + n++] = (int32_t)(idx - 1);
     }
     if (grow((void **)&o->fsz, &o->cap_f, o->nf + 1, sizeof(int32_t)))
@@ -277,8 +320,29 @@ static ccn_status parse_line(ccn_obj *o, cursor *c, long line, ccn_error *err) {
     if (len < 0) return bad(err, line, "token too long");
     if (strcmp(t, "v") == 0) return parse_v(o, c, line, err);
     if (strcmp(t, "f") == 0) return parse_f(o, c, line, err);
+    if (strcmp(t, "vt") == 0) return parse_vt(o, c, line, err);
     if (strcmp(t, "t") == 0) return parse_tag(o, c, line, err);
-    return CCN_OK; /* vt, vn, o, g, s, usemtl, ... */
+    return CCN_OK; /* vn, o, g, s, usemtl, ... */
+}
+
+/* The UV map is used when there are vt lines and every face corner has a texture index; an
+ * index beyond the vt lines is an error naming its line, a partial map a warning. */
+static ccn_status finish_uvs(ccn_obj *o, ccn_error *err) {
+    int any = o->nfv > o->nfvt_missing;
+    if (o->nvt > 0 && any && o->vt_max >= o->nvt)
+        return ccn__fail(err, CCN_ERR_IO, CCN_ELEM_LINE, (int32_t)(o->vt_max_line > INT32_MAX ? -1 : o->vt_max_line),
+                         "OBJ line %ld: texture index %d, but the file has %d vt lines",
+                         o->vt_max_line, (int)o->vt_max + 1, (int)o->nvt);
+    o->fvar_ok = o->nvt > 0 && o->nfv > 0 && o->nfvt_missing == 0;
+    if ((o->nvt > 0 || any) && !o->fvar_ok && o->nwarn < OBJ_MAX_WARNINGS)
+        snprintf(o->warn[o->nwarn], sizeof o->warn[0], "UV map ignored: %s",
+                 o->nvt == 0 ? "texture indices but no vt lines"
+                 : any ? "some face corners have no texture index" : "no face uses the vt lines");
+    if ((o->nvt > 0 || any) && !o->fvar_ok) o->nwarn++;
+    if (o->fvar_ok) /* pack to vt_width components */
+        for (int32_t i = 0; i < o->nvt; i++)
+            for (int32_t k = 0; k < o->vt_width; k++) o->vt[(size_t)o->vt_width * i + k] = o->vt[3 * (size_t)i + k];
+    return CCN_OK;
 }
 
 ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error *err) {
@@ -288,6 +352,7 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
     ccn_obj *o = calloc(1, sizeof *o);
     if (!o) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     o->tags.boundary_corners = o->tags.boundary_none = o->tags.crease_method = o->tags.fvar_boundary = -1;
+    o->vt_max = -1;
     const char *s = text, *end = text + len;
     long line = 0;
     while (s < end) {
@@ -314,6 +379,8 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
         for (int32_t k = o->nvc; k < o->nv; k++) o->vcrease[k] = 0.0;
         o->nvc = o->nv;
     }
+    ccn_status st = finish_uvs(o, err);
+    if (st) { ccn_obj_destroy(o); return st; }
     *out = o;
     return CCN_OK;
 }
@@ -321,7 +388,7 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
 void ccn_obj_destroy(ccn_obj *o) {
     if (!o) return;
     free(o->pos); free(o->fsz); free(o->fv); free(o->ev); free(o->knot); free(o->crease);
-    free(o->vcrease);
+    free(o->vcrease); free(o->vt); free(o->fvt);
     free(o);
 }
 
@@ -338,6 +405,18 @@ ccn_status ccn_obj_cage(const ccn_obj *o, ccn_cage *c) {
     c->edge_knots = o->nk ? o->knot : NULL;
     c->edge_creases = o->has_crease ? o->crease : NULL;
     c->vertex_creases = o->nvc > 0 ? o->vcrease : NULL; /* nvc = nv (ccn_obj_parse) */
+    return CCN_OK;
+}
+
+ccn_status ccn_obj_fvar(const ccn_obj *o, ccn_fvar_channel *ch) {
+    if (!o || !ch) return CCN_ERR_ARGUMENT;
+    memset(ch, 0, sizeof *ch);
+    ch->linear = o->tags.fvar_boundary >= 0 ? o->tags.fvar_boundary : CCN_FVAR_LINEAR_ALL;
+    if (!o->fvar_ok) return CCN_OK;
+    ch->width = o->vt_width;
+    ch->num_values = o->nvt;
+    ch->values = o->vt;
+    ch->indices = o->fvt;
     return CCN_OK;
 }
 

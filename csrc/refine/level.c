@@ -109,29 +109,35 @@ static void rule_point(const ccn__level *c, int32_t v, int rule, int32_t n, cons
     }
 }
 
-/* Vertex point on a creased mesh (OpenSubdiv's ComputeVertexVertexMask). */
+/* Vertex point on a creased mesh (OpenSubdiv's ComputeVertexVertexMask). The rule comes from
+ * the sharpness around r = v, or around c->partner[v] (face-varying dependent sharpness; the
+ * crease then runs along v's own sharp edges, which are its two boundary edges). */
 static void creased_vertex_point(const ccn__level *c, int32_t v, const double *fp, double out[3]) {
     const ccn_mesh *m = c->m;
-    int32_t n = ccn__valence(m, v);
-    float sbuf[2 * CREASE_STACK], *ps = sbuf;
-    if (n > CREASE_STACK && !(ps = malloc(sizeof(float) * 2 * (size_t)n))) {
+    int32_t r = c->partner && c->partner[v] >= 0 ? c->partner[v] : v;
+    int32_t n = ccn__valence(m, r), nv = ccn__valence(m, v), mx = n > nv ? n : nv;
+    float sbuf[3 * CREASE_STACK], *ps = sbuf;
+    if (mx > CREASE_STACK && !(ps = malloc(sizeof(float) * 3 * (size_t)mx))) {
         rule_point(c, v, CCN_RULE_CORNER, 0, NULL, fp, out); /* out of memory: keep the point */
         return;
     }
-    float *cs = ps + n;
-    ccn__fan_sharpness(m, v, ps);
-    float pvs = ccn__vertex_sharpness(m, v, c->pinned);
+    float *cs = ps + mx, *own = r == v ? ps : cs + mx;
+    ccn__fan_sharpness(m, r, ps);
+    if (r != v) ccn__fan_sharpness(m, v, own);
+    float pvs = ccn__vertex_sharpness(m, r, c->pinned);
     int prule = ccn__sharp_rule(pvs, n, ps);
     if (prule == CCN_RULE_SMOOTH || prule == CCN_RULE_DART) {
         ccn__nurss_vertex_point(m, v, c->H, fp, out);
     } else {
-        rule_point(c, v, prule, n, ps, fp, out);
+        rule_point(c, v, prule, nv, own, fp, out);
         float cvs = ccn__sharp_decrement(pvs);
         ccn__sharp_children(c->crease_method, n, ps, cs);
         int crule = ccn__sharp_rule(cvs, n, cs);
         if (crule != prule) {
             double ch[3], w = (double)ccn__sharp_fraction(c->crease_method, pvs, cvs, n, ps, cs);
-            rule_point(c, v, crule, n, cs, fp, ch);
+            if (r == v) rule_point(c, v, crule, n, cs, fp, ch);
+            else if (crule == CCN_RULE_SMOOTH || crule == CCN_RULE_DART) ccn__nurss_vertex_point(m, v, c->H, fp, ch);
+            else rule_point(c, v, crule, nv, own, fp, ch);
             for (int k = 0; k < 3; k++) out[k] = w * out[k] + (1.0 - w) * ch[k];
         }
     }

@@ -21,6 +21,10 @@ typedef struct {
     size_t *Moff;
     double *H;           /* scratch: 3*ne curve edge points */
     int32_t fallbacks;
+    /* Face-varying channels (refine/fvar.c), else NULL: vertex v's rule (smooth, crease or
+     * corner, and the fractional weight where it changes) follows the sharpness of vertex
+     * partner[v] >= 0 (OpenSubdiv's dependent sharpness), its crease along its own edges. */
+    const int32_t *partner;
     ccn__ev_cache *ev_cache; /* the owner's cache of eigen polyhedron choices (may be NULL) */
     int32_t ev_poly;     /* ccn_options.ev_polyhedron */
     int32_t ev_verified, ev_outside; /* EVs of this level verified / outside the G1 range */

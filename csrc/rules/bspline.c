@@ -27,11 +27,13 @@
 
 #include "rules/crease.h"
 
-/* Fan edges of v that split the look-ups (boundary edges count). */
+/* Fan edges of v that split the look-ups (boundary edges count): the outgoing half-edges of
+ * v's fan but a boundary vertex's first (its outgoing boundary edge; the incoming one is not
+ * in the fan). */
 static int32_t split_count(const ccn_mesh *m, int32_t v) {
-    int32_t n = ccn__valence(m, v), k = m->vboundary[v] ? 2 : 0;
-    for (int32_t i = m->vboundary[v] ? 1 : 0; i < (m->vboundary[v] ? n - 1 : n); i++)
-        k += ccn__edge_splits(m, ccn__fan_edge(m, v, i));
+    int32_t b = m->vboundary[v], k = b ? 2 : 0;
+    for (int32_t i = m->vfan_start[v] + b; i < m->vfan_start[v + 1]; i++)
+        k += m->esharp[m->hedge[m->vfan[i]]] >= 1.0f;
     return k;
 }
 

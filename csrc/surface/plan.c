@@ -15,6 +15,7 @@
 #include "base/vec3.h"
 #include "bi5/bi5.h"
 #include "surface/caps.h"
+#include "surface/plan_fvar.h"
 #include "surface/plan_levels.h"
 #include "surface/tessellate.h"
 #include "topology/mesh.h"
@@ -40,6 +41,8 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
+    for (int32_t c = 0; c < p->nfv; c++) ccn__fvchan_free(p->fv[c]);
+    free(p->fv); free(p->vd_buf);
     ccn__ev_cache_destroy(p->ev_cache);
     free(p);
 }

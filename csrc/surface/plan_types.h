@@ -7,6 +7,7 @@
 #include "topology/halfedge.h"
 
 struct ccn__bi5;
+struct ccn__fvchan; /* a face-varying channel (surface/plan_fvar.c) */
 
 /* One extraordinary vertex filled by the guided bi-5 cap (K&P 2018). */
 typedef struct {
@@ -77,6 +78,12 @@ struct ccn_plan {
     int32_t *bv_out, *bv_rf;
     double *bv_uv;
     ccn_sizes sizes;
+    /* face-varying channels (surface/plan_fvar.c) */
+    int32_t nfv;
+    struct ccn__fvchan **fv;
+    /* per-vertex data (ccn_plan_evaluate_vertex_data): scratch positions of levels 0..L (and
+     * L+1 when built) and of the level-(L+1) subset, allocated on first use */
+    double *vd_buf;
     ccn__ev_cache *ev_cache; /* eigen polyhedron choices, shared by every level and limit */
     ccn_cache *op_cache;     /* the caller's bi-5 operators (ccn_plan_create_cached), or NULL:
                                 then ops holds the plan's own */

@@ -463,6 +463,12 @@ static ccn_status cache_put(ccn__ring_work *w, const ring_cfg *g, uint64_t h, co
 ccn_status ccn__ring_limit_eval(const ccn_mesh *m, int32_t v, int scheme, int pinned,
                                 int crease_method, ccn__ring_work *w, ccn__ring_limit *out,
                                 ccn_error *err) {
+    return ccn__ring_limit_eval_vs(m, v, scheme, pinned, crease_method, -1.0f, w, out, err);
+}
+
+ccn_status ccn__ring_limit_eval_vs(const ccn_mesh *m, int32_t v, int scheme, int pinned,
+                                   int crease_method, float child_vs, ccn__ring_work *w,
+                                   ccn__ring_limit *out, ccn_error *err) {
     int32_t n = ccn__valence(m, v);
     if (n > MAXV || n < 2 || m->vfan_start[v + 1] == m->vfan_start[v])
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
@@ -479,7 +485,7 @@ ccn_status ccn__ring_limit_eval(const ccn_mesh *m, int32_t v, int scheme, int pi
         g.c[k] = bnd ? 0.0f : ccn__child_edge_sharpness(m, crease_method, e, v);
     }
     for (int32_t k = 0; k < n; k++) g.d[k] /= dmax;
-    g.vs = ccn__sharp_decrement(m->vsharp ? m->vsharp[v] : 0.0f);
+    g.vs = child_vs >= 0.0f ? child_vs : ccn__sharp_decrement(m->vsharp ? m->vsharp[v] : 0.0f);
     /* the child 1-ring in level-(l+1) numbering */
     int32_t nf = g.boundary ? n - 1 : n;
     out->npts = 1 + n + nf;

@@ -41,5 +41,10 @@ void ccn__ring_work_ev(const ccn__ring_work *w, int32_t *ev_poly, ccn__ev_cache 
 ccn_status ccn__ring_limit_eval(const ccn_mesh *m, int32_t v, int scheme, int pinned,
                                 int crease_method, ccn__ring_work *w, ccn__ring_limit *out,
                                 ccn_error *err);
+/* The same with v's sharpness one level finer given (child_vs >= 0) instead of its own:
+ * face-varying values whose rule follows another value's sharpness (refine/fvar.h). */
+ccn_status ccn__ring_limit_eval_vs(const ccn_mesh *m, int32_t v, int scheme, int pinned,
+                                   int crease_method, float child_vs, ccn__ring_work *w,
+                                   ccn__ring_limit *out, ccn_error *err);
 
 #endif

@@ -63,16 +63,28 @@ static void resolve_options(const ccn_obj *obj, ccn_options *o) {
     if (o->crease_method < 0) o->crease_method = t.crease_method >= 0 ? t.crease_method : CCN_CREASE_UNIFORM;
 }
 
-int ccn_cli_load_mesh(const char *path, ccn_options *o, ccn_mesh **out) {
-    ccn_obj *obj = NULL;
-    ccn_cage cage;
-    int rc = load_cage(path, &obj, &cage);
+int ccn_cli_load_uv(const char *path, ccn_options *o, int *fvar_linear, ccn_obj **obj,
+                    ccn_cage *cage, ccn_fvar_channel *uv) {
+    int rc = load_cage(path, obj, cage);
     if (rc) return rc;
-    resolve_options(obj, o);
-    ccn_error err;
-    ccn_status st = ccn_mesh_create(&cage, out, &err);
-    ccn_obj_destroy(obj);
-    return st ? ccn_cli_error(path, &err) : 0;
+    resolve_options(*obj, o);
+    ccn_obj_fvar(*obj, uv);
+    if (*fvar_linear < 0) *fvar_linear = uv->linear;
+    uv->linear = *fvar_linear;
+    return 0;
+}
+
+static const char *FVAR_NAMES[] = {"none", "corners-only", "corners-plus1", "corners-plus2",
+                                   "boundaries", "all"};
+
+int ccn_cli_fvar_linear(const char *s) {
+    for (int m = 0; m < 6; m++)
+        if (strcmp(s, FVAR_NAMES[m]) == 0) return m;
+    return -1;
+}
+
+const char *ccn_cli_fvar_linear_name(int m) {
+    return m >= 0 && m < 6 ? FVAR_NAMES[m] : "?";
 }
 
 int ccn_cli_load_plan(const char *path, ccn_options *o, ccn_plan **plan) {
@@ -106,7 +118,26 @@ int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan) {
     return st ? ccn_cli_error(path, &err) : 0;
 }
 
-static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
+/* vt lines and the texture index of each face corner of a refined UV map. */
+static int write_uv_values(FILE *f, const ccn_fvar *uv, int32_t **corner) {
+    ccn_fvar_info fi;
+    ccn_fvar_info_get(uv, &fi);
+    double *val = malloc(sizeof(double) * (size_t)fi.width * (size_t)(fi.num_values ? fi.num_values : 1));
+    *corner = malloc(sizeof(int32_t) * (size_t)(fi.num_face_verts ? fi.num_face_verts : 1));
+    if (!val || !*corner) { free(val); return -1; }
+    ccn_fvar_copy(uv, val, *corner);
+    fprintf(f, "# ccnurbs uv: %d values, %d seam edges, %d sharp values\n", (int)fi.num_values,
+            (int)fi.num_seam_edges, (int)fi.num_sharp_values);
+    for (int32_t i = 0; i < fi.num_values; i++) {
+        fputs("vt", f);
+        for (int32_t k = 0; k < fi.width; k++) fprintf(f, " %.17g", val[(size_t)fi.width * i + k]);
+        fputc('\n', f);
+    }
+    free(val);
+    return 0;
+}
+
+static int write_body(FILE *f, const ccn_mesh *m, const ccn_fvar *uv, const char *header) {
     ccn_mesh_info in;
     ccn_mesh_info_get(m, &in);
     double *pos = malloc(sizeof(double) * 3 * (size_t)(in.num_verts ? in.num_verts : 1));
@@ -116,6 +147,7 @@ static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
     double *ek = malloc(sizeof(double) * (size_t)(in.num_edges ? in.num_edges : 1));
     double *es = malloc(sizeof(double) * (size_t)(in.num_edges ? in.num_edges : 1));
     double *vs = malloc(sizeof(double) * (size_t)(in.num_verts ? in.num_verts : 1));
+    int32_t *uvc = NULL;
     int rc = -1;
     if (!pos || !fs || !fv || !ev || !ek || !es || !vs) goto done;
     ccn_mesh_copy(m, pos, fs, fv, ev, ek);
@@ -126,9 +158,13 @@ static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
             (int)in.num_edges, (int)in.num_ring_conflicts, (int)in.num_ev_fallbacks);
     for (int32_t v = 0; v < in.num_verts; v++)
         fprintf(f, "v %.17g %.17g %.17g\n", pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
+    if (uv && write_uv_values(f, uv, &uvc)) goto done;
     for (int32_t i = 0, k = 0; i < in.num_faces; i++) {
         fputc('f', f);
-        for (int32_t j = 0; j < fs[i]; j++, k++) fprintf(f, " %d", (int)fv[k] + 1);
+        for (int32_t j = 0; j < fs[i]; j++, k++) {
+            if (uvc) fprintf(f, " %d/%d", (int)fv[k] + 1, (int)uvc[k] + 1);
+            else fprintf(f, " %d", (int)fv[k] + 1);
+        }
         fputc('\n', f);
     }
     for (int32_t e = 0; e < in.num_edges; e++)
@@ -140,11 +176,15 @@ static int write_body(FILE *f, const ccn_mesh *m, const char *header) {
         if (vs[v] > 0) fprintf(f, "# corner %d %.9g\n", (int)v + 1, vs[v]);
     rc = ferror(f) ? -1 : 0;
 done:
-    free(pos); free(fs); free(fv); free(ev); free(ek); free(es); free(vs);
+    free(pos); free(fs); free(fv); free(ev); free(ek); free(es); free(vs); free(uvc);
     return rc;
 }
 
 int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header) {
+    return ccn_cli_write_mesh_uv(path, m, NULL, header);
+}
+
+int ccn_cli_write_mesh_uv(const char *path, const ccn_mesh *m, const ccn_fvar *uv, const char *header) {
     size_t n = strlen(path);
     char *tmp = malloc(n + 16);
     if (!tmp) return 2;
@@ -155,7 +195,7 @@ int ccn_cli_write_mesh(const char *path, const ccn_mesh *m, const char *header) 
         free(tmp);
         return 2;
     }
-    int rc = write_body(f, m, header);
+    int rc = write_body(f, m, uv, header);
     if (fclose(f) != 0) rc = -1;
     if (rc == 0 && rename(tmp, path) != 0) rc = -1;
     if (rc != 0) {
@@ -188,9 +228,10 @@ int ccn_cli_int(const char *s, int lo, int hi, int *out) {
 
 /* Shared option parser of refine / limit / patches (see cli.h). */
 int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_options *o,
-                  const char **in, const char **out) {
+                  int *fvar_linear, const char **in, const char **out) {
     o->boundary_corners = -1; /* unset: the file's tags decide (resolve_options) */
     o->crease_method = -1;
+    if (fvar_linear) *fvar_linear = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(a, "--scheme") == 0 && val) {
@@ -220,6 +261,13 @@ int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_o
         } else if (strcmp(a, "--polyhedron") == 0 && val) {
             if (ccn_cli_int(val, CCN_POLY_SELECT, CCN_POLY_COUNT, &o->ev_polyhedron)) {
                 fprintf(stderr, "ccnurbs: --polyhedron must be 0 (the per-vertex choice) .. %d\n", CCN_POLY_COUNT);
+                return 2;
+            }
+            i++;
+        } else if (fvar_linear && strcmp(a, "--fvar-linear") == 0 && val) {
+            if ((*fvar_linear = ccn_cli_fvar_linear(val)) < 0) {
+                fprintf(stderr, "ccnurbs: bad --fvar-linear '%s' (none, corners-only, corners-plus1, "
+                                "corners-plus2, boundaries or all)\n", val);
                 return 2;
             }
             i++;

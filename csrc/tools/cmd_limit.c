@@ -1,4 +1,5 @@
-/* ccnurbs limit: the limit mesh (positions + exact normals) as OBJ with vn lines. */
+/* ccnurbs limit: the limit mesh (positions + exact normals) as OBJ with vn lines; the UV map
+ * (vt) as limit values per face corner (f v/vt/vn, --fvar-linear). */
 #include "cli.h"
 #include "commands.h"
 
@@ -6,8 +7,10 @@
 #include <string.h>
 #include <unistd.h>
 
+typedef struct { int32_t width, num_values; const double *values; const int32_t *face_values; } uv_out;
+
 /* vn lines: one per vertex, or (corner normals) one per face corner, 4 per face in order. */
-static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm) {
+static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm, const uv_out *uv) {
     fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
                "%d EV fallbacks, %d ring conflicts\n", (int)s->levels, (int)s->num_verts,
             (int)s->num_faces, (int)s->num_caps, (int)s->num_cap_fallbacks,
@@ -19,23 +22,31 @@ static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm) {
     int32_t nn = lm->corner_normals ? 4 * s->num_faces : s->num_verts;
     for (int32_t v = 0; v < nn; v++)
         fprintf(f, "vn %.17g %.17g %.17g\n", nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
+    for (int32_t i = 0; uv && i < uv->num_values; i++) {
+        fputs("vt", f);
+        for (int32_t k = 0; k < uv->width; k++) fprintf(f, " %.17g", uv->values[(size_t)uv->width * i + k]);
+        fputc('\n', f);
+    }
     for (int32_t q = 0; q < s->num_faces; q++) {
         const int32_t *fv = lm->face_verts + 4 * q;
-        int32_t n0 = lm->corner_normals ? 4 * q : fv[0], n1 = lm->corner_normals ? 4 * q + 1 : fv[1];
-        int32_t n2 = lm->corner_normals ? 4 * q + 2 : fv[2], n3 = lm->corner_normals ? 4 * q + 3 : fv[3];
-        fprintf(f, "f %d//%d %d//%d %d//%d %d//%d\n", fv[0] + 1, n0 + 1, fv[1] + 1, n1 + 1,
-                fv[2] + 1, n2 + 1, fv[3] + 1, n3 + 1);
+        fputc('f', f);
+        for (int k = 0; k < 4; k++) {
+            int32_t n = lm->corner_normals ? 4 * q + k : fv[k];
+            if (uv) fprintf(f, " %d/%d/%d", fv[k] + 1, uv->face_values[4 * q + k] + 1, n + 1);
+            else fprintf(f, " %d//%d", fv[k] + 1, n + 1);
+        }
+        fputc('\n', f);
     }
     return ferror(f) ? -1 : 0;
 }
 
-static int write_atomic(const char *path, const ccn_sizes *s, const ccn_limit_mesh *lm) {
+static int write_atomic(const char *path, const ccn_sizes *s, const ccn_limit_mesh *lm, const uv_out *uv) {
     size_t n = strlen(path);
     char *tmp = malloc(n + 32);
     if (!tmp) return 2;
     snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
-    int rc = f ? write_limit(f, s, lm) : -1;
+    int rc = f ? write_limit(f, s, lm, uv) : -1;
     if (f && fclose(f) != 0) rc = -1;
     if (rc == 0 && rename(tmp, path) != 0) rc = -1;
     if (rc) { remove(tmp); fprintf(stderr, "ccnurbs: cannot write %s\n", path); }
@@ -55,27 +66,54 @@ int ccn_cmd_limit(int argc, char **argv) {
             argc--;
             i--;
         }
-    int rc = ccn_cli_parse(argc, argv, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, &in, &out);
+    int fvar_linear = -1;
+    int rc = ccn_cli_parse(argc, argv, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, &fvar_linear, &in, &out);
     if (rc) return rc;
+    ccn_obj *obj = NULL;
+    ccn_cage cage;
+    ccn_fvar_channel uvc;
+    if ((rc = ccn_cli_load_uv(in, &o, &fvar_linear, &obj, &cage, &uvc))) return rc;
     ccn_plan *plan = NULL;
-    if ((rc = ccn_cli_load_plan(in, &o, &plan))) return rc;
+    ccn_error err;
+    int32_t ch = -1;
+    if (ccn_plan_create(&cage, &o, &plan, &err) || (uvc.num_values && ccn_plan_add_fvar(plan, &uvc, &ch, &err))) {
+        ccn_plan_destroy(plan);
+        ccn_obj_destroy(obj);
+        return ccn_cli_error(in, &err);
+    }
+    ccn_obj_destroy(obj);
     ccn_sizes s;
     ccn_plan_sizes(plan, &s);
+    uv_out uv = {0, 0, NULL, NULL};
+    double *uv_values = NULL;
+    int32_t *uv_faces = NULL;
+    if (ch >= 0) {
+        ccn_fvar_sizes fs;
+        ccn_plan_fvar_sizes(plan, ch, &fs);
+        uv.width = fs.width;
+        uv.num_values = fs.num_values;
+        uv_values = malloc(sizeof(double) * (size_t)fs.width * (size_t)(fs.num_values ? fs.num_values : 1));
+        uv_faces = malloc(sizeof(int32_t) * 4 * (size_t)(s.num_faces ? s.num_faces : 1));
+        uv.values = uv_values;
+        uv.face_values = uv_faces;
+    }
     ccn_limit_mesh lm = {0};
     lm.positions = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
     lm.normals = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
     lm.face_verts = malloc(sizeof(int32_t) * 4 * (size_t)(s.num_faces ? s.num_faces : 1));
     if (corner_normals) lm.corner_normals = malloc(sizeof(double) * 12 * (size_t)(s.num_faces ? s.num_faces : 1));
-    ccn_error err;
-    if (!lm.positions || !lm.normals || !lm.face_verts || (corner_normals && !lm.corner_normals)) {
+    if (!lm.positions || !lm.normals || !lm.face_verts || (corner_normals && !lm.corner_normals) ||
+        (ch >= 0 && (!uv_values || !uv_faces))) {
         fprintf(stderr, "ccnurbs: out of memory\n");
         rc = 2;
-    } else if (ccn_plan_evaluate(plan, NULL, &lm, &err)) {
+    } else if (ccn_plan_evaluate(plan, NULL, &lm, &err) ||
+               (ch >= 0 && ccn_plan_evaluate_fvar(plan, ch, NULL, uv_values, uv_faces, &err))) {
         rc = ccn_cli_error(in, &err);
     } else {
-        rc = write_atomic(out, &s, &lm);
+        rc = write_atomic(out, &s, &lm, ch >= 0 ? &uv : NULL);
     }
     free(lm.positions); free(lm.normals); free(lm.face_verts); free(lm.corner_normals);
+    free(uv_values); free(uv_faces);
     ccn_plan_destroy(plan);
     return rc;
 }

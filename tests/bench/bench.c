@@ -1,7 +1,10 @@
 /* Benchmark of the C library: plan creation (topology/interval change) and evaluation
- * (position-only change) for one cage; prints seconds (min over repeats). */
+ * (position-only change) for one cage; prints seconds (min over repeats). With the cage's UV
+ * map (`vt`) also: the plan with one UV channel against the plan without (creation time,
+ * evaluation of positions + UVs against positions alone, heap bytes the plan holds). */
 #include "ccnurbs.h"
 
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +16,12 @@ static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/* Heap bytes in use (glibc: small-chunk arena + mmapped chunks). */
+static double heap_bytes(void) {
+    struct mallinfo2 mi = mallinfo2();
+    return (double)mi.uordblks + (double)mi.hblkhd;
 }
 
 static char *slurp(const char *path, size_t *len) {
@@ -89,6 +98,46 @@ int main(int argc, char **argv) {
            cache ? " (one ccn_cache)" : "");
     ccn_plan_destroy(plan);
     ccn_cache_destroy(cache);
+    ccn_fvar_channel uv;
+    ccn_obj_fvar(obj, &uv);
+    const char *mode = getenv("CCN_BENCH_FVAR"); /* ccn_fvar_linear, default CORNERS_ONLY */
+    uv.linear = mode ? atoi(mode) : CCN_FVAR_LINEAR_CORNERS_ONLY;
+    if (uv.num_values) { /* the same plan with one UV channel */
+        double tp0 = 1e30, tp1 = 1e30, te0 = 1e30, te1 = 1e30, m0 = 0, m1 = 0;
+        ccn_fvar_sizes fs = {0};
+        double *uvo = NULL;
+        for (int r = 0; r < reps; r++) {
+            double h0 = heap_bytes(), t0 = now();
+            ccn_plan *p = NULL;
+            int32_t ch;
+            if (ccn_plan_create(&cage, &o, &p, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+            double t1 = now(), h1 = heap_bytes();
+            if (ccn_plan_add_fvar(p, &uv, &ch, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+            double t2 = now(), h2 = heap_bytes();
+            tp0 = t1 - t0 < tp0 ? t1 - t0 : tp0;
+            tp1 = t2 - t0 < tp1 ? t2 - t0 : tp1;
+            m0 = h1 - h0;
+            m1 = h2 - h0;
+            ccn_plan_fvar_sizes(p, ch, &fs);
+            if (!uvo) uvo = malloc(sizeof(double) * (size_t)fs.width * (size_t)fs.num_values);
+            for (int k = 0; k < 3; k++) {
+                cp[0] += 1e-3;
+                double e0 = now();
+                if (ccn_plan_evaluate(p, cp, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+                double e1 = now();
+                if (ccn_plan_evaluate_fvar(p, ch, NULL, uvo, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+                double e2 = now();
+                te0 = e1 - e0 < te0 ? e1 - e0 : te0;
+                te1 = e2 - e0 < te1 ? e2 - e0 : te1;
+            }
+            ccn_plan_destroy(p);
+        }
+        printf("ccn uv %s L%d: %d values, %d seam edges -> %d limit values; plan %.4f s, with uv %.4f s; "
+               "evaluate %.4f s, with uv %.4f s; memory %.1f MB, with uv %.1f MB\n",
+               argv[1], levels, (int)uv.num_values, (int)fs.num_seam_edges, (int)fs.num_values, tp0, tp1,
+               te0, te1, m0 / 1e6, m1 / 1e6);
+        free(uvo);
+    }
     ccn_obj_destroy(obj);
     free(text); free(pos); free(nrm); free(cp);
     return 0;

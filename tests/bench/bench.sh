@@ -77,6 +77,17 @@ for cage in $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj
 done
 echo "CAD export (ccn_plan_export, issue 17) of the production-like cages, into memory:"
 for cage in carlike carlike_knots; do build/bench/export_bench "$D/$cage.obj" 3 || exit 2; done
+echo "One UV channel (the cages' box unwrap, --cap refine; target: <= 1.5x the plan without):"
+echo "mesh level | plan | plan + uv | ratio | evaluate | evaluate + uv | ratio | memory MB | memory + uv MB | ratio"
+for cage in sphere8k carlike carlike_knots; do
+  for L in 2 3; do
+    u=$(build/bench/ccn_bench "$D/$cage.obj" "$L" refine "$R" | grep '^ccn uv') || exit 2
+    unum() { echo "$u" | sed -n "s/.*$1 \([0-9.]*\) \(s\|MB\).*/\1/p"; }
+    p0=$(unum "plan"); p1=$(unum "plan [0-9.]* s, with uv"); e0=$(unum "evaluate"); e1=$(unum "evaluate [0-9.]* s, with uv")
+    m0=$(unum "memory"); m1=$(unum "memory [0-9.]* MB, with uv")
+    echo "$cage L$L | $p0 | $p1 | $(ratio "$p1" "$p0") | $e0 | $e1 | $(ratio "$e1" "$e0") | $m0 | $m1 | $(ratio "$m1" "$m0")"
+  done
+done
 # ---- Blender: the modifier vs Subdivision Surface ----------------------------------------------
 [ "${BENCH_BLENDER:-1}" = 0 ] && exit 0
 blender_rows() { # label target-for-position-updates log: the target rows from bench_blender.py

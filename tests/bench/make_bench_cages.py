@@ -2,13 +2,35 @@
 """Benchmark cages (standard library only): a quad cube-sphere (6 x 37 x 37 = 8214 faces),
 a 50k-face one (6 x 91 x 91), a production-like cage with valences 3-6 (>= 1500 faces, built by
 one Catmull-Clark-style split of a mixed cage), a cage with non-uniform knot intervals and
-Blender's default 32-sided cylinder with one ring of intervals set to 3."""
+Blender's default 32-sided cylinder with one ring of intervals set to 3. Each has a UV map (`vt`,
+`f v/vt`): six charts, one per direction of the face centres (a box unwrap), seams between
+them."""
 import math, os, random, sys
 
+def box_uvs(V, F):
+    """A box unwrap: each face's chart is the dominant axis (and sign) of its centre; a
+    corner's UV is the vertex's other two coordinates, placed in the chart's tile."""
+    vt, ids, FT = [], {}, []
+    for q in F:
+        c = [sum(V[v][i] for v in q) / len(q) for i in range(3)]
+        ax = max(range(3), key=lambda i: abs(c[i]))
+        chart = 2 * ax + (c[ax] < 0)
+        a, b = [i for i in range(3) if i != ax]
+        ft = []
+        for v in q:
+            if (v, chart) not in ids:
+                ids[(v, chart)] = len(vt)
+                vt.append(((chart % 3) + 0.25 * (V[v][a] + 1.5), (chart // 3) + 0.25 * (V[v][b] + 1.5)))
+            ft.append(ids[(v, chart)])
+        FT.append(ft)
+    return vt, FT
+
 def write(path, V, F, knots=None):
+    vt, FT = box_uvs(V, F)
     with open(path, "w") as f:
         for v in V: f.write("v %.9f %.9f %.9f\n" % tuple(v))
-        for q in F: f.write("f " + " ".join(str(i + 1) for i in q) + "\n")
+        for t in vt: f.write("vt %.9f %.9f\n" % t)
+        for q, t in zip(F, FT): f.write("f " + " ".join("%d/%d" % (i + 1, j + 1) for i, j in zip(q, t)) + "\n")
         for (a, b, d) in knots or []: f.write("# knot %d %d %.6g\n" % (a + 1, b + 1, d))
 
 def cube_sphere(n):

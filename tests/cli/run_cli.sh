@@ -1,6 +1,7 @@
 #!/bin/sh
 # CLI contract: errors print a message on stderr, exit 2 and write no output file;
-# a successful refine writes v/f lines and "# knot" lines with the refined intervals.
+# a successful refine writes v/f lines and "# knot" lines with the refined intervals; UV maps
+# (vt, f v/vt) come back refined (refine) or as limit values per face corner (limit).
 cd "$(dirname "$0")/../.." || exit 2
 CLI=${CCNURBS:-build/ccnurbs}
 T=$(mktemp -d) || exit 2
@@ -77,6 +78,29 @@ expect_error "NaN crease"         "NaN crease sharpness"          refine --level
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n# corner 9 2\n' > "$T/farcorner.obj"
 expect_error "corner beyond vertices" "corner names vertex 9"   refine --levels 1 "$T/farcorner.obj" "$T/out.obj"
 expect_error "bad crease method"  "bad --crease-method"           refine --crease-method foo tests/data/cube.obj "$T/out.obj"
+
+# UV maps: vt in and out, --fvar-linear, the file's facevaryinginterpolateboundary tag.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.2 0.1\nvt 0.7 0.4\nvt 0.6 0.9\nvt 0.1 0.8\nf 1/1 2/2 3/3 4/4\nf 2/5 5/6 6/7 3/8\nt facevaryinginterpolateboundary 1/0/0 5\n' > "$T/uv.obj"
+if "$CLI" refine --levels 1 "$T/uv.obj" "$T/out.obj" 2> "$T/stderr" && grep -q '^vt 0.40000000000000002 0.55000000000000004$' "$T/out.obj" &&
+   grep -q -- '--fvar-linear all' "$T/out.obj" && [ "$(grep -c '^vt ' "$T/out.obj")" = 18 ] && grep -q '^f [0-9]*/[0-9]* ' "$T/out.obj"; then
+  ok "refine writes refined vt (the tag's mode: all, bilinear face point)"
+else bad "refine with vt: $(cat "$T/stderr")"; fi
+if grep -q '^vt 0.20000000000000001 0.10000000000000001$' "$T/out.obj" &&
+   "$CLI" refine --levels 1 --fvar-linear none "$T/uv.obj" "$T/out.obj" 2> "$T/stderr" && grep -q -- '--fvar-linear none' "$T/out.obj" &&
+   ! grep -q '^vt 0.20000000000000001 0.10000000000000001$' "$T/out.obj"; then
+  ok "--fvar-linear wins over the tag (all keeps the corner values, none moves them)"
+else bad "--fvar-linear none: $(cat "$T/stderr")"; fi
+if "$CLI" limit --levels 2 "$T/uv.obj" "$T/out.obj" 2> "$T/stderr" && grep -q '^f [0-9]*/[0-9]*/[0-9]* ' "$T/out.obj" &&
+   [ "$(grep -c '^vt ' "$T/out.obj")" -gt 25 ]; then
+  ok "limit writes limit vt per face corner (f v/vt/vn)"
+else bad "limit with vt: $(cat "$T/stderr")"; fi
+expect_error "bad fvar mode"      "bad --fvar-linear"             refine --fvar-linear foo "$T/uv.obj" "$T/out.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/4\n' > "$T/vtbeyond.obj"
+expect_error "texture index beyond vt" "OBJ line 5: texture index 4" limit --levels 1 "$T/vtbeyond.obj" "$T/out.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3 4\n' > "$T/vtpartial.obj"
+if "$CLI" refine --levels 1 "$T/vtpartial.obj" "$T/out.obj" 2> "$T/stderr" && grep -q "UV map ignored" "$T/stderr" &&
+   ! grep -q '^vt' "$T/out.obj"; then ok "a partial UV map is ignored with a warning"
+else bad "partial UV map: $(cat "$T/stderr")"; fi
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

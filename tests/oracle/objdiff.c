@@ -1,6 +1,6 @@
 /* objdiff: compares two OBJ meshes whose vertex and face order may differ (test oracle).
  *
- *   objdiff [--tol-rel T] [--normals T] a.obj b.obj
+ *   objdiff [--tol-rel T] [--normals T] [--uv T] a.obj b.obj
  *
  * Needs equal vertex and face counts. Every vertex of a is matched to the nearest vertex of
  * b (k-d tree); the match must be a bijection. The error is max |a_i - b_match(i)| divided
@@ -20,6 +20,12 @@
  * i-th vertex, as `ccnurbs limit` and `osd_refine --limit-normals` write them); for every
  * matched pair whose normals are both non-zero the unit normals must differ by <= T (length
  * of the difference); a zero normal (`vn 0 0 0`: undefined there) is skipped and counted.
+ * With --uv T also `vt` lines and each face corner's texture index (`f v/vt[/vn]`, every
+ * corner of both files needs one): matched faces are compared corner by corner (the corners
+ * the face match pairs), the largest component difference divided by the diagonal of the
+ * bounding box of a's `vt` values (1 if that is 0) must be <= T. Among faces that are equal as
+ * cycles (coincident vertex groups), each face of a is paired with the face of b whose values
+ * are nearest.
  */
 #include <errno.h>
 #include <math.h>
@@ -38,6 +44,9 @@ typedef struct {
     int *foff;    /* nf */
     int *fverts;  /* sum fsize, 0-based */
     long nfv;
+    double *uv;   /* 3*nuv (padded with 0) */
+    int nuv;
+    int *fuv;     /* per face corner: 0-based texture index, -1 if none */
 } Mesh;
 
 static _Noreturn void die(const char *fmt, ...) {
@@ -91,7 +100,21 @@ static void parse_obj(const char *path, Mesh *m) {
         if (eol) *eol = '\0';
         lineno++;
         while (is_space(*p)) p++;
-        if (p[0] == 'v' && p[1] == 'n' && is_space(p[2])) {
+        if (p[0] == 'v' && p[1] == 't' && is_space(p[2])) {
+            if (m->nuv % 1024 == 0) m->uv = xrealloc(m->uv, sizeof(double) * 3 * ((size_t)m->nuv + 1024));
+            char *s = p + 2;
+            for (int k = 0; k < 3; k++) {
+                char *end;
+                double x = strtod(s, &end);
+                if (end == s) {
+                    if (k == 0) die("%s:%ld: bad texture line", path, lineno);
+                    x = 0.0;
+                } else if (!isfinite(x)) die("%s:%ld: bad texture line", path, lineno);
+                m->uv[3 * m->nuv + k] = x;
+                s = end;
+            }
+            m->nuv++;
+        } else if (p[0] == 'v' && p[1] == 'n' && is_space(p[2])) {
             if (m->nn % 1024 == 0) m->nrm = xrealloc(m->nrm, sizeof(double) * 3 * ((size_t)m->nn + 1024));
             char *s = p + 2;
             for (int k = 0; k < 3; k++) {
@@ -134,11 +157,20 @@ static void parse_obj(const char *path, Mesh *m) {
                 if (idx < 0) idx = m->nv + idx + 1;
                 if (idx < 1 || idx > 2000000000L) die("%s:%ld: face index out of range", path, lineno);
                 s = end;
+                long uv = 0;
+                if (*s == '/' && s[1] != '/' && !is_space(s[1]) && s[1]) {
+                    char *e2;
+                    uv = strtol(s + 1, &e2, 10);
+                    if (e2 == s + 1 || uv == 0) die("%s:%ld: bad texture index", path, lineno);
+                    if (uv < 0) uv = m->nuv + uv + 1;
+                }
                 while (*s && !is_space(*s)) s++; /* skip /vt/vn */
                 if (m->nfv == capfv) {
                     capfv = capfv ? 2 * capfv : 4096;
                     m->fverts = xrealloc(m->fverts, sizeof(int) * (size_t)capfv);
+                    m->fuv = xrealloc(m->fuv, sizeof(int) * (size_t)capfv);
                 }
+                m->fuv[m->nfv] = (int)uv - 1;
                 m->fverts[m->nfv++] = (int)(idx - 1);
                 n++;
             }
@@ -259,6 +291,7 @@ static int uf_find(int *parent, int x) {
 typedef struct {
     int n;
     const int *v; /* canonical rotation, n entries */
+    int idx, r;   /* the face's index and the corner the canonical rotation starts at */
 } Face;
 
 static int face_cmp(const void *x, const void *y) {
@@ -297,9 +330,32 @@ static Face *canon_faces(const Mesh *m, const int *map, const int *group, int **
         if (rot != tmp) free(rot);
         f[i].n = n;
         f[i].v = s + off;
+        f[i].idx = i;
+        f[i].r = r;
     }
     *store = s;
     return f;
+}
+
+/* Largest component difference of the corner values of face fa of a and fb of b. */
+static double face_uv_diff(const Mesh *a, const Face *fa, const Mesh *b, const Face *fb) {
+    double d = 0.0;
+    for (int k = 0; k < fa->n; k++) {
+        int ta = a->fuv[a->foff[fa->idx] + (fa->r + k) % fa->n];
+        int tb = b->fuv[b->foff[fb->idx] + (fb->r + k) % fb->n];
+        for (int c = 0; c < 3; c++) {
+            double x = fabs(a->uv[3 * ta + c] - b->uv[3 * tb + c]);
+            if (!(x <= d)) d = x;
+        }
+    }
+    return d;
+}
+
+static void check_uvs(const Mesh *m) {
+    for (long i = 0; i < m->nfv; i++)
+        if (m->fuv[i] < 0 || m->fuv[i] >= m->nuv)
+            die("%s: --uv needs a texture index in [1, %d] at every face corner (corner %ld has %d)",
+                m->path, m->nuv, i + 1, m->fuv[i] + 1);
 }
 
 /* Unit vector of n (3 doubles) into u; returns 0 for a zero vector. */
@@ -311,13 +367,17 @@ static int unit(const double *n, double *u) {
 }
 
 int main(int argc, char **argv) {
-    double tol = 1e-9, ntol = -1.0;
+    double tol = 1e-9, ntol = -1.0, utol = -1.0;
     const char *pa = NULL, *pb = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--tol-rel") && i + 1 < argc) {
             char *end;
             tol = strtod(argv[++i], &end);
             if (*end || !(tol >= 0)) die("bad --tol-rel '%s'", argv[i]);
+        } else if (!strcmp(argv[i], "--uv") && i + 1 < argc) {
+            char *end;
+            utol = strtod(argv[++i], &end);
+            if (*end || !(utol >= 0)) die("bad --uv '%s'", argv[i]);
         } else if (!strcmp(argv[i], "--normals") && i + 1 < argc) {
             char *end;
             ntol = strtod(argv[++i], &end);
@@ -433,9 +493,33 @@ int main(int argc, char **argv) {
     qsort(fb, (size_t)b.nf, sizeof(Face), face_cmp);
     int missing = 0, ia = 0, ib = 0;
     const Face *first_missing = NULL;
+    double uworst = 0.0;
+    int uworst_f = -1;
+    if (utol >= 0) { check_uvs(&a); check_uvs(&b); }
     while (ia < a.nf && ib < b.nf) {
         int c = face_cmp(&fa[ia], &fb[ib]);
-        if (c == 0) { ia++; ib++; }
+        if (c == 0 && utol >= 0) { /* a run of equal faces: pair by nearest values */
+            int ea = ia, eb = ib;
+            while (ea < a.nf && face_cmp(&fa[ea], &fa[ia]) == 0) ea++;
+            while (eb < b.nf && face_cmp(&fb[eb], &fb[ib]) == 0) eb++;
+            char *taken = calloc((size_t)(eb - ib), 1);
+            if (!taken) die("out of memory");
+            for (int x = ia; x < ea; x++) {
+                int best = -1;
+                double bd = INFINITY;
+                for (int y = ib; y < eb; y++) {
+                    if (taken[y - ib]) continue;
+                    double d = face_uv_diff(&a, &fa[x], &b, &fb[y]);
+                    if (best < 0 || d < bd) { best = y; bd = d; }
+                }
+                if (best < 0) { if (!first_missing) first_missing = &fa[x]; missing++; continue; }
+                taken[best - ib] = 1;
+                if (bd > uworst || uworst_f < 0) { uworst = bd; uworst_f = fa[x].idx; }
+            }
+            free(taken);
+            ia = ea;
+            ib = eb;
+        } else if (c == 0) { ia++; ib++; }
         else if (c < 0) { if (!first_missing) first_missing = &fa[ia]; missing++; ia++; }
         else ib++;
     }
@@ -463,12 +547,31 @@ int main(int argc, char **argv) {
         snprintf(ntext, sizeof ntext, ", normals %d compared (%d zero, skipped), max_diff %.3g", ncmp,
                  nskip, nworst);
     }
+    double udiag = 1.0;
+    if (utol >= 0 && a.nuv > 0) {
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; k++) lo[k] = hi[k] = a.uv[k];
+        for (int i = 1; i < a.nuv; i++)
+            for (int k = 0; k < 3; k++) {
+                if (a.uv[3 * i + k] < lo[k]) lo[k] = a.uv[3 * i + k];
+                if (a.uv[3 * i + k] > hi[k]) hi[k] = a.uv[3 * i + k];
+            }
+        double d = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        if (d > 0) udiag = d;
+    }
+    double urel = uworst / udiag;
+    if (utol >= 0) {
+        size_t l = strlen(ntext);
+        snprintf(ntext + l, sizeof ntext - l, ", uv max_rel %.3g", urel);
+    }
     if (ngroups) {
         size_t l = strlen(ntext);
         snprintf(ntext + l, sizeof ntext - l, ", %d coincident vertex group(s)", ngroups);
     }
     int nok = ntol < 0 || nworst <= ntol;
-    int ok = rel <= tol && dup == 0 && missing == 0 && nok;
+    int uok = utol < 0 || urel <= utol;
+    int ok = rel <= tol && dup == 0 && missing == 0 && nok && uok;
     if (ok) {
         printf("ok: %d verts, %d faces, max_rel %.3g%s\n", a.nv, a.nf, rel, ntext);
         return 0;
@@ -483,6 +586,7 @@ int main(int argc, char **argv) {
         printf("; normal > tol %.3g at a-vertex %d (%.17g %.17g %.17g) vs b-vertex %d (%.17g %.17g %.17g)",
                ntol, nworst_i + 1, na[0], na[1], na[2], map[nworst_i] + 1, nb[0], nb[1], nb[2]);
     }
+    if (!uok) printf("; uv > tol %.3g at a-face %d", utol, uworst_f + 1);
     if (dup) printf("; not a bijection: %d b-vertices (or group members) matched more than once (a-vertex %d)", dup, first_dup + 1);
     if (missing) {
         printf("; %d of %d faces of a not in b (e.g. b-vertices", missing, a.nf);

@@ -7,7 +7,8 @@ ORACLE_SAVED_GOAL := $(.DEFAULT_GOAL)
 ORACLE_CFLAGS      = -std=c11 -O2 -Wall -Wextra -Werror
 ORACLE_CXXFLAGS    = -std=c++14 -O2 -Wall -Wextra -Werror
 
-OSD_REFINE_SRC = tests/oracle/osd_refine.cpp tests/oracle/osd_obj.cpp tests/oracle/osd_patch.cpp
+OSD_SHARED_SRC = tests/oracle/osd_limit.cpp tests/oracle/osd_obj.cpp
+OSD_REFINE_SRC = tests/oracle/osd_refine.cpp tests/oracle/osd_patch.cpp $(OSD_SHARED_SRC)
 $(B)/osd_refine: $(OSD_REFINE_SRC) tests/oracle/osd_oracle.h
 	@mkdir -p $(@D)
 	$(CXX) $(ORACLE_CXXFLAGS) $(OSD_REFINE_SRC) -o $@ -losdCPU
@@ -16,6 +17,12 @@ $(B)/objdiff: tests/oracle/objdiff.c
 	@mkdir -p $(@D)
 	$(CC) $(ORACLE_CFLAGS) $< -o $@ -lm
 
-TEST_DEPS += $(B)/osd_refine $(B)/objdiff
+# fvar_oracle links the library too: ccnurbs' face-varying channels against OpenSubdiv in one
+# process (tests/oracle/run_fvar_shapes.sh)
+$(B)/fvar_oracle: tests/oracle/fvar_oracle.cpp $(OSD_SHARED_SRC) tests/oracle/osd_oracle.h $(B)/libccnurbs.a csrc/include/ccnurbs.h
+	@mkdir -p $(@D)
+	$(CXX) $(ORACLE_CXXFLAGS) -Icsrc/include tests/oracle/fvar_oracle.cpp $(OSD_SHARED_SRC) -o $@ $(B)/libccnurbs.a -losdCPU $(LDLIBS)
+
+TEST_DEPS += $(B)/osd_refine $(B)/objdiff $(B)/fvar_oracle
 DEPS_SCRIPTS += tests/oracle/osd_shapes_deps.sh
 .DEFAULT_GOAL := $(ORACLE_SAVED_GOAL)

@@ -261,6 +261,25 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
                 }
             }
             m.verts.push_back(v);
+        } else if (tag == "vt") {
+            Vertex3 t;
+            t.Clear();
+            int k = 0;
+            std::string tok;
+            for (; k < 3 && (ss >> tok); k++) {
+                char *end = nullptr;
+                t.p[k] = std::strtod(tok.c_str(), &end);
+                if (end == tok.c_str() || *end != '\0' || !std::isfinite(t.p[k])) {
+                    msg = where.str() + "bad texture coordinate '" + tok + "'";
+                    return false;
+                }
+            }
+            if (k == 0) {
+                msg = where.str() + "texture coordinate needs a number";
+                return false;
+            }
+            m.uvWidth = std::max(m.uvWidth, k);
+            m.uvs.push_back(t);
         } else if (tag == "f") {
             std::string tok;
             int n = 0;
@@ -279,6 +298,17 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
                     return false;
                 }
                 m.faceVerts.push_back((int)(idx - 1));
+                long uv = 0;  // texture index: the field after the first '/'
+                if (*end == '/' && end[1] != '/' && end[1] != '\0') {
+                    char *e2 = nullptr;
+                    uv = std::strtol(end + 1, &e2, 10);
+                    if (e2 == end + 1 || (*e2 != '\0' && *e2 != '/') || uv == 0) {
+                        msg = where.str() + "bad texture index '" + tok + "'";
+                        return false;
+                    }
+                    if (uv < 0) uv = (long)m.uvs.size() + uv + 1;
+                }
+                m.faceUVs.push_back((int)uv - 1);
                 n++;
             }
             if (n < 3) {
@@ -323,6 +353,12 @@ bool readObj(const char *path, Mesh &m, std::string &msg) {
         msg = std::string(path) + ": no faces";
         return false;
     }
+    for (int t : m.faceUVs)
+        if (t >= (int)m.uvs.size() && !m.uvs.empty()) {
+            msg = std::string(path) + ": texture index " + std::to_string(t + 1) + " of " +
+                  std::to_string(m.uvs.size()) + " vt lines";
+            return false;
+        }
     for (auto const &c : m.creases) {
         if (!edges.count(c.first)) {
             msg = std::string(path) + ": crease on vertices " + std::to_string(c.first.first) +

@@ -2,9 +2,9 @@
 //
 //   osd_refine [--levels K] [--corners smooth|pinned] [--limit | --limit-normals | --limit-osd |
 //              --patch-limit [--isolation N] [--inf-sharp-patch 0|1] [--single-crease-patch 0|1]
-//              [--endcap gregory|bspline]] in.obj out.obj
+//              [--endcap gregory|bspline]] [--fvar-linear M] in.obj out.obj
 //
-// Input: OBJ with OpenSubdiv shape tags or CCNURBS sharpness comments (osd_obj.cpp).
+// Input: OBJ with OpenSubdiv shape tags or CCNURBS sharpness comments and UV maps (osd_obj.cpp).
 // Options. Boundary interpolation is EDGE_ONLY (--corners smooth, the default) or
 // EDGE_AND_CORNER (--corners pinned) unless the file has an interpolateboundary tag, which
 // then wins over --corners. Creasing is CREASE_UNIFORM unless creasemethod says chaikin.
@@ -47,6 +47,16 @@
 //     defaults are Blender's (isolation 10 = Quality 10, infinitely sharp patches, no
 //     single-crease patches, Gregory basis end caps). Not the exact limit near irregular
 //     features: see osd_patch.cpp.
+//   --fvar-linear M (0..5 or none, corners-only, corners-plus1, corners-plus2, boundaries,
+//     all): the face-varying interpolation (wins over the file's facevaryinginterpolateboundary
+//     tag; neither: OpenSubdiv's default, all).
+// UV maps. When every face corner has a texture index (`f v/vt`), the `vt` values are a
+// face-varying channel and the output has the level-K values as `vt` lines and faces as
+// `f v/vt` (`f v/vt/vn` with --limit-normals), in OpenSubdiv's order: InterpolateFaceVarying
+// level by level; with --limit (levels >= 1), the exact limit of each value: LimitFaceVarying
+// at level K where it is exact, with its crease weights in double precision, and where Limit is
+// not (see above) the one-ring refinement, carrying the values (osd_limit.cpp, localLimitFVar,
+// limitFaceVaryingExact). --patch-limit writes no UV map (positions only).
 // Level-K vertex order: OpenSubdiv "orderVerticesFromFacesFirst" (at each level face
 // points, then edge points, then vertex points). Errors: message on stderr, exit 2.
 #include "osd_oracle.h"
@@ -73,230 +83,13 @@
 using namespace OpenSubdiv;
 using namespace osd_oracle;
 
-namespace osd_oracle {
-
-int g_osdErrors = 0;
-
-[[noreturn]] void die(const std::string &msg) {
-    std::fprintf(stderr, "osd_refine: %s\n", msg.c_str());
-    std::exit(2);
-}
-
-}  // namespace osd_oracle
-
 namespace {
-
-double g_settle = 1e-16;  // environment OSD_REFINE_SETTLE overrides (for experiments)
-int g_maxLevels = 120;
-
-void osdError(Far::ErrorType, const char *msg) {
-    std::fprintf(stderr, "osd_refine: OpenSubdiv error: %s\n", msg);
-    g_osdErrors++;
-}
-
-void osdWarning(const char *msg) {
-    std::fprintf(stderr, "osd_refine: OpenSubdiv warning: %s\n", msg);
-}
 
 void usage() {
     die("usage: osd_refine [--levels K] [--corners smooth|pinned] "
         "[--limit | --limit-normals | --limit-osd | --patch-limit [--isolation N] "
         "[--inf-sharp-patch 0|1] [--single-crease-patch 0|1] [--endcap gregory|bspline]] "
-        "in.obj out.obj");
-}
-
-typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-
-// A mesh with its sharpness, ready for a TopologyDescriptor.
-struct Cage {
-    std::vector<Vertex3> pos;
-    std::vector<int> faceSizes, faceVerts;
-    std::vector<int> creasePairs;
-    std::vector<float> creaseWeights;
-    std::vector<int> cornerVerts;
-    std::vector<float> cornerWeights;
-};
-
-Far::TopologyRefiner *createRefiner(Cage const &c, Sdc::Options const &opts) {
-    Far::TopologyDescriptor desc;
-    desc.numVertices = (int)c.pos.size();
-    desc.numFaces = (int)c.faceSizes.size();
-    desc.numVertsPerFace = c.faceSizes.data();
-    desc.vertIndicesPerFace = c.faceVerts.data();
-    desc.numCreases = (int)c.creaseWeights.size();
-    desc.creaseVertexIndexPairs = c.creasePairs.empty() ? nullptr : c.creasePairs.data();
-    desc.creaseWeights = c.creaseWeights.empty() ? nullptr : c.creaseWeights.data();
-    desc.numCorners = (int)c.cornerWeights.size();
-    desc.cornerVertexIndices = c.cornerVerts.empty() ? nullptr : c.cornerVerts.data();
-    desc.cornerWeights = c.cornerWeights.empty() ? nullptr : c.cornerWeights.data();
-    return Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opts));
-}
-
-bool isSemiSharp(float s) { return s > 0.0f && s < Sdc::Crease::SHARPNESS_INFINITE; }
-
-bool isSmoothRule(Sdc::Crease::Rule r) {
-    return r == Sdc::Crease::RULE_SMOOTH || r == Sdc::Crease::RULE_DART;
-}
-
-// Interior vertex of two faces with the smooth or dart rule: Limit() uses the corner mask.
-bool isInteriorValence2(Far::TopologyLevel const &lev, int v) {
-    return !lev.IsVertexBoundary(v) && lev.GetVertexFaces(v).size() == 2 &&
-           isSmoothRule(lev.GetVertexRule(v));
-}
-
-bool hasSemiSharp(Far::TopologyLevel const &lev, int v) {
-    if (isSemiSharp(lev.GetVertexSharpness(v))) return true;
-    Far::ConstIndexArray ve = lev.GetVertexEdges(v);
-    for (int i = 0; i < ve.size(); i++)
-        if (isSemiSharp(lev.GetEdgeSharpness(ve[i]))) return true;
-    return false;
-}
-
-bool facesAllQuads(Far::TopologyLevel const &lev, int v) {
-    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
-    for (int i = 0; i < vf.size(); i++)
-        if (lev.GetFaceVertices(vf[i]).size() != 4) return false;
-    return true;
-}
-
-// Limit() uses the smooth mask at a dart, but the dart's sharp edge refines with the crease
-// rule, so the mask is not that of the vertex's refinement matrix; at an interior valence-2
-// vertex Limit() uses the corner mask. Both need refining until the point settles.
-bool needsSettling(Far::TopologyLevel const &lev, int v) {
-    return isInteriorValence2(lev, v) || lev.GetVertexRule(v) == Sdc::Crease::RULE_DART;
-}
-
-// Does Limit() at this level give the exact limit of vertex v? (see the header)
-bool limitMaskExact(Far::TopologyLevel const &lev, int v) {
-    return !hasSemiSharp(lev, v) && !needsSettling(lev, v) && facesAllQuads(lev, v);
-}
-
-// Whether Tan1 x Tan2 of Limit() is the surface normal at v (see the header); the rule is
-// final there (limitMaskExact, or valence 2 refined to convergence).
-bool normalDefined(Far::TopologyLevel const &lev, int v, Sdc::Options const &opts) {
-    const bool boundary = lev.IsVertexBoundary(v);
-    const int nf = lev.GetVertexFaces(v).size();
-    if (boundary && opts.GetVtxBoundaryInterpolation() == Sdc::Options::VTX_BOUNDARY_NONE)
-        return false;
-    switch (lev.GetVertexRule(v)) {
-    case Sdc::Crease::RULE_SMOOTH: return !boundary && nf >= 3;
-    case Sdc::Crease::RULE_CREASE: return boundary && nf == 2;
-    case Sdc::Crease::RULE_CORNER: return boundary && nf == 1;
-    default: return false;
-    }
-}
-
-double diagonal(std::vector<Vertex3> const &p) {
-    if (p.empty()) return 0.0;
-    double mn[3], mx[3];
-    for (int k = 0; k < 3; k++) mn[k] = mx[k] = p[0].p[k];
-    for (auto const &q : p)
-        for (int k = 0; k < 3; k++) {
-            mn[k] = std::min(mn[k], q.p[k]);
-            mx[k] = std::max(mx[k], q.p[k]);
-        }
-    return std::sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) +
-                     (mx[2] - mn[2]) * (mx[2] - mn[2]));
-}
-
-// The faces around vertex v of level lev (positions P) with every sharpness they carry, as
-// a Cage; returns v's index in it.
-int extractRing(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v, Cage &c) {
-    c = Cage();
-    std::map<int, int> local;
-    std::vector<int> global;
-    auto loc = [&](int g) {
-        auto it = local.find(g);
-        if (it != local.end()) return it->second;
-        const int l = (int)c.pos.size();
-        local[g] = l;
-        global.push_back(g);
-        c.pos.push_back(P[(size_t)g]);
-        return l;
-    };
-    const int center = loc(v);
-    std::set<int> seen;
-    Far::ConstIndexArray vf = lev.GetVertexFaces(v);
-    for (int i = 0; i < vf.size(); i++) {
-        Far::ConstIndexArray fv = lev.GetFaceVertices(vf[i]);
-        c.faceSizes.push_back(fv.size());
-        for (int k = 0; k < fv.size(); k++) c.faceVerts.push_back(loc(fv[k]));
-        Far::ConstIndexArray fe = lev.GetFaceEdges(vf[i]);
-        for (int k = 0; k < fe.size(); k++) {
-            if (!seen.insert(fe[k]).second) continue;
-            const float s = lev.GetEdgeSharpness(fe[k]);
-            if (s > 0.0f) {
-                Far::ConstIndexArray ev = lev.GetEdgeVertices(fe[k]);
-                c.creasePairs.push_back(loc(ev[0]));
-                c.creasePairs.push_back(loc(ev[1]));
-                c.creaseWeights.push_back(s);
-            }
-        }
-    }
-    for (size_t l = 0; l < global.size(); l++) {
-        const float s = lev.GetVertexSharpness(global[l]);
-        if (s > 0.0f) {
-            c.cornerVerts.push_back((int)l);
-            c.cornerWeights.push_back(s);
-        }
-    }
-    return center;
-}
-
-struct LimitPoint {
-    Vertex3 pos, tan1, tan2;
-    bool normalOk;
-};
-
-// Exact limit of vertex v of level lev by refining its one-ring (see the header).
-LimitPoint localLimit(Far::TopologyLevel const &lev, std::vector<Vertex3> const &P, int v,
-                      Sdc::Options const &opts) {
-    Cage c;
-    int center = extractRing(lev, P, v, c);
-    const double scale = diagonal(c.pos);
-    bool settled = false;  // valence 2 or dart: the point no longer moves
-    for (int it = 0;; it++) {
-        Far::TopologyRefiner *ref = createRefiner(c, opts);
-        if (!ref || g_osdErrors) die("OpenSubdiv rejected a vertex one-ring");
-        Far::TopologyLevel const &l0 = ref->GetLevel(0);
-        if (!hasSemiSharp(l0, center) && facesAllQuads(l0, center) &&
-            (settled || !needsSettling(l0, center))) {
-            std::vector<Vertex3> pos(c.pos.size()), t1(c.pos.size()), t2(c.pos.size());
-            Far::PrimvarRefinerReal<double> pr(*ref);
-            pr.Limit(c.pos, pos, t1, t2);
-            LimitPoint r{pos[(size_t)center], t1[(size_t)center], t2[(size_t)center],
-                         normalDefined(l0, center, opts)};
-            delete ref;
-            return r;
-        }
-        if (it >= g_maxLevels) die("a vertex limit did not settle in " + std::to_string(g_maxLevels) + " levels");
-        Far::TopologyRefiner::UniformOptions uo(1);
-        uo.fullTopologyInLastLevel = true;
-        ref->RefineUniform(uo);
-        if (g_osdErrors) die("OpenSubdiv refinement of a vertex one-ring failed");
-        std::vector<Vertex3> next((size_t)ref->GetLevel(1).GetNumVertices());
-        Far::PrimvarRefinerReal<double> pr(*ref);
-        pr.Interpolate(1, c.pos, next);
-        const int child = ref->GetLevel(0).GetVertexChildVertex(center);
-        double d2 = 0.0, mag = 0.0;
-        for (int k = 0; k < 3; k++) {
-            const double d = next[(size_t)child].p[k] - c.pos[(size_t)center].p[k];
-            d2 += d * d;
-            mag = std::max(mag, std::fabs(next[(size_t)child].p[k]));
-        }
-        // the move cannot get below the rounding of the coordinates themselves
-        settled = std::sqrt(d2) <= std::max(g_settle * scale, 4 * DBL_EPSILON * mag);
-        Cage nc;
-        center = extractRing(ref->GetLevel(1), next, child, nc);
-        c.pos.swap(nc.pos);
-        c.faceSizes.swap(nc.faceSizes);
-        c.faceVerts.swap(nc.faceVerts);
-        c.creasePairs.swap(nc.creasePairs);
-        c.creaseWeights.swap(nc.creaseWeights);
-        c.cornerVerts.swap(nc.cornerVerts);
-        c.cornerWeights.swap(nc.cornerWeights);
-        delete ref;
-    }
+        "[--fvar-linear M] in.obj out.obj");
 }
 
 Vertex3 unitNormal(Vertex3 const &a, Vertex3 const &b) {
@@ -328,6 +121,7 @@ int main(int argc, char **argv) {
     int levels = 1;
     bool pinned = false, limit = false, normals = false, limitOsd = false, patch = false;
     bool patchOpt = false;  // a --patch-limit setting was given
+    int fvarLinear = -1;
     PatchOptions po;
     const char *inPath = nullptr, *outPath = nullptr;
     auto flag = [&](const char *name, const char *v) {
@@ -366,6 +160,13 @@ int main(int argc, char **argv) {
             if (c == "smooth") pinned = false;
             else if (c == "pinned") pinned = true;
             else die("--corners must be smooth or pinned");
+        } else if (a == "--fvar-linear" && i + 1 < argc) {
+            static const char *names[6] = {"none", "corners-only", "corners-plus1", "corners-plus2",
+                                           "boundaries", "all"};
+            const std::string m = argv[++i];
+            for (int k = 0; k < 6; k++)
+                if (m == names[k] || m == std::to_string(k)) fvarLinear = k;
+            if (fvarLinear < 0) die("--fvar-linear must be 0..5 or an OpenSubdiv name");
         } else if (a == "--limit") {
             limit = true;
         } else if (a == "--limit-normals") {
@@ -395,6 +196,8 @@ int main(int argc, char **argv) {
     Mesh m;
     std::string msg;
     if (!readObj(inPath, m, msg)) die(msg);
+    if (fvarLinear >= 0) m.fvarInterpolateBoundary = fvarLinear;
+    const bool uv = m.hasUV() && !patch;
 
     Sdc::Options sdcOpts;
     sdcOpts.SetVtxBoundaryInterpolation(pinned ? Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER
@@ -432,6 +235,10 @@ int main(int argc, char **argv) {
         base.cornerVerts.push_back(c.first);
         base.cornerWeights.push_back(c.second);
     }
+    if (uv) {
+        base.fvValues = (int)m.uvs.size();
+        base.fvIndices = m.faceUVs;
+    }
     Far::TopologyRefiner *refiner = createRefiner(base, sdcOpts);
     if (!refiner || g_osdErrors) die("OpenSubdiv rejected the topology");
 
@@ -448,15 +255,33 @@ int main(int argc, char **argv) {
     }
 
     Far::PrimvarRefinerReal<double> primvar(*refiner);
-    std::vector<Vertex3> cur = m.verts, next;
+    std::vector<Vertex3> cur = m.verts, next, curfv = m.uvs, nextfv;
     for (int l = 1; l <= levels; l++) {
         next.assign((size_t)refiner->GetLevel(l).GetNumVertices(), Vertex3());
         primvar.Interpolate(l, cur, next);
         cur.swap(next);
+        if (uv) {
+            nextfv.assign((size_t)refiner->GetLevel(l).GetNumFVarValues(0), Vertex3());
+            primvar.InterpolateFaceVarying(l, curfv, nextfv, 0);
+            curfv.swap(nextfv);
+        }
     }
     Far::TopologyLevel const &lev = refiner->GetLevel(levels);
     std::vector<Vertex3> nrm;
     int nLocal = 0, nNoNormal = 0;
+    if (limit && uv) {
+        if (levels < 1) die("face-varying limits need --levels >= 1");
+        std::vector<Vertex3> lim;
+        limitFaceVaryingExact(*refiner, curfv, lim);
+        for (int v = 0; !limitOsd && v < (int)cur.size(); v++) {
+            if (limitMaskExact(lev, v)) continue;
+            std::vector<Vertex3> per = localLimitFVar(lev, cur, curfv, v, sdcOpts);
+            Far::ConstIndexArray vf = lev.GetVertexFaces(v);
+            for (int i = 0; i < vf.size(); i++)
+                lim[(size_t)lev.GetFaceFVarValues(vf[i], 0)[cornerOf(lev, vf[i], v)]] = per[(size_t)i];
+        }
+        curfv.swap(lim);
+    }
     if (limit) {
         std::vector<Vertex3> pos(cur.size()), t1(cur.size()), t2(cur.size());
         primvar.Limit(cur, pos, t1, t2);
@@ -519,12 +344,18 @@ int main(int argc, char **argv) {
         std::fprintf(out, "v %.17g %.17g %.17g\n", cur[i].p[0], cur[i].p[1], cur[i].p[2]);
     for (size_t i = 0; i < nrm.size(); i++)
         std::fprintf(out, "vn %.17g %.17g %.17g\n", nrm[i].p[0], nrm[i].p[1], nrm[i].p[2]);
+    for (size_t i = 0; uv && i < curfv.size(); i++) {
+        std::fprintf(out, "vt");
+        for (int k = 0; k < m.uvWidth; k++) std::fprintf(out, " %.17g", curfv[i].p[k]);
+        std::fputc('\n', out);
+    }
     for (int f = 0; f < lev.GetNumFaces(); f++) {
         Far::ConstIndexArray fv = lev.GetFaceVertices(f);
         std::fputc('f', out);
         for (int i = 0; i < fv.size(); i++) {
-            if (normals) std::fprintf(out, " %d//%d", fv[i] + 1, fv[i] + 1);
-            else std::fprintf(out, " %d", fv[i] + 1);
+            std::fprintf(out, " %d", fv[i] + 1);
+            if (uv) std::fprintf(out, "/%d", lev.GetFaceFVarValues(f, 0)[i] + 1);
+            if (normals) std::fprintf(out, "%s/%d", uv ? "" : "/", fv[i] + 1);
         }
         std::fputc('\n', out);
     }

@@ -1,0 +1,179 @@
+"""UV maps and attributes carried from the cage to the limit mesh.
+
+* UV maps: each UV map of the cage (as the stack above hands it over, tap.py) is a face-varying
+  channel of the plan. The corners of a vertex whose UVs are equal share one value; where they
+  differ the edge is a seam (Blender's Subdivision Surface merges UVs closer than 1e-4; here
+  they must be equal, as an unwrap makes them). Interpolated with the UV Smooth setting
+  (Subdivision Surface's names and default, OpenSubdiv's FVarLinearInterpolation modes), with
+  the intervals and creases of the surface, to their exact limit; written as UV maps of the
+  same names, in the same order, the active and the render-active one kept.
+* Point attributes (float, 2-D and 3-D vectors, colours): interpolated by the positions' rules
+  through the same plan (ccn_plan_evaluate_vertex_data: their exact limit).
+* Face attributes (any type): copied from the cage face each limit face lies on (face_origin).
+Not carried: edge attributes and corner attributes other than UV maps, point attributes of
+integer or boolean type, Blender's internal layers (names starting with "."), position, the tap
+marker, creases, `sharp_face` (the limit is shaded smooth, its normals set by Normals) and
+`material_index` (proxies.py copies it). UVs and attributes do not depend on positions: a move
+rewrites neither. All bulk data goes through foreach_get / foreach_set and numpy.
+"""
+import hashlib
+
+import numpy as np
+
+KEY_PROP = "ccnurbs_attr_key"     # on the proxy mesh: the key of the UVs / attributes written
+NAMES_PROP = "ccnurbs_attr_names"  # on the proxy mesh: the attributes this module wrote
+TAP_ATTR, LIMIT_ATTR = "ccn_co", "ccn_limit"
+SKIP = {"position", TAP_ATTR, LIMIT_ATTR, "crease_vert", "crease_edge", "sharp_face",
+        "material_index", "knot_interval"}
+# data type -> (foreach property, components, numpy type)
+TYPES = {'FLOAT': ('value', 1, np.float32), 'FLOAT2': ('vector', 2, np.float32),
+         'FLOAT_VECTOR': ('vector', 3, np.float32), 'FLOAT_COLOR': ('color', 4, np.float32),
+         'BYTE_COLOR': ('color', 4, np.float32), 'INT': ('value', 1, np.int32),
+         'INT8': ('value', 1, np.int32), 'BOOLEAN': ('value', 1, bool),
+         'INT32_2D': ('value', 2, np.int32), 'QUATERNION': ('value', 4, np.float32),
+         'FLOAT4X4': ('value', 16, np.float32)}
+POINT_TYPES = ('FLOAT', 'FLOAT2', 'FLOAT_VECTOR', 'FLOAT_COLOR', 'BYTE_COLOR')  # interpolated
+MAX_WIDTH = 64  # CCN_FVAR_MAX_WIDTH: per-vertex data is evaluated in groups of this many
+
+_uv_cache = {}  # object name -> (data hash, UV channels)
+
+
+class Extras:
+    """What a cage carries besides its geometry: UV maps, point and face attributes."""
+    __slots__ = ("uv_names", "uv_active", "uv_render", "uvs", "point", "face")
+
+
+def _read_attr(att, n):
+    prop, k, dt = TYPES[att.data_type]
+    a = np.empty(n * k, dt)
+    att.data.foreach_get(prop, a)
+    return a.reshape(n, k)
+
+
+def read(me, perm=None):
+    """UV maps (per face corner, in the cage's corner order: `perm` reorders Blender's loops),
+    point and face attributes of a mesh."""
+    x = Extras()
+    nl, nv, nf = len(me.loops), len(me.vertices), len(me.polygons)
+    layers = me.uv_layers
+    x.uv_names = [u.name for u in layers]
+    x.uv_active = layers.active_index if len(layers) else -1
+    x.uv_render = next((i for i, u in enumerate(layers) if u.active_render), -1)
+    x.uvs = []
+    for u in layers:
+        a = np.empty(2 * nl, np.float32)
+        u.data.foreach_get("uv", a)
+        a = a.reshape(nl, 2)
+        x.uvs.append(a[perm] if perm is not None else a)
+    x.point, x.face = [], []
+    uv_names = set(x.uv_names)
+    for att in me.attributes:
+        name = att.name
+        if name.startswith(".") or name in SKIP or name in uv_names or att.data_type not in TYPES:
+            continue
+        if att.domain == 'POINT' and att.data_type in POINT_TYPES and len(att.data) == nv:
+            x.point.append((name, att.data_type, _read_attr(att, nv)))
+        elif att.domain == 'FACE' and len(att.data) == nf:
+            x.face.append((name, att.data_type, _read_attr(att, nf)))
+    return x
+
+
+def _hash(parts):
+    h = hashlib.blake2b(digest_size=16)
+    for p in parts:
+        h.update(p if isinstance(p, bytes) else np.ascontiguousarray(p).tobytes())
+        h.update(b"|")
+    return h.hexdigest()
+
+
+def uv_channels(name, x, face_verts):
+    """Each UV map as (values (N, 2) f64, value index per face corner), and the key of their
+    topology (seams): cached per object while the UVs are unchanged."""
+    if x is None or not x.uvs:
+        return [], ""
+    data = _hash([face_verts] + x.uvs + [repr(x.uv_names).encode()])
+    cached = _uv_cache.get(name)
+    if cached is not None and cached[0] == data:
+        return cached[1]
+    chans = []
+    for a in x.uvs:
+        key = np.empty((len(a), 3), np.int64)
+        key[:, 0] = face_verts
+        key[:, 1:] = a.view(np.uint32)
+        uniq, inv = np.unique(key, axis=0, return_inverse=True)
+        values = uniq[:, 1:].astype(np.uint32).view(np.float32).astype(np.float64)
+        chans.append((np.ascontiguousarray(values), np.asarray(inv, np.int32).ravel()))
+    res = (chans, _hash([repr(x.uv_names).encode()] + [c[1] for c in chans]))
+    _uv_cache[name] = (data, res)
+    return res
+
+
+def forget(name):
+    _uv_cache.pop(name, None)
+
+
+def data_key(x, uv_smooth):
+    """Key of everything written by `write` besides topology: UV values, attribute data."""
+    if x is None:
+        return "-"
+    parts = [repr((x.uv_names, x.uv_active, x.uv_render, uv_smooth,
+                   [(n, t) for n, t, _ in x.point], [(n, t) for n, t, _ in x.face])).encode()]
+    parts += x.uvs + [a for _, _, a in x.point] + [a for _, _, a in x.face]
+    return _hash(parts)
+
+
+def add_channels(plan, chans, uv_smooth):
+    """The plan's channel index of each UV map."""
+    return [plan.add_fvar(values, idx, uv_smooth) for values, idx in chans]
+
+
+def _attribute(me, name, data_type, domain):
+    a = me.attributes.get(name)
+    if a is not None and (a.data_type != data_type or a.domain != domain):
+        me.attributes.remove(a)
+        a = None
+    return a if a is not None else me.attributes.new(name, data_type, domain)
+
+
+def write(me, x, plan, chans, channel_ids, face_origin):
+    """UV maps, point and face attributes of the limit mesh `me` (the proxy, its topology just
+    written or unchanged), with the plan's channels."""
+    names = x.uv_names if x is not None else []
+    if [u.name for u in me.uv_layers] != names:
+        while len(me.uv_layers):
+            me.uv_layers.remove(me.uv_layers[0])
+        for n in names:
+            me.uv_layers.new(name=n)
+    layers = me.uv_layers
+    for i, (cid, (values, _)) in enumerate(zip(channel_ids, chans)):
+        out, fv = plan.evaluate_fvar(cid, values)
+        layers[i].data.foreach_set("uv", out[fv.ravel()].astype(np.float32).ravel())
+    if x is not None and x.uv_active >= 0 and len(layers):
+        layers.active_index = x.uv_active
+    if x is not None and x.uv_render >= 0 and len(layers):
+        layers[x.uv_render].active_render = True
+    written = []
+    if x is not None and x.point:
+        data = np.concatenate([a.astype(np.float64) for _, _, a in x.point], axis=1)
+        out = np.concatenate([plan.evaluate_vertex_data(data[:, c:c + MAX_WIDTH])
+                              for c in range(0, data.shape[1], MAX_WIDTH)], axis=1)
+        col = 0
+        for name, t, a in x.point:
+            k = a.shape[1]
+            vals = out[:, col:col + k]
+            col += k
+            if t == 'BYTE_COLOR':
+                vals = np.clip(vals, 0.0, 1.0)
+            att = _attribute(me, name, t, 'POINT')
+            att.data.foreach_set(TYPES[t][0], vals.astype(np.float32).ravel())
+            written.append(name)
+    if x is not None and x.face:
+        origin = np.clip(face_origin, 0, len(x.face[0][2]) - 1)
+        for name, t, a in x.face:
+            _attribute(me, name, t, 'FACE').data.foreach_set(TYPES[t][0], a[origin].ravel())
+            written.append(name)
+    for name in me.get(NAMES_PROP, []):  # written before, gone from the cage now
+        a = me.attributes.get(name)
+        if name not in written and a is not None:
+            me.attributes.remove(a)
+    me[NAMES_PROP] = written

@@ -1,0 +1,470 @@
+/* The composed limit stencils of a face-varying channel (surface/fvar_compose.h).
+ *
+ * The channel is the value mesh of refine/fvar.c refined through the plan's L levels in
+ * lockstep with the vertex levels (their intervals and creases), with the exact limit stencil
+ * of every level-L value vertex built as for positions (surface/limit.c on the value mesh:
+ * tensor B-spline stencils where the 3x3 neighbourhood is regular, one level finer next to
+ * irregular value vertices, the stationary 1-ring matrix on seams, corners and creases, the
+ * left eigenvectors of M at EVs, taken over from the positions' stencil where the value vertex
+ * matches the vertex). All of it is linear in the cage values, and an output value depends only
+ * on the values at the corners of the faces that share a value vertex with its cage face (the
+ * 4 x 4 of a regular patch). So its weights are read off by probing: the cage's value vertices
+ * are coloured so that no two in such a neighbourhood share a colour, every colour is set to 1
+ * in turn (three per pass, the rules' three components), the levels and limit stencils run, and
+ * each output's result for a colour is the weight of the one value of that colour around it.
+ * The weights are those evaluation would apply, summed in another order (a few ulps); each
+ * stencil's weights must sum to 1 (affine invariance), which checks the neighbourhood bound.
+ * Evaluation is then one sparse product per channel, and the levels are freed. Mode ALL
+ * (bilinear) composes the same way from its level-L values.
+ */
+#include "surface/fvar_compose.h"
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "refine/fvar.h"
+#include "rules/crease.h"
+#include "surface/limit.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The channel's refinement, kept while its stencils are composed. */
+typedef struct {
+    int32_t L;
+    ccn__fvar_level *lev;     /* L + 1 levels */
+    ccn__level *prep;         /* L prepared levels */
+    ccn__level sub;           /* level L -> L+1 around near[] (has_sub) */
+    int has_sub, bilinear;
+    int32_t nnear, *near;
+    int32_t *st_start, *st_v; /* CSR per level-L value vertex; index >= nvL: an (L+1) point */
+    double *st_w;
+    double *posS;             /* level-(L+1) points, 3 * (nf + ne + nv) of level L */
+    int32_t *value_of;        /* level-0 value vertex -> cage value */
+} builder;
+
+static void builder_free(builder *c) {
+    for (int32_t l = 0; c->lev && l <= c->L; l++) ccn__fvar_free(&c->lev[l]);
+    for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
+    if (c->has_sub) ccn__level_free(&c->sub);
+    free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
+    free(c->posS); free(c->value_of);
+    memset(c, 0, sizeof *c);
+}
+
+void ccn__fvar_stencils_free(ccn__fvar_stencils *s) {
+    if (!s) return;
+    free(s->start); free(s->idx); free(s->w); free(s->face_values);
+    memset(s, 0, sizeof *s);
+}
+
+/* ---- the channel's levels and limit stencils -------------------------------------------- */
+
+typedef struct { int32_t n, cap; int32_t *v; double *w; } wbuf;
+
+static int push(wbuf *b, const ccn__stencil *s, int32_t off) {
+    if (b->n + s->n > b->cap) {
+        int64_t nc = 2 * (int64_t)b->cap + s->n + 1024;
+        if (nc > INT32_MAX) return -1;
+        int32_t *v = realloc(b->v, sizeof(int32_t) * (size_t)nc);
+        if (v) b->v = v;
+        double *w = realloc(b->w, sizeof(double) * (size_t)nc);
+        if (w) b->w = w;
+        if (!v || !w) return -1;
+        b->cap = (int32_t)nc;
+    }
+    for (int i = 0; i < s->n; i++) {
+        b->v[b->n] = s->v[i] + off;
+        b->w[b->n++] = s->wp[i];
+    }
+    return 0;
+}
+
+static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irr) {
+    if (irr[v]) return 1;
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t f = m->hface[m->vfan[k]];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
+            if (irr[m->hvert[h]]) return 1;
+    }
+    return 0;
+}
+
+/* A value vertex u at an interior EV of the value mesh has the vertex's fan, intervals and
+ * scheme: its child stencil is the positions' stencil of vertex v, renumbered (level L+1 face
+ * points keep their index, the edge points of v's spokes and v's vertex point map to u's). */
+static int reuse_ev_stencil(const ccn_plan *p, const ccn_mesh *fm, int32_t u, int32_t v,
+                            ccn__stencil *s) {
+    const ccn_mesh *vm = p->lev[p->L];
+    int32_t o = p->vmapL[v], nvL = vm->nv;
+    if (o < 0) return 0;
+    s->n = 0;
+    for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
+        int32_t i = p->st_v[k] - nvL, j = -1;
+        if (i < 0 || s->n >= CCN_STENCIL_MAX) return 0;
+        if (i < vm->nf) j = i;
+        else if (i >= vm->nf + vm->ne) j = i == vm->nf + vm->ne + v ? fm->nf + fm->ne + u : -1;
+        else
+            for (int32_t q = vm->vfan_start[v]; q < vm->vfan_start[v + 1] && j < 0; q++)
+                if (vm->hedge[vm->vfan[q]] == i - vm->nf) j = fm->nf + fm->hedge[vm->vfan[q]];
+        if (j < 0) return 0;
+        s->v[s->n] = j; s->wp[s->n] = p->st_wp[k]; s->wu[s->n] = s->wv[s->n] = 0.0;
+        s->n++;
+    }
+    return 1;
+}
+
+/* A value whose rule follows its partner's sharpness (OpenSubdiv's dependent sharpness): does
+ * the partner still have semi-sharp edges (then the value's limit is taken one level finer,
+ * where the sub level applied the rule), and their sharpness one level finer, the largest, to
+ * take as the value's own vertex sharpness there (the same corner-to-crease levels and
+ * fractional weight when one edge is semi-sharp, as in the shapes that have it; 0: none). */
+static int partner_semisharp(const ccn__fvar_level *fl, int32_t v, int method, float *child) {
+    const ccn_mesh *m = fl->m;
+    *child = 0.0f;
+    if (!fl->partner || fl->partner[v] < 0 || !m->esharp) return 0;
+    int32_t a = fl->partner[v], n = ccn__valence(m, a), semi = 0;
+    for (int32_t k = 0; k < n; k++) {
+        if (m->vboundary[a] && (k == 0 || k == n - 1)) continue;
+        int32_t e = ccn__fan_edge(m, a, k);
+        semi |= m->esharp[e] > 0.0f && m->esharp[e] < CCN_SHARPNESS_INFINITE;
+        float cs = ccn__child_edge_sharpness(m, method, e, a);
+        if (cs > 0.0f && cs < CCN_SHARPNESS_INFINITE && cs > *child) *child = cs;
+    }
+    return semi;
+}
+
+static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) {
+    const ccn__fvar_level *fl = &c->lev[c->L];
+    const ccn_mesh *m = fl->m;
+    ccn__stencil *s = malloc(sizeof *s);
+    ccn__ring_limit *ring = malloc(sizeof *ring);
+    ccn__ring_work *work = ccn__ring_work_create();
+    uint8_t *irr = malloc((size_t)m->nv);
+    wbuf b = {0, 0, NULL, NULL};
+    c->st_start = malloc(sizeof(int32_t) * ((size_t)m->nv + 1));
+    c->near = malloc(sizeof(int32_t) * (size_t)m->nv);
+    ccn_status st = CCN_OK;
+    if (!s || !ring || !work || !irr || !c->st_start || !c->near) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
+    }
+    ccn__ring_work_set_ev(work, p->opts.ev_polyhedron, p->ev_cache);
+    c->st_start[0] = 0;
+    float dep;
+    for (int32_t v = 0; v < m->nv; v++)
+        irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(fl, v, p->opts.crease_method, &dep);
+    for (int32_t v = 0; v < m->nv && !st; v++) {
+        int32_t off = 0;
+        partner_semisharp(fl, v, p->opts.crease_method, &dep);
+        if (!near_irregular(m, v, irr)) {
+            ccn__limit_stencil(m, v, 0, s);
+        } else if (dep > 0.0f) { /* the partner's sharpness as its own */
+            c->near[c->nnear++] = v;
+            off = m->nv;
+            st = ccn__ring_limit_eval_vs(m, v, p->opts.scheme, 0, p->opts.crease_method, dep, work, ring, err);
+            s->n = 0;
+            for (int32_t i = 0; !st && i < ring->npts; i++) {
+                s->v[s->n] = ring->pts[i]; s->wp[s->n] = ring->wp[i]; s->wu[s->n] = s->wv[s->n] = 0.0;
+                s->n++;
+            }
+        } else {
+            c->near[c->nnear++] = v;
+            off = m->nv;
+            if (!(ccn__limit_kind(m, v, 0) == CCN_LIMIT_EV && reuse_ev_stencil(p, m, v, fl->vvert[v], s)))
+                st = ccn__child_limit_stencil(m, v, 0, p->opts.scheme, p->opts.crease_method, work, s,
+                                              ring, err);
+        }
+        if (!st && push(&b, s, off))
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        c->st_start[v + 1] = b.n;
+    }
+done:
+    if (!st && b.n) { /* to size: the buffers grew by doubling */
+        int32_t *v = realloc(b.v, sizeof(int32_t) * (size_t)b.n);
+        double *w = realloc(b.w, sizeof(double) * (size_t)b.n);
+        if (v) b.v = v;
+        if (w) b.w = w;
+    }
+    int32_t *nr = c->nnear ? realloc(c->near, sizeof(int32_t) * (size_t)c->nnear) : NULL;
+    if (nr) c->near = nr;
+    c->st_v = b.v;
+    c->st_w = b.w;
+    free(s); free(ring); free(irr);
+    ccn__ring_work_destroy(work);
+    return st;
+}
+
+static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *c, ccn_error *err) {
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    c->L = p->L;
+    c->bilinear = ch->linear == CCN_FVAR_LINEAR_ALL;
+    c->lev = calloc((size_t)c->L + 1, sizeof *c->lev);
+    c->prep = calloc((size_t)(c->L ? c->L : 1), sizeof *c->prep);
+    if (!c->lev || !c->prep)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
+    if (st) return st;
+    for (int32_t l = 0; l < c->L; l++) {
+        if ((st = ccn__fvar_prepare(&c->prep[l], &c->lev[l], p->opts.scheme, p->opts.crease_method,
+                                      p->opts.ev_polyhedron, p->ev_cache, err))) {
+            memset(&c->prep[l], 0, sizeof c->prep[l]);
+            return st;
+        }
+        c->prep[l].threads = p->threads;
+        if ((st = ccn__fvar_child(&c->lev[l], &c->prep[l], p->lev[l], p->lev[l + 1], &c->lev[l + 1], err)))
+            return st;
+    }
+    const ccn_mesh *mL = c->lev[c->L].m;
+    if (!c->bilinear && (st = limit_stencils(p, c, err))) return st;
+    if (c->nnear) {
+        if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method,
+                                      p->opts.ev_polyhedron, p->ev_cache, err)))
+            return st;
+        c->has_sub = 1;
+        c->posS = malloc(sizeof(double) * 3 * ((size_t)mL->nf + mL->ne + mL->nv));
+        if (!c->posS) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    }
+    return CCN_OK;
+}
+
+typedef struct { const builder *c; double *out; } limit_job;
+
+/* The limit of the level-L values (3 components) into out (3 per level-L value vertex). */
+static void limit_range(void *ctx, int32_t b, int32_t end) {
+    const limit_job *j = ctx;
+    const builder *c = j->c;
+    const ccn_mesh *mL = c->lev[c->L].m;
+    const double *PL = mL->pos, *PS = c->posS;
+    int32_t nvL = mL->nv;
+    for (int32_t o = b; o < end; o++) {
+        double *x = j->out + 3 * (size_t)o;
+        if (c->bilinear) { memcpy(x, PL + 3 * (size_t)o, sizeof(double) * 3); continue; }
+        double x0 = 0, x1 = 0, x2 = 0;
+        for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
+            int32_t i = c->st_v[k];
+            const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
+            double w = c->st_w[k];
+            x0 += w * q[0]; x1 += w * q[1]; x2 += w * q[2];
+        }
+        x[0] = x0; x[1] = x1; x[2] = x2;
+    }
+}
+
+/* ---- composition -------------------------------------------------------------------------- */
+
+typedef struct { int32_t *start, *list; } csr;
+
+/* K(f): the value vertices at the corners of the faces that share a value vertex with face f
+ * (level 0), each once. */
+static int neighbourhoods(const ccn_mesh *m, csr *K) {
+    int32_t cap = 64, n = 0;
+    K->start = malloc(sizeof(int32_t) * ((size_t)m->nf + 1));
+    K->list = malloc(sizeof(int32_t) * (size_t)cap);
+    int32_t *seen = malloc(sizeof(int32_t) * (size_t)m->nv);
+    if (!K->start || !K->list || !seen) { free(seen); return -1; }
+    for (int32_t v = 0; v < m->nv; v++) seen[v] = -1;
+    K->start[0] = 0;
+    for (int32_t f = 0; f < m->nf; f++) {
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+            int32_t u = m->hvert[h];
+            for (int32_t q = m->vfan_start[u]; q < m->vfan_start[u + 1]; q++) {
+                int32_t g = m->hface[m->vfan[q]];
+                for (int32_t k = m->fstart[g]; k < m->fstart[g + 1]; k++) {
+                    int32_t w = m->hvert[k];
+                    if (seen[w] == f) continue;
+                    seen[w] = f;
+                    if (n == cap) {
+                        int32_t *l = cap < INT32_MAX / 2 ? realloc(K->list, sizeof(int32_t) * 2 * (size_t)cap) : NULL;
+                        if (!l) { free(seen); return -1; }
+                        K->list = l;
+                        cap *= 2;
+                    }
+                    K->list[n++] = w;
+                }
+            }
+        }
+        K->start[f + 1] = n;
+    }
+    free(seen);
+    return 0;
+}
+
+/* Colours of the value vertices: no two in one K(f) alike (greedy, smallest free colour).
+ * Returns the number of colours, -1 on failure. */
+static int32_t colour(const ccn_mesh *m, const csr *K, int32_t *col) {
+    int32_t nv = m->nv, ncol = 0;
+    csr I = {calloc((size_t)nv + 1, sizeof(int32_t)), malloc(sizeof(int32_t) * (size_t)(K->start[m->nf] + 1))};
+    int32_t *mark = malloc(sizeof(int32_t) * ((size_t)nv + 1));
+    if (!I.start || !I.list || !mark) { free(I.start); free(I.list); free(mark); return -1; }
+    for (int32_t i = 0; i < K->start[m->nf]; i++) I.start[K->list[i] + 1]++;
+    for (int32_t v = 0; v < nv; v++) I.start[v + 1] += I.start[v];
+    for (int32_t f = 0; f < m->nf; f++) /* I(v): the faces f with v in K(f) */
+        for (int32_t i = K->start[f]; i < K->start[f + 1]; i++) I.list[I.start[K->list[i]]++] = f;
+    for (int32_t v = nv; v > 0; v--) I.start[v] = I.start[v - 1];
+    I.start[0] = 0;
+    for (int32_t c = 0; c <= nv; c++) mark[c] = -1;
+    for (int32_t v = 0; v < nv; v++) col[v] = -1;
+    /* breadth-first order over the value mesh's edges: fronts colour like a tiling */
+    int32_t *order = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1)), head = 0, tail = 0;
+    uint8_t *queued = calloc((size_t)(nv ? nv : 1), 1);
+    if (!order || !queued) { free(order); free(queued); free(I.start); free(I.list); free(mark); return -1; }
+    for (int32_t s0 = 0; s0 < nv; s0++) {
+        if (queued[s0]) continue;
+        queued[s0] = 1;
+        order[tail++] = s0;
+        while (head < tail) {
+            int32_t u = order[head++];
+            for (int32_t q = m->vfan_start[u]; q < m->vfan_start[u + 1]; q++) {
+                int32_t h = m->vfan[q], a = m->hvert[ccn__next(m, h)], z = m->hvert[ccn__prev(m, h)];
+                if (!queued[a]) { queued[a] = 1; order[tail++] = a; }
+                if (!queued[z]) { queued[z] = 1; order[tail++] = z; }
+            }
+        }
+    }
+    for (int32_t t = 0; t < nv; t++) {
+        int32_t v = order[t];
+        for (int32_t i = I.start[v]; i < I.start[v + 1]; i++) {
+            int32_t f = I.list[i];
+            for (int32_t k = K->start[f]; k < K->start[f + 1]; k++)
+                if (col[K->list[k]] >= 0) mark[col[K->list[k]]] = v;
+        }
+        int32_t c = 0;
+        while (mark[c] == v) c++;
+        col[v] = c;
+        if (c + 1 > ncol) ncol = c + 1;
+    }
+    free(order); free(queued);
+    free(I.start); free(I.list); free(mark);
+    return ncol;
+}
+
+/* The cage face each level-L value vertex lies on (through one of its faces). */
+static void origin_faces(const ccn_plan *p, const ccn_mesh *mL, int32_t *fo) {
+    for (int32_t o = 0; o < mL->nv; o++) {
+        int32_t g = mL->hface[mL->vfan[mL->vfan_start[o]]];
+        for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
+        fo[o] = g;
+    }
+}
+
+/* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
+ * stencil run (out: 3 per output value); each candidate weight of those colours is read off. */
+static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, double *out,
+                  const int32_t *bucket, const int32_t *owner, const int32_t *ccol, double *cw) {
+    ccn_mesh *m0 = c->lev[0].m;
+    for (int32_t v = 0; v < m0->nv; v++)
+        for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
+    for (int32_t l = 0; l < c->L; l++) ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
+    if (c->has_sub) ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
+    limit_job j = {c, out};
+    int32_t nout = c->lev[c->L].m->nv;
+    ccn__parallel_for(p->threads, nout, limit_range, &j);
+    for (int32_t i = bucket[b]; i < bucket[b + 1]; i++) { /* the candidates of these colours */
+        int32_t e = owner[2 * (size_t)i], o = owner[2 * (size_t)i + 1];
+        cw[e] = out[3 * (size_t)o + ccol[e] - 3 * b];
+    }
+}
+
+static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
+    const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
+    int32_t nout = mL->nv;
+    csr K = {NULL, NULL};
+    int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv), *fo = malloc(sizeof(int32_t) * (size_t)nout);
+    double *out3 = malloc(sizeof(double) * 3 * (size_t)nout);
+    int32_t ncol = -1, *ccol = NULL, *bucket = NULL, *owner = NULL;
+    ccn_status st = CCN_OK;
+    if (col && fo && !neighbourhoods(m0, &K)) ncol = colour(m0, &K, col);
+    s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
+    if (ncol < 0 || !out3 || !s->start) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
+    }
+    /* the candidates: for each output, the value vertices of its cage face's neighbourhood */
+    origin_faces(p, mL, fo);
+    int64_t total = 0;
+    for (int32_t o = 0; o < nout; o++) total += K.start[fo[o] + 1] - K.start[fo[o]];
+    if (total > INT32_MAX) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large"); goto done; }
+    s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
+    s->w = calloc((size_t)(total ? total : 1), sizeof(double));
+    if (!s->idx || !s->w) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    ccol = malloc(sizeof(int32_t) * (size_t)(total ? total : 1)); /* each candidate's colour */
+    if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    s->start[0] = 0;
+    for (int32_t o = 0, n = 0; o < nout; o++) {
+        for (int32_t k = K.start[fo[o]]; k < K.start[fo[o] + 1]; k++) {
+            ccol[n] = col[K.list[k]];
+            s->idx[n++] = K.list[k];
+        }
+        s->start[o + 1] = n;
+    }
+    /* the candidates by pass (counting sort): (entry, output) pairs */
+    int32_t npass = (ncol + 2) / 3;
+    bucket = calloc((size_t)npass + 1, sizeof(int32_t));
+    owner = malloc(sizeof(int32_t) * 2 * (size_t)(total ? total : 1));
+    if (!bucket || !owner) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    for (int32_t e = 0; e < (int32_t)total; e++) bucket[ccol[e] / 3 + 1]++;
+    for (int32_t b = 0; b < npass; b++) bucket[b + 1] += bucket[b];
+    for (int32_t o = 0; o < nout; o++)
+        for (int32_t e = s->start[o]; e < s->start[o + 1]; e++) {
+            int32_t i = bucket[ccol[e] / 3]++;
+            owner[2 * (size_t)i] = e;
+            owner[2 * (size_t)i + 1] = o;
+        }
+    for (int32_t b = npass; b > 0; b--) bucket[b] = bucket[b - 1];
+    bucket[0] = 0;
+    for (int32_t b = 0; b < npass; b++) probe(p, c, col, b, out3, bucket, owner, ccol, s->w);
+    free(ccol); free(bucket); free(owner);
+    ccol = bucket = owner = NULL;
+    /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
+     * value vertices once), and every stencil sums to 1 */
+    int32_t n = 0, e0 = 0;
+    for (int32_t o = 0; o < nout && !st; o++) {
+        int32_t first = n, e1 = s->start[o + 1]; /* the row as built (start is rewritten) */
+        double sum = 0.0;
+        for (int32_t e = e0; e < e1; e++) {
+            double w = s->w[e];
+            if (w == 0.0) continue;
+            sum += w;
+            int32_t val = c->value_of[s->idx[e]], q = first;
+            while (q < n && s->idx[q] != val) q++;
+            if (q < n) s->w[q] += w;
+            else { s->idx[n] = val; s->w[n++] = w; }
+        }
+        if (!(fabs(sum - 1.0) <= 1e-9)) /* weight outside the neighbourhood: cannot happen */
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
+                           "face-varying stencil of output value %d sums to %.17g", (int)o, sum);
+        s->start[o + 1] = n;
+        e0 = e1;
+    }
+    if (!st) {
+        int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
+        double *b = realloc(s->w, sizeof(double) * (size_t)(n ? n : 1));
+        if (a) s->idx = a;
+        if (b) s->w = b;
+    }
+done:
+    free(K.start); free(K.list); free(col); free(fo); free(out3); free(ccol); free(bucket);
+    free(owner);
+    return st;
+}
+
+ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn__fvar_stencils *s,
+                             ccn_error *err) {
+    builder c;
+    memset(&c, 0, sizeof c);
+    memset(s, 0, sizeof *s);
+    ccn_status st = build(p, ch, &c, err);
+    if (!st) {
+        const ccn_mesh *mL = c.lev[c.L].m;
+        s->nout = mL->nv;
+        s->num_seams = c.lev[0].num_seams;
+        s->num_sharp = ccn__fvar_num_sharp(&c.lev[c.L]);
+        s->face_values = malloc(sizeof(int32_t) * (size_t)mL->nh);
+        if (!s->face_values) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+        else memcpy(s->face_values, mL->hvert, sizeof(int32_t) * (size_t)mL->nh);
+    }
+    if (!st) st = compose(p, &c, s, err);
+    builder_free(&c);
+    if (st) ccn__fvar_stencils_free(s);
+    return st;
+}
