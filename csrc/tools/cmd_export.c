@@ -77,7 +77,7 @@ int ccn_cmd_export(int argc, char **argv) {
     }
     ccn_options o = {0};
     const char *in = NULL, *out = NULL;
-    int rc = ccn_cli_parse(nrest, rest, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, &in, &out);
+    int rc = ccn_cli_parse(nrest, rest, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, NULL, &in, &out);
     free(rest);
     if (rc) return rc;
     if (!have_format) { /* from the extension, else STEP */
