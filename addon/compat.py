@@ -36,17 +36,41 @@ def set_face_loops(mesh, loop_start, loop_total):
         mesh.polygons.foreach_set("loop_total", loop_total)
 
 
+# 4.5+: custom normals can be "free" normals, the float vectors themselves in the
+# `custom_normal` attribute on the point or corner domain, shown and kept as they are. Writing
+# them is one foreach_set; the encoded custom normals of `normals_split_custom_set*` (and of
+# every version before) cost a loop-normal-space pass per write (measured on a 40k-vertex
+# grid: 0.07-0.10 s encoded, 0.0004 s free; issue 15).
+FREE_NORMALS = VERSION >= (4, 5, 0)
+
+
+def _set_free_normals(mesh, normals, domain):
+    a = mesh.attributes.get("custom_normal")
+    if a is not None and (a.data_type != 'FLOAT_VECTOR' or a.domain != domain):
+        mesh.attributes.remove(a)
+        a = None
+    if a is None:
+        a = mesh.attributes.new("custom_normal", 'FLOAT_VECTOR', domain)
+    a.data.foreach_set("vector", normals.reshape(-1))
+    mesh.update()
+
+
 def set_vertex_normals(mesh, normals):
-    """Custom split normals from per-vertex unit normals, smooth shading.
-    < 4.1 needs `use_auto_smooth` for custom normals to be used; 4.1 removed it."""
+    """Custom normals from per-vertex unit normals (numpy float32 (N, 3)), smooth shading:
+    free point normals on 4.5+, else encoded split normals; < 4.1 needs `use_auto_smooth` for
+    custom normals to be used (4.1 removed it)."""
+    if FREE_NORMALS:
+        return _set_free_normals(mesh, normals, 'POINT')
     if hasattr(mesh, "use_auto_smooth"):
         mesh.use_auto_smooth = True
     mesh.normals_split_custom_set_from_vertices(normals)
 
 
 def set_corner_normals(mesh, normals):
-    """Custom split normals per face corner (loop order), smooth shading: each side of a crease
-    keeps its own exact normal. < 4.1 needs `use_auto_smooth`, as above."""
+    """Custom normals per face corner (loop order), smooth shading: each side of a crease
+    keeps its own exact normal. Free corner normals on 4.5+, else encoded, as above."""
+    if FREE_NORMALS:
+        return _set_free_normals(mesh, normals, 'CORNER')
     if hasattr(mesh, "use_auto_smooth"):
         mesh.use_auto_smooth = True
     mesh.normals_split_custom_set(normals)
@@ -54,9 +78,12 @@ def set_corner_normals(mesh, normals):
 
 def use_plain_normals(mesh):
     """Blender's own smooth vertex normals (no custom normals): < 4.1 turns auto smooth off
-    (custom normals are then ignored); 4.1+ has none after `clear_geometry`."""
+    (custom normals are then ignored); 4.1+ drops a `custom_normal` attribute if there is one
+    (none after `clear_geometry`)."""
     if hasattr(mesh, "use_auto_smooth"):
         mesh.use_auto_smooth = False
+    elif mesh.attributes.get("custom_normal") is not None:
+        mesh.attributes.remove(mesh.attributes["custom_normal"])
 
 
 def corner_normals(mesh):

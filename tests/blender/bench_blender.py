@@ -10,7 +10,9 @@ For each cage and level: the time from a change to the evaluated mesh being avai
 vertex moved, in Object Mode and in Edit Mode), a topology change (the mesh datablock swapped
 for one with a face removed) and, for CCNURBS, an interval edit (one edge's knot interval
 changed: same topology). Default settings (Exact normals, Guided Bi-5 cap) and Fast normals.
-Prints lines starting with "bench".
+Then animation playback: the production-like cage (carlike, 2.3k faces) bent by a one-bone
+armature over 24 keyed frames, frames per second of frame_set + evaluation
+(CCN_BENCH_ANIMATION_CASES). Prints lines starting with "bench".
 """
 import os
 import sys
@@ -151,6 +153,85 @@ def bench(name, level):
     sys.stdout.flush()
 
 
+def _rig(ob):
+    """An armature with one bone bending the cage's +x half, keyed over FRAMES frames."""
+    arm = bpy.data.armatures.new("Rig")
+    rig = bpy.data.objects.new("Rig", arm)
+    bpy.context.scene.collection.objects.link(rig)
+    for o in bpy.context.view_layer.objects:
+        o.select_set(False)
+    bpy.context.view_layer.objects.active = rig
+    bpy.ops.object.mode_set(mode='EDIT')
+    b = arm.edit_bones.new("Bend")
+    b.head, b.tail = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)
+    bpy.ops.object.mode_set(mode='OBJECT')
+    co = np.empty(3 * len(ob.data.vertices), np.float32)
+    ob.data.vertices.foreach_get("co", co)
+    vg = ob.vertex_groups.new(name="Bend")
+    vg.add([int(i) for i in np.nonzero(co[0::3] > 0)[0]], 1.0, 'REPLACE')
+    m = ob.modifiers.new("Armature", 'ARMATURE')
+    m.object = rig
+    pb = rig.pose.bones["Bend"]
+    pb.rotation_mode = 'XYZ'
+    for f, a in ((1, 0.0), (FRAMES, 0.6)):
+        pb.rotation_euler = (0.0, a, 0.0)
+        pb.keyframe_insert("rotation_euler", frame=f)
+    bpy.context.view_layer.objects.active = ob
+    ob.select_set(True)
+
+
+FRAMES = 24
+
+
+def time_playback(ob):
+    """Frames per second of stepping through the animation (each frame evaluated until the
+    modifier's output is there: for CCNURBS the second evaluation shows the new limit)."""
+    sc = bpy.context.scene
+    best = 1e30
+    for r in range(REPS):
+        t0 = time.perf_counter()
+        for f in range(1, FRAMES + 1):
+            sc.frame_set(f)
+            evaluated(ob)
+        best = min(best, time.perf_counter() - t0)
+    # what was timed is the animation: the shown surface differs from frame to frame
+    seen = set()
+    for f in (2, FRAMES // 2, FRAMES):
+        sc.frame_set(f)
+        evaluated(ob)
+        me = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+        co = np.empty(3 * len(me.vertices), np.float32)
+        me.vertices.foreach_get("co", co)
+        seen.add(round(float(np.abs(co).sum()), 3))
+    if len(seen) < 3:
+        raise RuntimeError("playback: the evaluated surface did not follow the armature")
+    return FRAMES / best
+
+
+def bench_animation(name, level):
+    """Issue 15 row 7: playback of an armature-deformed cage, CCNURBS vs Subdivision Surface."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    ob, _, _ = load(name)
+    _rig(ob)
+    mod = ob.modifiers.new("Subsurf", 'SUBSURF')
+    mod.levels = mod.render_levels = level
+    evaluated(ob)
+    sub = time_playback(ob)
+    ob.modifiers.remove(mod)
+    bpy.ops.object.ccnurbs_add()
+    ob.ccnurbs.levels = level
+    ccn_mod = [m for m in ob.modifiers if m.type == 'NODES'][0]  # Add puts it first: below the rig
+    with bpy.context.temp_override(object=ob, active_object=ob):
+        bpy.ops.object.modifier_move_to_index(modifier=ccn_mod.name, index=len(ob.modifiers) - 1)
+    evaluated(ob)
+    evaluated(ob)
+    ccn = time_playback(ob)
+    print("bench animation %s L%d (Blender %s, %d faces, armature, %d frames): ccnurbs %.1f fps, "
+          "subsurf %.1f fps (%.2fx)" % (name, level, bpy.app.version_string, len(ob.data.polygons),
+                                        FRAMES, ccn, sub, sub / ccn))
+    sys.stdout.flush()
+
+
 def install():
     if bpy.app.version >= (4, 2, 0):
         res = bpy.ops.extensions.package_install_files(filepath=ZIP, repo="user_default",
@@ -172,6 +253,9 @@ def main():
     for c in cases.split():
         name, level = c.split(":")
         bench(name, int(level))
+    for c in os.environ.get("CCN_BENCH_ANIMATION_CASES", "carlike:2").split():
+        name, level = c.split(":")
+        bench_animation(name, int(level))
 
 
 main()
