@@ -6,6 +6,8 @@ WARN     = -std=c11 -Wall -Wextra -Werror -pedantic
 CPPFLAGS = -Icsrc/include -Icsrc -D_POSIX_C_SOURCE=200809L
 LDLIBS   = -llapacke -llapack -lm -lpthread
 B        = build
+# parallel jobs of the build inside `make test` (the reference machine has 2 cores)
+TEST_JOBS ?= 2
 
 # The library: every csrc/<layer>/*.c except the CLI (csrc/tools); csrc/README.md names the layers.
 LIB_SRC  = $(sort $(filter-out csrc/tools/%,$(wildcard csrc/*/*.c)))
@@ -56,7 +58,7 @@ $(B)/tests/%: tests/c/%.c $(B)/libccnurbs.a $(HDRS)
 	$(CC) $(CPPFLAGS) -Itests/c $(WARN) $(CFLAGS) $< -o $@ $(B)/libccnurbs.a $(LDLIBS)
 
 test: deps
-	@$(MAKE) --no-print-directory build $(TEST_BIN) $(TEST_DEPS)
+	@$(MAKE) --no-print-directory -j$(TEST_JOBS) build $(TEST_BIN) $(TEST_DEPS)
 	@./tests/run_tests.sh
 
 demo: deps
