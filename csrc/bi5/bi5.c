@@ -206,6 +206,18 @@ static void centre_point(int32_t n, const double *X, double ctr[3]) {
     }
 }
 
+/* One stencil row on the net relabelled so that sector s becomes 0: the centre weight row[0]
+ * and the 6 weights per sector of its n sectors (the centre-point and normal terms are the
+ * caller's). */
+static inline void stencil_row(const double *row, const double *X, int32_t n, int32_t s, double acc[3]) {
+    acc[0] = row[0] * X[0], acc[1] = row[0] * X[1], acc[2] = row[0] * X[2];
+    for (int32_t k = 0; k < n; k++) {
+        const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
+        for (int32_t q = 0; q < 6; q++)
+            for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
+    }
+}
+
 /* Uniform operator: sector s = stencil applied to the net relabelled so that s becomes 0. */
 static void apply_stencil(const ccn__bi5 *b, const double *X, const double ctr[3], double *patches) {
     int32_t n = b->n, nc = 6 * n + 1, m = nc + 1, nt = 3 * b->nsig + 1;
@@ -213,12 +225,8 @@ static void apply_stencil(const ccn__bi5 *b, const double *X, const double ctr[3
         for (int32_t t = 0; t < nt; t++)
             for (int32_t e = 0; e < 36; e++) {
                 const double *row = b->stencil + ((size_t)t * 36 + e) * m;
-                double acc[3] = {row[0] * X[0], row[0] * X[1], row[0] * X[2]};
-                for (int32_t k = 0; k < n; k++) {
-                    const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
-                    for (int32_t q = 0; q < 6; q++)
-                        for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
-                }
+                double acc[3];
+                stencil_row(row, X, n, s, acc);
                 double *o = patches + (((size_t)t * n + s) * 36 + e) * 3;
                 for (int c = 0; c < 3; c++) o[c] = acc[c] + row[nc] * ctr[c];
             }
@@ -244,12 +252,8 @@ static void apply_stencil_normal(const ccn__bi5 *b, const double *X, const doubl
         for (int32_t t = 0; t < nt; t++)
             for (int32_t e = 0; e < 36; e++) {
                 const double *row = b->stencilF + ((size_t)t * 36 + e) * mf;
-                double acc[3] = {row[0] * X[0], row[0] * X[1], row[0] * X[2]};
-                for (int32_t k = 0; k < n; k++) {
-                    const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
-                    for (int32_t q = 0; q < 6; q++)
-                        for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
-                }
+                double acc[3];
+                stencil_row(row, X, n, s, acc);
                 double *o = patches + (((size_t)t * n + s) * 36 + e) * 3;
                 for (int c = 0; c < 3; c++) o[c] = acc[c] + row[nc] * ctr[c] + row[nc + 1] * p[c] + row[nc + 2] * p[3 + c];
             }
