@@ -192,6 +192,20 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
     return CCN_OK;
 }
 
+
+/* The guide's Bezier coefficients from its parameters: gbb = gpar * par (m columns). */
+static void guide_from_params(const ccn__bi5 *b, const double *par, int32_t m, double *gbb) {
+    int32_t n = b->n, P = b->npar;
+    for (int32_t r = 0; r < 28 * n; r++) {
+        double *o = gbb + (size_t)r * m;
+        memset(o, 0, sizeof(double) * (size_t)m);
+        for (int32_t p = 0; p < P; p++) {
+            double w = b->gpar[(size_t)r * P + p];
+            if (w != 0.0) vaxpy(o, w, par + (size_t)p * m, m);
+        }
+    }
+}
+
 ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double *b600,
                               int32_t m, double *gbb, ccn_error *err) {
     int32_t n = b->n, P = b->npar, rows = 27 * n, idx[27];
@@ -219,14 +233,7 @@ ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double
         par[c] = b600[c];
         for (int32_t p = 1; p < P; p++) par[(size_t)p * m + c] = tgt[(size_t)c * rows + p - 1];
     }
-    for (int32_t r = 0; r < 28 * n; r++) { /* gbb = gpar * par */
-        double *o = gbb + (size_t)r * m;
-        memset(o, 0, sizeof(double) * (size_t)m);
-        for (int32_t p = 0; p < P; p++) {
-            double w = b->gpar[(size_t)r * P + p];
-            if (w != 0.0) vaxpy(o, w, par + (size_t)p * m, m);
-        }
-    }
+    guide_from_params(b, par, m, gbb);
     free(tgt); free(par);
     return CCN_OK;
 }
@@ -261,14 +268,7 @@ ccn_status ccn__bi5_guide_fit_fixed(const ccn__bi5 *b, const double *tcc, const 
         par[2 * m + c] = p12[m + c];
         for (int32_t q = 3; q < P; q++) par[(size_t)q * m + c] = tgt[(size_t)c * rows + q - 3];
     }
-    for (int32_t r = 0; r < 28 * n; r++) { /* gbb = gpar * par */
-        double *o = gbb + (size_t)r * m;
-        memset(o, 0, sizeof(double) * (size_t)m);
-        for (int32_t q = 0; q < P; q++) {
-            double w = b->gpar[(size_t)r * P + q];
-            if (w != 0.0) vaxpy(o, w, par + (size_t)q * m, m);
-        }
-    }
+    guide_from_params(b, par, m, gbb);
     free(tgt); free(par);
     return CCN_OK;
 }
