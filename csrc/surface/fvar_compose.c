@@ -227,26 +227,35 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     return CCN_OK;
 }
 
-typedef struct { const builder *c; double *out; } limit_job;
+/* One probe pass's limit values, read off as they are made: output o's limit of the level-L
+ * values (3 components: colours 3b .. 3b+2 set to 1) is the weight of each of o's candidates
+ * (row start[o] .. start[o+1]) with one of those colours. */
+typedef struct { const builder *c; const int32_t *start, *ccol; double *cw; int32_t b; } limit_job;
 
-/* The limit of the level-L values (3 components) into out (3 per level-L value vertex). */
 static void limit_range(void *ctx, int32_t b, int32_t end) {
     const limit_job *j = ctx;
     const builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
     const double *PL = mL->pos, *PS = c->posS;
+    const int32_t *start = j->start, *ccol = j->ccol, c0 = 3 * j->b;
     int32_t nvL = mL->nv;
     for (int32_t o = b; o < end; o++) {
-        double *x = j->out + 3 * (size_t)o;
-        if (c->bilinear) { memcpy(x, PL + 3 * (size_t)o, sizeof(double) * 3); continue; }
-        double x0 = 0, x1 = 0, x2 = 0;
-        for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
-            int32_t i = c->st_v[k];
-            const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
-            double w = c->st_w[k];
-            x0 += w * q[0]; x1 += w * q[1]; x2 += w * q[2];
+        double x[3];
+        if (c->bilinear) memcpy(x, PL + 3 * (size_t)o, sizeof x);
+        else {
+            double x0 = 0, x1 = 0, x2 = 0;
+            for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
+                int32_t i = c->st_v[k];
+                const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
+                double w = c->st_w[k];
+                x0 += w * q[0]; x1 += w * q[1]; x2 += w * q[2];
+            }
+            x[0] = x0; x[1] = x1; x[2] = x2;
         }
-        x[0] = x0; x[1] = x1; x[2] = x2;
+        for (int32_t e = start[o]; e < start[o + 1]; e++) {
+            uint32_t k = (uint32_t)(ccol[e] - c0);
+            if (k < 3) j->cw[e] = x[k];
+        }
     }
 }
 
@@ -348,21 +357,16 @@ static void origin_faces(const ccn_plan *p, const ccn_mesh *mL, int32_t *fo) {
 }
 
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
- * stencil run (out: 3 per output value); each candidate weight of those colours is read off. */
-static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, double *out,
-                  const int32_t *bucket, const int32_t *owner, const int32_t *ccol, double *cw) {
+ * stencil run; each candidate weight of those colours is read off (limit_range). */
+static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, const int32_t *start,
+                  const int32_t *ccol, double *cw) {
     ccn_mesh *m0 = c->lev[0].m;
     for (int32_t v = 0; v < m0->nv; v++)
         for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
     for (int32_t l = 0; l < c->L; l++) ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
     if (c->has_sub) ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
-    limit_job j = {c, out};
-    int32_t nout = c->lev[c->L].m->nv;
-    ccn__parallel_for(p->threads, nout, limit_range, &j);
-    for (int32_t i = bucket[b]; i < bucket[b + 1]; i++) { /* the candidates of these colours */
-        int32_t e = owner[2 * (size_t)i], o = owner[2 * (size_t)i + 1];
-        cw[e] = out[3 * (size_t)o + ccol[e] - 3 * b];
-    }
+    limit_job j = {c, start, ccol, cw, b};
+    ccn__parallel_for(p->threads, c->lev[c->L].m->nv, limit_range, &j);
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
@@ -370,12 +374,11 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     int32_t nout = mL->nv;
     csr K = {NULL, NULL};
     int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv), *fo = malloc(sizeof(int32_t) * (size_t)nout);
-    double *out3 = malloc(sizeof(double) * 3 * (size_t)nout);
-    int32_t ncol = -1, *ccol = NULL, *bucket = NULL, *owner = NULL;
+    int32_t ncol = -1, *ccol = NULL;
     ccn_status st = CCN_OK;
     if (col && fo && !neighbourhoods(m0, &K)) ncol = colour(m0, &K, col);
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
-    if (ncol < 0 || !out3 || !s->start) {
+    if (ncol < 0 || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
@@ -397,24 +400,9 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         }
         s->start[o + 1] = n;
     }
-    /* the candidates by pass (counting sort): (entry, output) pairs */
-    int32_t npass = (ncol + 2) / 3;
-    bucket = calloc((size_t)npass + 1, sizeof(int32_t));
-    owner = malloc(sizeof(int32_t) * 2 * (size_t)(total ? total : 1));
-    if (!bucket || !owner) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
-    for (int32_t e = 0; e < (int32_t)total; e++) bucket[ccol[e] / 3 + 1]++;
-    for (int32_t b = 0; b < npass; b++) bucket[b + 1] += bucket[b];
-    for (int32_t o = 0; o < nout; o++)
-        for (int32_t e = s->start[o]; e < s->start[o + 1]; e++) {
-            int32_t i = bucket[ccol[e] / 3]++;
-            owner[2 * (size_t)i] = e;
-            owner[2 * (size_t)i + 1] = o;
-        }
-    for (int32_t b = npass; b > 0; b--) bucket[b] = bucket[b - 1];
-    bucket[0] = 0;
-    for (int32_t b = 0; b < npass; b++) probe(p, c, col, b, out3, bucket, owner, ccol, s->w);
-    free(ccol); free(bucket); free(owner);
-    ccol = bucket = owner = NULL;
+    for (int32_t b = 0, npass = (ncol + 2) / 3; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
+    free(ccol);
+    ccol = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
      * value vertices once), and every stencil sums to 1 */
     int32_t n = 0, e0 = 0;
@@ -443,8 +431,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         if (b) s->w = b;
     }
 done:
-    free(K.start); free(K.list); free(col); free(fo); free(out3); free(ccol); free(bucket);
-    free(owner);
+    free(K.start); free(K.list); free(col); free(fo); free(ccol);
     return st;
 }
 
