@@ -133,30 +133,87 @@ static int partner_semisharp(const ccn__fvar_level *fl, int32_t v, int method, f
     return semi;
 }
 
+/* Regular value vertices away from irregular ones (the tensor B-spline 3 x 3 stencil, at
+ * most FAST_MAX entries) are independent: their stencils are made in parallel into fixed
+ * slots; the others one after the other (they share the ring scratch and the EV cache). */
+#define FAST_MAX 9
+
+typedef struct {
+    const ccn__fvar_level *fl;
+    int method;
+    uint8_t *irr;
+    int32_t *cnt;     /* entries of a vertex's fast stencil; -1: made serially */
+    int32_t *sv;      /* FAST_MAX slots per vertex */
+    double *sw;
+} fast_job;
+
+static void irr_range(void *ctx, int32_t b, int32_t end) {
+    const fast_job *j = ctx;
+    const ccn_mesh *m = j->fl->m;
+    float dep;
+    for (int32_t v = b; v < end; v++)
+        j->irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(j->fl, v, j->method, &dep);
+}
+
+static void fast_range(void *ctx, int32_t b, int32_t end) {
+    const fast_job *j = ctx;
+    const ccn_mesh *m = j->fl->m;
+    ccn__stencil *s = malloc(sizeof *s);
+    for (int32_t v = b; v < end; v++) {
+        j->cnt[v] = -1;
+        if (!s || near_irregular(m, v, j->irr)) continue;
+        ccn__limit_stencil(m, v, 0, s);
+        if (s->n > FAST_MAX) continue;
+        for (int i = 0; i < s->n; i++) {
+            j->sv[FAST_MAX * (size_t)v + i] = s->v[i];
+            j->sw[FAST_MAX * (size_t)v + i] = s->wp[i];
+        }
+        j->cnt[v] = s->n;
+    }
+    free(s);
+}
+
+typedef struct { builder *c; const int32_t *cnt, *sv, *sstart, *bv; const double *sw, *bw; } gather_job;
+
+static void gather_range(void *ctx, int32_t b, int32_t end) {
+    const gather_job *j = ctx;
+    builder *c = j->c;
+    for (int32_t v = b; v < end; v++) {
+        int32_t o = c->st_start[v], n = c->st_start[v + 1] - o;
+        const int32_t *from_v = j->cnt[v] >= 0 ? j->sv + FAST_MAX * (size_t)v : j->bv + j->sstart[v];
+        const double *from_w = j->cnt[v] >= 0 ? j->sw + FAST_MAX * (size_t)v : j->bw + j->sstart[v];
+        memcpy(c->st_v + o, from_v, sizeof(int32_t) * (size_t)n);
+        memcpy(c->st_w + o, from_w, sizeof(double) * (size_t)n);
+    }
+}
+
 static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) {
     const ccn__fvar_level *fl = &c->lev[c->L];
     const ccn_mesh *m = fl->m;
+    size_t nv = (size_t)(m->nv ? m->nv : 1);
     ccn__stencil *s = malloc(sizeof *s);
     ccn__ring_limit *ring = malloc(sizeof *ring);
     ccn__ring_work *work = ccn__ring_work_create();
-    uint8_t *irr = malloc((size_t)m->nv);
     wbuf b = {0, 0, NULL, NULL};
+    fast_job fj = {fl, p->opts.crease_method, malloc(nv), malloc(sizeof(int32_t) * nv),
+                   malloc(sizeof(int32_t) * FAST_MAX * nv), malloc(sizeof(double) * FAST_MAX * nv)};
+    int32_t *sstart = malloc(sizeof(int32_t) * nv); /* a serial stencil's start in b */
     c->st_start = malloc(sizeof(int32_t) * ((size_t)m->nv + 1));
-    c->near = malloc(sizeof(int32_t) * (size_t)m->nv);
+    c->near = malloc(sizeof(int32_t) * nv);
     ccn_status st = CCN_OK;
-    if (!s || !ring || !work || !irr || !c->st_start || !c->near) {
+    if (!s || !ring || !work || !fj.irr || !fj.cnt || !fj.sv || !fj.sw || !sstart || !c->st_start || !c->near) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
     ccn__ring_work_set_ev(work, p->opts.ev_polyhedron, p->ev_cache);
-    c->st_start[0] = 0;
+    ccn__parallel_for(p->threads, m->nv, irr_range, &fj);
+    ccn__parallel_for(p->threads, m->nv, fast_range, &fj);
     float dep;
-    for (int32_t v = 0; v < m->nv; v++)
-        irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(fl, v, p->opts.crease_method, &dep);
     for (int32_t v = 0; v < m->nv && !st; v++) {
+        if (fj.cnt[v] >= 0) continue;
         int32_t off = 0;
         partner_semisharp(fl, v, p->opts.crease_method, &dep);
-        if (!near_irregular(m, v, irr)) {
+        if (!near_irregular(m, v, fj.irr)) {
             ccn__limit_stencil(m, v, 0, s);
         } else if (dep > 0.0f) { /* the partner's sharpness as its own */
             c->near[c->nnear++] = v;
@@ -174,22 +231,39 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
                 st = ccn__child_limit_stencil(m, v, 0, p->opts.scheme, p->opts.crease_method, work, s,
                                               ring, err);
         }
+        sstart[v] = b.n;
         if (!st && push(&b, s, off))
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-        c->st_start[v + 1] = b.n;
+        fj.cnt[v] = -1 - (b.n - sstart[v]); /* -1 - entries */
     }
+    if (st) goto done;
+    /* the stencils in vertex order, sized exactly */
+    c->st_start[0] = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int64_t n = fj.cnt[v] >= 0 ? fj.cnt[v] : -1 - fj.cnt[v];
+        if (c->st_start[v] + n > INT32_MAX) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large");
+            goto done;
+        }
+        c->st_start[v + 1] = c->st_start[v] + (int32_t)n;
+    }
+    size_t total = (size_t)c->st_start[m->nv];
+    c->st_v = malloc(sizeof(int32_t) * (total ? total : 1));
+    c->st_w = malloc(sizeof(double) * (total ? total : 1));
+    if (!c->st_v || !c->st_w) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
+    }
+    gather_job gj = {c, fj.cnt, fj.sv, sstart, b.v, fj.sw, b.w};
+    ccn__parallel_for(p->threads, m->nv, gather_range, &gj);
 done:
-    if (!st && b.n) { /* to size: the buffers grew by doubling */
-        int32_t *v = realloc(b.v, sizeof(int32_t) * (size_t)b.n);
-        double *w = realloc(b.w, sizeof(double) * (size_t)b.n);
-        if (v) b.v = v;
-        if (w) b.w = w;
+    if (c->near) {
+        int32_t *nr = c->nnear ? realloc(c->near, sizeof(int32_t) * (size_t)c->nnear) : NULL;
+        if (nr) c->near = nr;
     }
-    int32_t *nr = c->nnear ? realloc(c->near, sizeof(int32_t) * (size_t)c->nnear) : NULL;
-    if (nr) c->near = nr;
-    c->st_v = b.v;
-    c->st_w = b.w;
-    free(s); free(ring); free(irr);
+    free(b.v); free(b.w); free(sstart);
+    free(fj.irr); free(fj.cnt); free(fj.sv); free(fj.sw);
+    free(s); free(ring);
     ccn__ring_work_destroy(work);
     return st;
 }
@@ -369,6 +443,48 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
     ccn__parallel_for(p->threads, c->lev[c->L].m->nv, limit_range, &j);
 }
 
+typedef struct {
+    const csr *K; const int32_t *fo, *col, *start;
+    int32_t *idx, *ccol;
+} cand_job;
+
+/* The candidates of each output: the value vertices of its cage face's neighbourhood. */
+static void cand_range(void *ctx, int32_t b, int32_t end) {
+    const cand_job *j = ctx;
+    for (int32_t o = b; o < end; o++) {
+        int32_t n = j->start[o];
+        for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) {
+            j->ccol[n] = j->col[j->K->list[k]];
+            j->idx[n] = j->K->list[k];
+        }
+    }
+}
+
+typedef struct { ccn__fvar_stencils *s; const int32_t *value_of; int32_t *len; double *sum; } merge_job;
+
+/* Row o in place: zero weights dropped, value vertices -> the caller's values (summed where two
+ * value vertices carry one value); len[o] its new length, -1 if the weights do not sum to 1. */
+static void merge_range(void *ctx, int32_t b, int32_t end) {
+    const merge_job *j = ctx;
+    int32_t *idx = j->s->idx;
+    double *w = j->s->w;
+    for (int32_t o = b; o < end; o++) {
+        int32_t first = j->s->start[o], n = first;
+        double sum = 0.0;
+        for (int32_t e = first; e < j->s->start[o + 1]; e++) {
+            double we = w[e];
+            if (we == 0.0) continue;
+            sum += we;
+            int32_t val = j->value_of[idx[e]], q = first;
+            while (q < n && idx[q] != val) q++;
+            if (q < n) w[q] += we;
+            else { idx[n] = val; w[n++] = we; }
+        }
+        j->len[o] = fabs(sum - 1.0) <= 1e-9 ? n - first : -1;
+        j->sum[o] = sum;
+    }
+}
+
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
     int32_t nout = mL->nv;
@@ -393,37 +509,41 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     ccol = malloc(sizeof(int32_t) * (size_t)(total ? total : 1)); /* each candidate's colour */
     if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
     s->start[0] = 0;
-    for (int32_t o = 0, n = 0; o < nout; o++) {
-        for (int32_t k = K.start[fo[o]]; k < K.start[fo[o] + 1]; k++) {
-            ccol[n] = col[K.list[k]];
-            s->idx[n++] = K.list[k];
-        }
-        s->start[o + 1] = n;
-    }
+    for (int32_t o = 0; o < nout; o++) s->start[o + 1] = s->start[o] + K.start[fo[o] + 1] - K.start[fo[o]];
+    cand_job cj = {&K, fo, col, s->start, s->idx, ccol};
+    ccn__parallel_for(p->threads, nout, cand_range, &cj);
     for (int32_t b = 0, npass = (ncol + 2) / 3; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
     free(ccol);
     ccol = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
-     * value vertices once), and every stencil sums to 1 */
-    int32_t n = 0, e0 = 0;
-    for (int32_t o = 0; o < nout && !st; o++) {
-        int32_t first = n, e1 = s->start[o + 1]; /* the row as built (start is rewritten) */
-        double sum = 0.0;
-        for (int32_t e = e0; e < e1; e++) {
-            double w = s->w[e];
-            if (w == 0.0) continue;
-            sum += w;
-            int32_t val = c->value_of[s->idx[e]], q = first;
-            while (q < n && s->idx[q] != val) q++;
-            if (q < n) s->w[q] += w;
-            else { s->idx[n] = val; s->w[n++] = w; }
-        }
-        if (!(fabs(sum - 1.0) <= 1e-9)) /* weight outside the neighbourhood: cannot happen */
-            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
-                           "face-varying stencil of output value %d sums to %.17g", (int)o, sum);
-        s->start[o + 1] = n;
-        e0 = e1;
+     * value vertices once), and every stencil sums to 1; each row within its own entries (in
+     * parallel), then the rows moved together */
+    int32_t *len = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
+    double *sums = malloc(sizeof(double) * (size_t)(nout ? nout : 1));
+    if (!len || !sums) {
+        free(len); free(sums);
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
     }
+    merge_job mj = {s, c->value_of, len, sums};
+    ccn__parallel_for(p->threads, nout, merge_range, &mj);
+    int32_t n = 0;
+    for (int32_t o = 0; o < nout && !st; o++) {
+        int32_t e0 = s->start[o], k = len[o];
+        if (k < 0) { /* weight outside the neighbourhood: cannot happen */
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
+                           "face-varying stencil of output value %d sums to %.17g", (int)o, sums[o]);
+            break;
+        }
+        if (n != e0) {
+            memmove(s->idx + n, s->idx + e0, sizeof(int32_t) * (size_t)k);
+            memmove(s->w + n, s->w + e0, sizeof(double) * (size_t)k);
+        }
+        s->start[o] = n;
+        n += k;
+    }
+    free(len); free(sums);
+    s->start[nout] = n;
     if (!st) {
         int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
         double *b = realloc(s->w, sizeof(double) * (size_t)(n ? n : 1));
