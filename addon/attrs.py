@@ -20,6 +20,8 @@ import hashlib
 
 import numpy as np
 
+from . import compat
+
 KEY_PROP = "ccnurbs_attr_key"     # on the proxy mesh: the key of the UVs / attributes written
 NAMES_PROP = "ccnurbs_attr_names"  # on the proxy mesh: the attributes this module wrote
 TAP_ATTR, LIMIT_ATTR = "ccn_co", "ccn_limit"
@@ -62,7 +64,7 @@ def read(me, perm=None):
     x.uvs = []
     for u in layers:
         a = np.empty(2 * nl, np.float32)
-        u.data.foreach_get("uv", a)
+        compat.get_uv(me, u, a)
         a = a.reshape(nl, 2)
         x.uvs.append(a[perm] if perm is not None else a)
     x.point, x.face = [], []
@@ -147,7 +149,7 @@ def write(me, x, plan, chans, channel_ids, face_origin):
     layers = me.uv_layers
     for i, (cid, (values, _)) in enumerate(zip(channel_ids, chans)):
         out, fv = plan.evaluate_fvar(cid, values)
-        layers[i].data.foreach_set("uv", out[fv.ravel()].astype(np.float32).ravel())
+        compat.set_uv(me, layers[i], out[fv.ravel()].astype(np.float32).ravel())
     if x is not None and x.uv_active >= 0 and len(layers):
         layers.active_index = x.uv_active
     if x is not None and x.uv_render >= 0 and len(layers):

@@ -29,6 +29,110 @@ def switch_geometry_sockets(node):
 
 # ---- meshes -----------------------------------------------------------------------------------
 
+# Bulk arrays through their attributes where Blender stores them as attributes (positions 3.5+,
+# corner vertices/edges and edge vertices 3.6+, face materials 4.0+, edge selection 4.0+): one
+# copy, where `vertices.foreach_set("co")`, `loops.foreach_get("vertex_index")` and the other
+# element properties walk every element (measured on 4.5 and 5.0, 131k vertices / faces:
+# positions 17 ms -> 0.1 ms, corner vertices 26-36 ms -> 0.2 ms, material 11-25 ms -> 0.2 ms;
+# issue 15). Not for a mesh evaluated from an edit mesh: its attribute API reads the edit
+# BMesh's layers (tap.py), so the element properties are used there.
+
+def _array_attr(mesh, name, domain, data_type, n):
+    """The mesh's own attribute `name` with n elements, or None (absent, other layout, or an
+    edit-mode mesh whose attributes are the BMesh's)."""
+    if getattr(mesh, "is_editmode", False):
+        return None
+    a = mesh.attributes.get(name)
+    if a is None or a.domain != domain or a.data_type != data_type or len(a.data) != n:
+        return None
+    return a
+
+
+def get_positions(mesh, out):
+    a = _array_attr(mesh, "position", 'POINT', 'FLOAT_VECTOR', len(mesh.vertices))
+    (a.data.foreach_get("vector", out) if a is not None else mesh.vertices.foreach_get("co", out))
+
+
+def set_positions(mesh, values):
+    a = _array_attr(mesh, "position", 'POINT', 'FLOAT_VECTOR', len(mesh.vertices))
+    (a.data.foreach_set("vector", values) if a is not None else mesh.vertices.foreach_set("co", values))
+
+
+def get_corner_verts(mesh, out):
+    a = _array_attr(mesh, ".corner_vert", 'CORNER', 'INT', len(mesh.loops))
+    (a.data.foreach_get("value", out) if a is not None else mesh.loops.foreach_get("vertex_index", out))
+
+
+def set_corner_verts(mesh, values):
+    a = _array_attr(mesh, ".corner_vert", 'CORNER', 'INT', len(mesh.loops))
+    (a.data.foreach_set("value", values) if a is not None else mesh.loops.foreach_set("vertex_index", values))
+
+
+def get_corner_edges(mesh, out):
+    a = _array_attr(mesh, ".corner_edge", 'CORNER', 'INT', len(mesh.loops))
+    (a.data.foreach_get("value", out) if a is not None else mesh.loops.foreach_get("edge_index", out))
+
+
+def get_edge_verts(mesh, out):
+    """Flat (2 per edge)."""
+    a = _array_attr(mesh, ".edge_verts", 'EDGE', 'INT32_2D', len(mesh.edges))
+    (a.data.foreach_get("value", out) if a is not None else mesh.edges.foreach_get("vertices", out))
+
+
+def get_material_index(mesh, out):
+    a = _array_attr(mesh, "material_index", 'FACE', 'INT', len(mesh.polygons))
+    if a is not None:
+        a.data.foreach_get("value", out)
+    elif VERSION >= (4, 0, 0) and not getattr(mesh, "is_editmode", False):
+        out[:] = 0  # 4.0+: no attribute, every face uses the first material
+    else:
+        mesh.polygons.foreach_get("material_index", out)
+
+
+def set_material_index(mesh, values):
+    if VERSION >= (4, 0, 0):
+        a = mesh.attributes.get("material_index")
+        if a is None or a.domain != 'FACE' or a.data_type != 'INT':
+            if a is not None:
+                mesh.attributes.remove(a)
+            a = mesh.attributes.new("material_index", 'INT', 'FACE')
+        a.data.foreach_set("value", values)
+    else:
+        mesh.polygons.foreach_set("material_index", values)
+
+
+def set_all_smooth(mesh):
+    """Smooth shading on every face: 4.0+ no `sharp_face` attribute (its absence means smooth)."""
+    if VERSION >= (4, 0, 0):
+        a = mesh.attributes.get("sharp_face")
+        if a is not None:
+            mesh.attributes.remove(a)
+    else:
+        import numpy as np
+        mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), bool))
+
+
+def get_uv(mesh, layer, out):
+    """A UV map's per-corner values (flat, 2 per corner): its FLOAT2 corner attribute (3.5+)."""
+    a = _array_attr(mesh, layer.name, 'CORNER', 'FLOAT2', len(mesh.loops))
+    (a.data.foreach_get("vector", out) if a is not None else layer.data.foreach_get("uv", out))
+
+
+def set_uv(mesh, layer, values):
+    a = _array_attr(mesh, layer.name, 'CORNER', 'FLOAT2', len(mesh.loops))
+    (a.data.foreach_set("vector", values) if a is not None else layer.data.foreach_set("uv", values))
+
+
+def get_edge_select(mesh, out):
+    a = _array_attr(mesh, ".select_edge", 'EDGE', 'BOOLEAN', len(mesh.edges))
+    if a is not None:
+        a.data.foreach_get("value", out)
+    elif VERSION >= (4, 0, 0) and not getattr(mesh, "is_editmode", False):
+        out[:] = False  # 4.0+: no attribute, nothing selected
+    else:
+        mesh.edges.foreach_get("select", out)
+
+
 def set_face_loops(mesh, loop_start, loop_total):
     """Polygon corner ranges: `loop_total` is writable (and required) in 3.x only."""
     mesh.polygons.foreach_set("loop_start", loop_start)
