@@ -3,6 +3,9 @@
 * depsgraph_update_post: the cages whose geometry changed → their taps in this depsgraph →
   viewport proxies (Blender re-evaluates at once after our write, before drawing). Also the cheap
   hygiene triggers (hygiene.suspicious, object/group counts).
+  Blender < 4.5, interactive: the viewport proxies get Blender's own normals while the cage keeps
+  changing and a timer writes the exact ones NORMALS_DELAY after the last change (encoded custom
+  normals cost 5x the rest of an update; sync.PENDING).
 * frame_change_post: frame_set, playback and every frame of a render. Viewport depsgraph: the
   viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
   them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
@@ -18,7 +21,7 @@ import traceback
 import bpy
 from bpy.app.handlers import persistent
 
-from . import hygiene, modifier, overlay, proxies, sync, tap
+from . import compat, hygiene, modifier, overlay, proxies, sync, tap
 
 _busy = [False]
 _counts = [None]
@@ -60,9 +63,21 @@ def _shown(obj, depsgraph):
     return mod.show_viewport
 
 
-def sync_cages(depsgraph, objs, kind='VIEW', force=False):
-    """Reads the taps of `objs` from `depsgraph` and syncs their `kind` proxies. Returns the
+NORMALS_DELAY = 0.3  # seconds of quiet before deferred exact normals are written (UI only)
+# Deferred exact normals (sync.PENDING): Blender < 4.5 in an interactive session; [0] = True
+# makes scripts and headless tests defer too (they then call write_pending_normals()).
+DEFER_IN_BACKGROUND = [False]
+
+
+def defer_normals():
+    return not compat.FREE_NORMALS and (not bpy.app.background or DEFER_IN_BACKGROUND[0])
+
+
+def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
+    """Reads the taps of `objs` from `depsgraph` and syncs their `kind` proxies (viewport
+    proxies with deferred exact normals where defer_normals(), unless defer=False). Returns the
     number of proxies written."""
+    defer = kind == 'VIEW' and (defer_normals() if defer is None else defer)
     objs = [o for o in objs if modifier.is_cage(o) and o.library is None and _shown(o, depsgraph)]
     taps = tap.read(depsgraph, objs)
     written = 0
@@ -72,7 +87,7 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False):
             sync.missing_tap(obj, kind)
             continue
         before = sync.stats["syncs"]
-        sync.sync_object(obj, kind, cage, force=force)
+        sync.sync_object(obj, kind, cage, force=force, defer_normals=defer)
         written += sync.stats["syncs"] - before
         if kind == 'VIEW' and obj.ccnurbs.store_render_mesh and bpy.app.background:
             sync.sync_object(obj, 'RENDER', cage)  # farm files from scripts: no idle timer here
@@ -82,7 +97,27 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False):
         if bpy.app.timers.is_registered(_render_timer):
             bpy.app.timers.unregister(_render_timer)
         bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
+    if defer and sync.pending_normals and not bpy.app.background:  # each update: the delay again
+        if bpy.app.timers.is_registered(_normals_timer):
+            bpy.app.timers.unregister(_normals_timer)
+        bpy.app.timers.register(_normals_timer, first_interval=NORMALS_DELAY)
     return written
+
+
+def write_pending_normals():
+    """The exact normals of every viewport proxy that waits for them (sync.PENDING)."""
+    names = set(sync.pending_normals)
+    sync.pending_normals.clear()
+    objs = [o for o in bpy.data.objects if o.name_full in names]
+    if objs:
+        sync_cages(bpy.context.evaluated_depsgraph_get(), objs, 'VIEW', defer=False)
+
+
+def _normals_timer():
+    if _busy[0]:
+        return 0.1
+    _guarded(write_pending_normals)
+    return None
 
 
 RENDER_DELAY = 1.0  # seconds of quiet before stored render meshes are refreshed (UI only)

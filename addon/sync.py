@@ -30,6 +30,12 @@ stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "
          "internal_errors": 0, "render_frames": 0}
 _plans = {}      # (object name, kind) -> (topology key, native.Plan)
 _status = {}     # (object name, kind) -> Status
+# Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
+# evaluation of the cage afterwards cost 5x the rest of an update, issue 15): with
+# defer_normals the proxy gets Blender's own normals and this key suffix, and its cage is listed
+# in `pending_normals`; handlers.py writes the exact normals once editing pauses.
+PENDING = "|normals pending"
+pending_normals = set()  # names of cages whose viewport proxy waits for its exact normals
 
 
 class Status:
@@ -107,9 +113,10 @@ def _write_extras(me, plan, cage, uv_chans, ekey, rebuilt):
     me[attrs.KEY_PROP] = ekey
 
 
-def sync_object(obj, kind, cage, force=False):
+def sync_object(obj, kind, cage, force=False, defer_normals=False):
     """Brings the cage's viewport ('VIEW') or render ('RENDER') proxy up to date with `cage`
-    (the tap's arrays). Returns the Status; never raises."""
+    (the tap's arrays). defer_normals: exact normals are left for later (see PENDING). Returns
+    the Status; never raises."""
     s = obj.ccnurbs
     levels = s.levels if kind == 'VIEW' else s.render_levels
     key_name = (obj.name_full, kind)
@@ -130,7 +137,10 @@ def sync_object(obj, kind, cage, force=False):
         proxies.sync_materials(obj.data, p)
         old = _status.get(key_name)
         me = p.data
-        if not force and me.get(proxies.KEY_PROP) == key:
+        stored = me.get(proxies.KEY_PROP)
+        if stored == key + PENDING and defer_normals:
+            pending_normals.add(obj.name_full)  # e.g. after undo: still waiting
+        if not force and (stored == key or stored == key + PENDING and defer_normals):
             stats["skipped"] += 1
             if old is None or old.error:  # unknown (file just loaded) or fixed by undo
                 old = Status(kind, levels)
@@ -147,6 +157,8 @@ def sync_object(obj, kind, cage, force=False):
                          and len(me.vertices) == plan.sizes["num_verts"]
                          and len(me.polygons) == plan.sizes["num_faces"])
         exact = s.normals == 'EXACT'
+        deferred = exact and defer_normals
+        exact = exact and not deferred
         if same_topology and me.get(proxies.KEY_PROP) == key:
             pass  # forced: the proxy is already right
         elif same_topology:
@@ -160,7 +172,9 @@ def sync_object(obj, kind, cage, force=False):
             proxies.write_topology(me, res, cage, exact)
             _write_extras(me, plan, cage, uv_chans, ekey, True)
             stats["rebuilds"] += 1
-        me[proxies.KEY_PROP] = key
+        me[proxies.KEY_PROP] = key + PENDING if deferred else key
+        if deferred:
+            pending_normals.add(obj.name_full)
         me[proxies.TOPO_PROP] = faces
         me[proxies.PLAN_PROP] = topo
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)

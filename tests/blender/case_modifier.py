@@ -105,6 +105,47 @@ class TestModifier(AddonTestCase):
         ob.ccnurbs.levels = 3
         self.assertGreater(len(self.assertMatchesCLI(ob)), n2)
 
+    def test_exact_normals_after_editing_pauses(self):
+        """Blender < 4.5 (encoded custom normals, 5x the rest of an update): while editing the
+        limit has Blender's own normals and its exact normals follow once editing pauses (the
+        handlers' timer; here called directly, scripts do not defer). 4.5+: exact at once."""
+        ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
+        add_modifier(ob, levels=2)
+        h = ccn.handlers
+        h.DEFER_IN_BACKGROUND[0] = True
+        try:
+            for step in range(2):  # twice: the second edit happens while still pending
+                ob.data.vertices[step].co.z += 0.3
+                ob.data.update()
+                update()
+                key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
+                if ccn.compat.FREE_NORMALS:
+                    self.assertMatchesCLI(ob)
+                    self.assertEqual(ccn.sync.pending_normals, set())
+                    self.assertFalse(key.endswith(ccn.sync.PENDING), key)
+                    continue
+                self.assertMatchesCLI(ob, normals=False)  # positions exact at once
+                self.assertEqual(ccn.sync.pending_normals, {ob.name_full})
+                self.assertTrue(key.endswith(ccn.sync.PENDING), key)
+                me = ccn.modifier.proxy(ob, 'VIEW').data
+                self.assertIs(me.use_auto_smooth, False, "custom normals still shown")
+            st = dict(ccn.sync.stats)
+            h.write_pending_normals()
+            update()
+            self.assertMatchesCLI(ob)  # the exact normals
+            self.assertEqual(ccn.sync.pending_normals, set())
+            key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
+            self.assertFalse(key.endswith(ccn.sync.PENDING), key)
+            self.assertLessEqual(ccn.sync.stats["syncs"] - st["syncs"],
+                                 0 if ccn.compat.FREE_NORMALS else 1)
+            for _ in range(2):  # and then nothing more to do
+                update()
+            self.assertEqual(ccn.sync.stats["syncs"] - st["syncs"],
+                             0 if ccn.compat.FREE_NORMALS else 1)
+        finally:
+            h.DEFER_IN_BACKGROUND[0] = False
+            ccn.sync.pending_normals.clear()
+
     def test_edit_mode_updates(self):
         ob = add_modifier(grid(4))
         bpy.ops.object.mode_set(mode='EDIT')
