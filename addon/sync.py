@@ -78,6 +78,7 @@ def forget_all():
         plan.close()
     _plans.clear()
     _status.clear()
+    pending_normals.clear()
 
 
 def free_render_plans():
