@@ -109,7 +109,7 @@ def _positions(me, position_attr):
     if a is not None and a.domain == 'POINT' and a.data_type == 'FLOAT_VECTOR':
         a.data.foreach_get("vector", co)
     else:
-        compat.get_positions(me, co)
+        compat.get_array(me, "positions", co)
     return co.reshape(nv, 3).astype(np.float64)
 
 
@@ -122,9 +122,9 @@ def read_mesh(me, selection=False, position_attr=None, attributes=True, extras=F
     c.face_sizes = np.empty(nf, np.int32)
     me.polygons.foreach_get("loop_total", c.face_sizes)
     c.face_verts = np.empty(nl, np.int32)
-    compat.get_corner_verts(me, c.face_verts)
+    compat.get_array(me, "corner_verts", c.face_verts)
     c.loop_edges = np.empty(nl, np.int32)
-    compat.get_corner_edges(me, c.loop_edges)
+    compat.get_array(me, "corner_edges", c.loop_edges)
     starts = np.empty(nf, np.int32)
     me.polygons.foreach_get("loop_start", starts)
     packed = np.cumsum(c.face_sizes, dtype=np.int64) - c.face_sizes
@@ -134,7 +134,7 @@ def read_mesh(me, selection=False, position_attr=None, attributes=True, extras=F
         c.face_verts, c.loop_edges = c.face_verts[idx], c.loop_edges[idx]
     c.extras = attrs.read(me, idx) if extras and attributes else None
     ev = np.empty(2 * ne, np.int32)
-    compat.get_edge_verts(me, ev)
+    compat.get_array(me, "edge_verts", ev)
     c.edge_verts = ev.reshape(ne, 2)
     a = knot_attribute(me) if attributes else None
     if a is not None and len(a.data) == ne:
@@ -147,11 +147,11 @@ def read_mesh(me, selection=False, position_attr=None, attributes=True, extras=F
     c.vertex_creases = compat.vertex_creases(me) if attributes else None
     c.material_index = np.zeros(nf, np.int32)
     if attributes or compat.VERSION < (4, 0, 0):
-        compat.get_material_index(me, c.material_index)
+        compat.get_array(me, "material_index", c.material_index)
     c.num_materials = len(me.materials)
     if selection:
         s = np.empty(ne, bool)
-        compat.get_edge_select(me, s)
+        compat.get_array(me, "edge_select", s)
         c.edge_select = s
     else:
         c.edge_select = None

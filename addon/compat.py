@@ -48,45 +48,48 @@ def _array_attr(mesh, name, domain, data_type, n):
     return a
 
 
-def get_positions(mesh, out):
-    a = _array_attr(mesh, "position", 'POINT', 'FLOAT_VECTOR', len(mesh.vertices))
-    (a.data.foreach_get("vector", out) if a is not None else mesh.vertices.foreach_get("co", out))
+# array -> (attribute, domain, data type, its foreach property, element collection, element
+#           property, the value when 4.0+ has no such attribute (None: read the elements))
+_ARRAYS = {
+    "positions": ("position", 'POINT', 'FLOAT_VECTOR', "vector", "vertices", "co", None),
+    "corner_verts": (".corner_vert", 'CORNER', 'INT', "value", "loops", "vertex_index", None),
+    "corner_edges": (".corner_edge", 'CORNER', 'INT', "value", "loops", "edge_index", None),
+    "edge_verts": (".edge_verts", 'EDGE', 'INT32_2D', "value", "edges", "vertices", None),
+    "material_index": ("material_index", 'FACE', 'INT', "value", "polygons", "material_index", 0),
+    "edge_select": (".select_edge", 'EDGE', 'BOOLEAN', "value", "edges", "select", False),
+}
 
 
-def set_positions(mesh, values):
-    a = _array_attr(mesh, "position", 'POINT', 'FLOAT_VECTOR', len(mesh.vertices))
-    (a.data.foreach_set("vector", values) if a is not None else mesh.vertices.foreach_set("co", values))
-
-
-def get_corner_verts(mesh, out):
-    a = _array_attr(mesh, ".corner_vert", 'CORNER', 'INT', len(mesh.loops))
-    (a.data.foreach_get("value", out) if a is not None else mesh.loops.foreach_get("vertex_index", out))
-
-
-def set_corner_verts(mesh, values):
-    a = _array_attr(mesh, ".corner_vert", 'CORNER', 'INT', len(mesh.loops))
-    (a.data.foreach_set("value", values) if a is not None else mesh.loops.foreach_set("vertex_index", values))
-
-
-def get_corner_edges(mesh, out):
-    a = _array_attr(mesh, ".corner_edge", 'CORNER', 'INT', len(mesh.loops))
-    (a.data.foreach_get("value", out) if a is not None else mesh.loops.foreach_get("edge_index", out))
-
-
-def get_edge_verts(mesh, out):
-    """Flat (2 per edge)."""
-    a = _array_attr(mesh, ".edge_verts", 'EDGE', 'INT32_2D', len(mesh.edges))
-    (a.data.foreach_get("value", out) if a is not None else mesh.edges.foreach_get("vertices", out))
-
-
-def get_material_index(mesh, out):
-    a = _array_attr(mesh, "material_index", 'FACE', 'INT', len(mesh.polygons))
+def _bulk(mesh, spec, elems, eprop, array, write, absent=None):
+    name, domain, dtype, prop = spec
+    a = _array_attr(mesh, name, domain, dtype, len(elems))
     if a is not None:
-        a.data.foreach_get("value", out)
-    elif VERSION >= (4, 0, 0) and not getattr(mesh, "is_editmode", False):
-        out[:] = 0  # 4.0+: no attribute, every face uses the first material
+        (a.data.foreach_set if write else a.data.foreach_get)(prop, array)
+    elif (not write and absent is not None and VERSION >= (4, 0, 0)
+          and not getattr(mesh, "is_editmode", False)):
+        array[:] = absent
     else:
-        mesh.polygons.foreach_get("material_index", out)
+        (elems.foreach_set if write else elems.foreach_get)(eprop, array)
+
+
+def get_array(mesh, what, out):
+    """One of _ARRAYS into `out` (flat numpy array of the element property's layout)."""
+    name, domain, dtype, prop, coll, eprop, absent = _ARRAYS[what]
+    _bulk(mesh, (name, domain, dtype, prop), getattr(mesh, coll), eprop, out, False, absent)
+
+
+def set_array(mesh, what, values):
+    name, domain, dtype, prop, coll, eprop, _ = _ARRAYS[what]
+    _bulk(mesh, (name, domain, dtype, prop), getattr(mesh, coll), eprop, values, True)
+
+
+def get_uv(mesh, layer, out):
+    """A UV map's per-corner values (flat, 2 per corner): its FLOAT2 corner attribute (3.5+)."""
+    _bulk(mesh, (layer.name, 'CORNER', 'FLOAT2', "vector"), layer.data, "uv", out, False)
+
+
+def set_uv(mesh, layer, values):
+    _bulk(mesh, (layer.name, 'CORNER', 'FLOAT2', "vector"), layer.data, "uv", values, True)
 
 
 def set_material_index(mesh, values):
@@ -110,27 +113,6 @@ def set_all_smooth(mesh):
     else:
         import numpy as np
         mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), bool))
-
-
-def get_uv(mesh, layer, out):
-    """A UV map's per-corner values (flat, 2 per corner): its FLOAT2 corner attribute (3.5+)."""
-    a = _array_attr(mesh, layer.name, 'CORNER', 'FLOAT2', len(mesh.loops))
-    (a.data.foreach_get("vector", out) if a is not None else layer.data.foreach_get("uv", out))
-
-
-def set_uv(mesh, layer, values):
-    a = _array_attr(mesh, layer.name, 'CORNER', 'FLOAT2', len(mesh.loops))
-    (a.data.foreach_set("vector", values) if a is not None else layer.data.foreach_set("uv", values))
-
-
-def get_edge_select(mesh, out):
-    a = _array_attr(mesh, ".select_edge", 'EDGE', 'BOOLEAN', len(mesh.edges))
-    if a is not None:
-        a.data.foreach_get("value", out)
-    elif VERSION >= (4, 0, 0) and not getattr(mesh, "is_editmode", False):
-        out[:] = False  # 4.0+: no attribute, nothing selected
-    else:
-        mesh.edges.foreach_get("select", out)
 
 
 def set_face_loops(mesh, loop_start, loop_total):

@@ -59,7 +59,7 @@ def write_creases(me, res, cage):
     corner_crease = np.where(ekey[order][pos] == a * nvk + b, cage.edge_creases[order][pos], 0.0)
     origin = res["corner_edge_origin"].ravel()
     loop_edge = np.empty(len(me.loops), np.int32)
-    compat.get_corner_edges(me, loop_edge)
+    compat.get_array(me, "corner_edges", loop_edge)
     out = np.zeros(len(me.edges), np.float32)
     on = origin >= 0
     np.maximum.at(out, loop_edge[on], corner_crease[origin[on]].astype(np.float32))
@@ -74,8 +74,8 @@ def write_topology(me, res, cage, exact=True):
     me.vertices.add(nv)
     me.loops.add(4 * nf)
     me.polygons.add(nf)
-    compat.set_positions(me, pos)
-    compat.set_corner_verts(me, fv)
+    compat.set_array(me, "positions", pos)
+    compat.set_array(me, "corner_verts", fv)
     compat.set_face_loops(me, np.arange(0, 4 * nf, 4, dtype=np.int32), np.full(nf, 4, np.int32))
     compat.set_all_smooth(me)
     if cage.material_index is not None and cage.material_index.any():  # all 0: no attribute
@@ -88,7 +88,7 @@ def write_topology(me, res, cage, exact=True):
 
 
 def write_positions(me, res, exact=True):
-    compat.set_positions(me, res["positions"].astype(np.float32).ravel())
+    compat.set_array(me, "positions", res["positions"].astype(np.float32).ravel())
     me.update()
     write_normals(me, res, exact)
 
