@@ -102,7 +102,7 @@ def knot_attribute(me):
     return None
 
 
-def _positions(me, position_attr):
+def positions(me, position_attr=None):
     nv = len(me.vertices)
     co = np.empty(3 * nv, np.float32)
     a = me.attributes.get(position_attr) if position_attr else None
@@ -118,7 +118,7 @@ def read_mesh(me, selection=False, position_attr=None, attributes=True, extras=F
     extras: also the UV maps and point / face attributes the limit mesh carries (attrs.py)."""
     c = Cage()
     ne, nl, nf = len(me.edges), len(me.loops), len(me.polygons)
-    c.positions = _positions(me, position_attr)
+    c.positions = positions(me, position_attr)
     c.face_sizes = np.empty(nf, np.int32)
     me.polygons.foreach_get("loop_total", c.face_sizes)
     c.face_verts = np.empty(nl, np.int32)

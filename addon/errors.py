@@ -57,20 +57,6 @@ def selectable(st):
     return kind, index, pair
 
 
-def _stack_changes_topology(obj):
-    """Is an enabled modifier above CCNURBS one that can renumber the cage's elements?"""
-    for m in obj.modifiers:
-        if m.name == modifier.MOD_NAME:
-            return False
-        if m.show_viewport and m.type not in {'ARMATURE', 'CAST', 'CURVE', 'DISPLACE', 'HOOK',
-                                              'LAPLACIANDEFORM', 'LATTICE', 'MESH_DEFORM',
-                                              'SHRINKWRAP', 'SIMPLE_DEFORM', 'SMOOTH',
-                                              'CORRECTIVE_SMOOTH', 'LAPLACIANSMOOTH',
-                                              'SURFACE_DEFORM', 'WARP', 'WAVE'}:
-            return True
-    return False
-
-
 class OBJECT_OT_ccnurbs_select_error(bpy.types.Operator):
     """Select the vertex, edge or face the cage error names (Edit Mode)"""
     bl_idname = "object.ccnurbs_select_error"
@@ -85,7 +71,7 @@ class OBJECT_OT_ccnurbs_select_error(bpy.types.Operator):
     def execute(self, context):
         obj = context.active_object
         kind, index, pair = selectable(sync.status(obj, 'VIEW'))
-        if _stack_changes_topology(obj):
+        if not modifier.stack_keeps_topology(obj):
             self.report({'WARNING'}, "The error is in the mesh after the modifiers above CCNURBS; "
                         "apply or disable them to find the element in the mesh itself")
             return {'CANCELLED'}

@@ -64,6 +64,23 @@ def get_modifier(obj):
     return mod if mod is not None and mod.type == 'NODES' else None
 
 
+DEFORM_ONLY = {'ARMATURE', 'CAST', 'CURVE', 'DISPLACE', 'HOOK', 'LAPLACIANDEFORM', 'LATTICE',
+               'MESH_DEFORM', 'SHRINKWRAP', 'SIMPLE_DEFORM', 'SMOOTH', 'CORRECTIVE_SMOOTH',
+               'LAPLACIANSMOOTH', 'SURFACE_DEFORM', 'WARP', 'WAVE'}
+
+
+def stack_keeps_topology(obj):
+    """Does every enabled modifier above CCNURBS only move vertices (so the cage the library
+    sees has the object's own elements, in their order)?"""
+    ours = get_modifier(obj)
+    for m in obj.modifiers:
+        if m == ours:
+            return True
+        if m.show_viewport and m.type not in DEFORM_ONLY:
+            return False
+    return True
+
+
 def is_cage(obj):
     return (obj is not None and obj.type == 'MESH' and obj.ccnurbs.role == 'CAGE'
             and get_modifier(obj) is not None)

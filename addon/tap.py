@@ -22,7 +22,7 @@ until Object Mode; both last cases put a note in the panel (`edit_note`).
 import numpy as np
 
 from . import cage as cagemod
-from . import compat
+from . import compat, modifier
 from .modifier import TAP_ATTR
 
 _object_mode = {}  # object name -> (edge_verts bytes, knots, edge creases, vertex creases,
@@ -38,14 +38,21 @@ def _is_tap(me):
 
 def _read(obj, me):
     name = obj.name_full
-    c = cagemod.read_mesh(me, attributes=not getattr(me, "is_editmode", False), extras=True)
     edit_note.pop(name, None)
     if not getattr(me, "is_editmode", False):
+        c = cagemod.read_mesh(me, extras=True)
         _object_mode[name] = (c.edge_verts.tobytes(), c.knots, c.edge_creases, c.vertex_creases,
                               c.material_index, c.face_verts.tobytes(), c.extras)
         return c
     own = cagemod.read_mesh(cagemod.source_mesh(obj), extras=True)  # the edit mesh itself:
     # right when the stack keeps its edges (UVs and attributes: its corners)
+    if (modifier.stack_keeps_topology(obj) and len(me.vertices) == len(own.positions)
+            and len(me.loops) == len(own.face_verts) and len(me.edges) == len(own.edge_verts)):
+        # deform-only stack: the elements are the edit mesh's, in its order; the tap's element
+        # arrays would be read one element at a time (edit-mode meshes, see above)
+        own.positions = cagemod.positions(me)
+        return own
+    c = cagemod.read_mesh(me, attributes=False, extras=True)
     if np.array_equal(own.face_verts, c.face_verts):
         c.extras = own.extras
     if len(own.edge_verts) == len(c.edge_verts) and np.array_equal(own.edge_verts, c.edge_verts):

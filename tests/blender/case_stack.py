@@ -165,6 +165,29 @@ class TestStackAbove(AddonTestCase):
         self.assertLessEqual(np.abs(P - R).max(), POS_TOL, "edit-mode result != mirrored cage")
         np.testing.assert_allclose(evaluated_positions(ob), P, atol=TOL)
 
+    def test_edit_mode_through_deform_only_stack(self):
+        """Edit Mode with only deforming modifiers above (Displace, Simple Deform): the cage is
+        the edit mesh's elements at the stack's positions; equals the stack's CLI limit."""
+        ob = add_modifier(half_grid("EditDeform"), levels=2)
+        tex = bpy.data.textures.new("T", 'CLOUDS')
+        add_above(ob, "Displace", 'DISPLACE', texture=tex, strength=0.3, show_in_editmode=True,
+                  show_on_cage=False)
+        add_above(ob, "Twist", 'SIMPLE_DEFORM', deform_method='TWIST', angle=0.6,
+                  show_in_editmode=True, show_on_cage=False)
+        self.assertTrue(ccn.modifier.stack_keeps_topology(ob))
+        update()
+        bpy.ops.object.mode_set(mode='EDIT')
+        bm = bmesh.from_edit_mesh(ob.data)
+        bm.verts.ensure_lookup_table()
+        bm.verts[5].co.z = 0.8
+        bmesh.update_edit_mesh(ob.data)
+        P = evaluated_positions(ob)
+        bpy.ops.object.mode_set(mode='OBJECT')
+        R = cli_of_stack(ob)
+        self.assertEqual(P.shape, R.shape)
+        self.assertLessEqual(np.abs(P - R).max(), POS_TOL, "edit-mode result != deformed cage")
+        np.testing.assert_allclose(evaluated_positions(ob), P, atol=TOL)
+
     def test_apply_keeps_limit_only(self):
         ob = add_modifier(half_grid("ApplyMe"), levels=1)
         add_above(ob, "Mirror", 'MIRROR', use_mirror_merge=True)
