@@ -231,6 +231,7 @@ class Plan:
         lib = load()
         self._lib = lib
         self._handle = None
+        self._buffers = None  # evaluate(topology=False)'s output arrays, reused
         pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
         fs = np.ascontiguousarray(face_sizes, dtype=np.int32).reshape(-1)
         fv = np.ascontiguousarray(face_verts, dtype=np.int32).reshape(-1)
@@ -282,13 +283,20 @@ class Plan:
         """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces
         corner_normals (F*4,3) f64 (each face corner's own side), and, if topology, face_verts
         (F,4) int32, face_origin (F,) int32 and corner_edge_origin (F,4) int32 (the cage face
-        corner whose edge each output corner's edge lies on, -1 inside a cage face)."""
+        corner whose edge each output corner's edge lies on, -1 inside a cage face). Without
+        topology the arrays are the plan's own, overwritten by the next such call."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
         n, f = self.sizes["num_verts"], self.sizes["num_faces"]
-        out = {"positions": np.empty((n, 3), np.float64), "normals": np.empty((n, 3), np.float64)}
-        if self.sizes.get("num_sharp_corners", 0) > 0:
-            out["corner_normals"] = np.empty((4 * f, 3), np.float64)
+        if topology or self._buffers is None:
+            out = {"positions": np.empty((n, 3), np.float64),
+                   "normals": np.empty((n, 3), np.float64)}
+            if self.sizes.get("num_sharp_corners", 0) > 0:
+                out["corner_normals"] = np.empty((4 * f, 3), np.float64)
+            if not topology:  # position updates reuse these arrays (written before the next)
+                self._buffers = out
+        else:
+            out = dict(self._buffers)
         if topology:
             out["face_verts"] = np.empty((f, 4), np.int32)
             out["face_origin"] = np.empty(f, np.int32)
