@@ -92,6 +92,22 @@ def set_uv(mesh, layer, values):
     _bulk(mesh, (layer.name, 'CORNER', 'FLOAT2', "vector"), layer.data, "uv", values, True)
 
 
+def set_edges(mesh, edge_verts, corner_edges):
+    """Edges given (flat arrays) to a mesh without edges, where edges are attributes (4.0+):
+    returns False if not, and the caller lets Blender compute them (`update(calc_edges=True)`), which is 15 ms per 131k faces
+    where writing them is 0.5 ms (5.0); on 3.x writing them element by element costs more."""
+    if VERSION < (4, 0, 0) or len(mesh.edges):
+        return False
+    mesh.edges.add(len(edge_verts) // 2)
+    ev = _array_attr(mesh, ".edge_verts", 'EDGE', 'INT32_2D', len(mesh.edges))
+    ce = _array_attr(mesh, ".corner_edge", 'CORNER', 'INT', len(mesh.loops))
+    if ev is None or ce is None:  # edges added but not writable: never leave them unset
+        raise RuntimeError("mesh edges are not attributes in Blender %d.%d" % VERSION[:2])
+    ev.data.foreach_set("value", edge_verts)
+    ce.data.foreach_set("value", corner_edges)
+    return True
+
+
 def set_material_index(mesh, values):
     if VERSION >= (4, 0, 0):
         a = mesh.attributes.get("material_index")

@@ -84,7 +84,8 @@ class ccn_sizes(ctypes.Structure):
                 ("num_sharp_corners", ctypes.c_int32),
                 ("num_ev_verified", ctypes.c_int32),
                 ("num_ev_outside_g1", ctypes.c_int32),
-                ("num_caps_deferred", ctypes.c_int32)]
+                ("num_caps_deferred", ctypes.c_int32),
+                ("num_edges", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):
@@ -93,7 +94,9 @@ class ccn_limit_mesh(ctypes.Structure):
                 ("face_verts", c_int32_p),
                 ("face_origin", c_int32_p),
                 ("corner_normals", c_double_p),
-                ("corner_edge_origin", c_int32_p)]
+                ("corner_edge_origin", c_int32_p),
+                ("edge_verts", c_int32_p),
+                ("corner_edges", c_int32_p)]
 
 
 class ccn_fvar_channel(ctypes.Structure):
@@ -282,8 +285,9 @@ class Plan:
     def evaluate(self, positions=None, topology=True):
         """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces
         corner_normals (F*4,3) f64 (each face corner's own side), and, if topology, face_verts
-        (F,4) int32, face_origin (F,) int32 and corner_edge_origin (F,4) int32 (the cage face
-        corner whose edge each output corner's edge lies on, -1 inside a cage face). Without
+        (F,4) int32, face_origin (F,) int32, corner_edge_origin (F,4) int32 (the cage face
+        corner whose edge each output corner's edge lies on, -1 inside a cage face), edge_verts
+        (E,2) int32 and corner_edges (F,4) int32 (the output edges). Without
         topology the arrays are the plan's own, overwritten by the next such call."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
@@ -301,12 +305,16 @@ class Plan:
             out["face_verts"] = np.empty((f, 4), np.int32)
             out["face_origin"] = np.empty(f, np.int32)
             out["corner_edge_origin"] = np.empty((f, 4), np.int32)
+            out["edge_verts"] = np.empty((self.sizes["num_edges"], 2), np.int32)
+            out["corner_edges"] = np.empty((f, 4), np.int32)
         lm = ccn_limit_mesh(positions=_ptr(out["positions"], ctypes.c_double),
                             normals=_ptr(out["normals"], ctypes.c_double),
                             face_verts=_ptr(out.get("face_verts"), ctypes.c_int32),
                             face_origin=_ptr(out.get("face_origin"), ctypes.c_int32),
                             corner_normals=_ptr(out.get("corner_normals"), ctypes.c_double),
-                            corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32))
+                            corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32),
+                            edge_verts=_ptr(out.get("edge_verts"), ctypes.c_int32),
+                            corner_edges=_ptr(out.get("corner_edges"), ctypes.c_int32))
         pos = None
         if positions is not None:
             pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)

@@ -77,12 +77,13 @@ def write_topology(me, res, cage, exact=True):
     compat.set_array(me, "positions", pos)
     compat.set_array(me, "corner_verts", fv)
     compat.set_face_loops(me, np.arange(0, 4 * nf, 4, dtype=np.int32), np.full(nf, 4, np.int32))
+    edges = compat.set_edges(me, res["edge_verts"].ravel(), res["corner_edges"].ravel())
     compat.set_all_smooth(me)
     if cage.material_index is not None and cage.material_index.any():  # all 0: no attribute
         origin = np.clip(res["face_origin"], 0, len(cage.material_index) - 1)
         compat.set_material_index(me, cage.material_index[origin])
     me.attributes.new(LIMIT_ATTR, 'BOOLEAN', 'FACE').data.foreach_set("value", np.ones(nf, bool))
-    me.update(calc_edges=True)
+    me.update(calc_edges=not edges)
     write_creases(me, res, cage)
     write_normals(me, res, exact)
 

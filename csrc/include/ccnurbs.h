@@ -235,6 +235,7 @@ typedef struct {
                                  above the cap level (they would change no output sample); the
                                  finite patch set (ccn_plan_patches, ccn_plan_export) needs them:
                                  a plan one level finer builds them */
+    int32_t num_edges;        /* output mesh edges (those of its faces) */
 } ccn_sizes;
 
 /* Caller-owned output buffers; sizes from ccn_plan_sizes. */
@@ -253,6 +254,10 @@ typedef struct {
                                cage's face_verts, so its edge is face_verts[j] -> the face's next
                                corner), or -1 inside the cage face; may be NULL. Carries
                                creases, seams and sharp marks over to the limit mesh. */
+    int32_t *edge_verts;  /* 2 * num_edges: the output edges' vertices (in the order the faces
+                             first use them), may be NULL */
+    int32_t *corner_edges;/* 4 * num_faces: the edge from corner k to corner k+1 of each face,
+                             an index into edge_verts; may be NULL */
 } ccn_limit_mesh;
 
 /* Output topology: the level-L refinement of the cage, i.e. every cage quad sampled on a

@@ -37,6 +37,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t i = 0; i < p->nops; i++) ccn__bi5_destroy(p->ops[i]);
     free(p->ops); free(p->op_n); free(p->caps); free(p->prep); free(p->lev);
     free(p->vmapL); free(p->out_vL); free(p->out_fv); free(p->out_origin); free(p->out_eorigin);
+    free(p->out_ev); free(p->out_ce);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
@@ -100,6 +101,7 @@ static void fill_sizes(ccn_plan *p) {
     s->levels = p->L;
     s->refine_levels = p->R;
     s->num_caps_deferred = p->caps_deferred;
+    s->num_edges = p->nout_e;
     s->num_extraordinary = p->R >= 1 ? p->lev[1]->info.num_extraordinary : c->num_extraordinary;
     s->num_ev_fallbacks = r->num_ev_fallbacks;
     s->num_ring_conflicts = c->num_ring_conflicts;
@@ -284,5 +286,7 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
     if (out->corner_edge_origin)
         memcpy(out->corner_edge_origin, p->out_eorigin, sizeof(int32_t) * 4 * (size_t)p->nout_f);
+    if (out->edge_verts) memcpy(out->edge_verts, p->out_ev, sizeof(int32_t) * 2 * (size_t)p->nout_e);
+    if (out->corner_edges) memcpy(out->corner_edges, p->out_ce, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
 }

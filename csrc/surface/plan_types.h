@@ -46,6 +46,7 @@ struct ccn_plan {
     int32_t *out_vL;        /* output vertex -> level-L vertex */
     int32_t *out_fv, *out_origin;
     int32_t *out_eorigin;   /* 4 * nout_f: cage edge under each face corner's outgoing edge */
+    int32_t nout_e, *out_ev, *out_ce; /* output edges: 2 * nout_e vertices, 4 * nout_f per corner */
     /* limit stencils, CSR; index < lev[L]->nv: a level-L vertex, else (index - lev[L]->nv)
      * is a level-(L+1) point (face points, edge points, vertex points) */
     int32_t *st_start, *st_v;

@@ -28,6 +28,27 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     }
     p->nout_v = no;
     p->nout_f = mL->nf;
+    /* the output edges, numbered like the vertices: in the order the faces first use them */
+    int32_t *emap = malloc(sizeof(int32_t) * (size_t)(mL->ne ? mL->ne : 1)), ne = 0;
+    p->out_ce = malloc(sizeof(int32_t) * (size_t)(mL->nh ? mL->nh : 1));
+    p->out_ev = malloc(sizeof(int32_t) * 2 * (size_t)(mL->ne ? mL->ne : 1));
+    if (!emap || !p->out_ce || !p->out_ev) {
+        free(emap);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    }
+    for (int32_t e = 0; e < mL->ne; e++) emap[e] = -1;
+    for (int32_t h = 0; h < mL->nh; h++) {
+        int32_t e = mL->hedge[h];
+        if (emap[e] < 0) {
+            emap[e] = ne;
+            p->out_ev[2 * (size_t)ne] = p->vmapL[mL->everts[2 * (size_t)e]];
+            p->out_ev[2 * (size_t)ne + 1] = p->vmapL[mL->everts[2 * (size_t)e + 1]];
+            ne++;
+        }
+        p->out_ce[h] = emap[e];
+    }
+    p->nout_e = ne;
+    free(emap);
     p->out_vL = malloc(sizeof(int32_t) * (size_t)(no ? no : 1));
     if (!p->out_vL) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
     for (int32_t v = 0; v < mL->nv; v++)

@@ -39,6 +39,20 @@ class TestModifier(AddonTestCase):
         for p in ccn.modifier.proxies(ob):
             self.assertEqual(len(p.users_collection), 0, "proxy must not be in a scene")
         self.assertNotIn(ccn.modifier.proxy(ob, 'VIEW'), list(bpy.context.scene.objects))
+        # the limit mesh as written (its edges given by the library on 4.0+): Blender's own
+        # check finds nothing to fix, and its edges are those of its faces
+        pm = ccn.modifier.proxy(ob, 'VIEW').data
+        self.assertIs(pm.copy().validate(verbose=True), False, "the limit mesh needed fixing")
+        corner_edges = np.empty(len(pm.loops), np.int32)
+        pm.loops.foreach_get("edge_index", corner_edges)
+        lv = np.empty(len(pm.loops), np.int32)
+        pm.loops.foreach_get("vertex_index", lv)
+        ev = np.empty(2 * len(pm.edges), np.int32)
+        pm.edges.foreach_get("vertices", ev)
+        nxt = lv.reshape(-1, 4)[:, [1, 2, 3, 0]].ravel()
+        pairs = np.sort(np.column_stack([lv, nxt]), 1)
+        self.assertEqual(len(pm.edges), len(np.unique(pairs, axis=0)))
+        np.testing.assert_array_equal(np.sort(ev.reshape(-1, 2)[corner_edges], 1), pairs)
 
     def test_closed_cage_with_ngons(self):
         ob = add_modifier(load_cage("Prism", os.path.join(DATA, "ngon_prism.obj")), levels=2)

@@ -4,7 +4,7 @@
 #include "ccnurbs.h"
 #include "testlib.h"
 
-typedef struct { int32_t nv, nf; double *pos, *nrm; int32_t *fv, *origin; ccn_sizes s; } limit_mesh;
+typedef struct { int32_t nv, nf; double *pos, *nrm; int32_t *fv, *origin, *ev, *ce; ccn_sizes s; } limit_mesh;
 
 
 static ccn_obj *load(const char *name, ccn_cage *cage) {
@@ -31,14 +31,19 @@ static int evaluate(const ccn_cage *cage, const ccn_options *o, const double *po
     lm->nrm = malloc(sizeof(double) * 3 * lm->nv);
     lm->fv = malloc(sizeof(int32_t) * 4 * lm->nf);
     lm->origin = malloc(sizeof(int32_t) * lm->nf);
-    ccn_limit_mesh out = {.positions = lm->pos, .normals = lm->nrm, .face_verts = lm->fv, .face_origin = lm->origin};
+    lm->ev = malloc(sizeof(int32_t) * 2 * (lm->s.num_edges ? lm->s.num_edges : 1));
+    lm->ce = malloc(sizeof(int32_t) * 4 * lm->nf);
+    ccn_limit_mesh out = {.positions = lm->pos, .normals = lm->nrm, .face_verts = lm->fv, .face_origin = lm->origin,
+                          .edge_verts = lm->ev, .corner_edges = lm->ce};
     int rc = ccn_plan_evaluate(p, pos, &out, &err) ? -1 : 0;
     if (rc) fprintf(stderr, "evaluate: %s\n", err.message);
     ccn_plan_destroy(p);
     return rc;
 }
 
-static void free_lm(limit_mesh *lm) { free(lm->pos); free(lm->nrm); free(lm->fv); free(lm->origin); }
+static void free_lm(limit_mesh *lm) {
+    free(lm->pos); free(lm->nrm); free(lm->fv); free(lm->origin); free(lm->ev); free(lm->ce);
+}
 
 static double bbox_size(const double *p, int n) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -76,6 +81,21 @@ static int check_watertight(const limit_mesh *lm, const char *what) {
         if (!bsearch(&r, k, 4 * (size_t)lm->nf, sizeof *k, cmp_edge)) boundary++;
     }
     CHECK(dup == 0, "%s: %d directed edges used twice", what, dup);
+    /* the output edges: one per undirected face edge, each corner's the pair of its corners */
+    int32_t ne = lm->s.num_edges, bad = 0, *used = calloc((size_t)(ne ? ne : 1), sizeof(int32_t));
+    CHECK(2 * ne == 4 * lm->nf + boundary, "%s: %d edges, faces have %d", what, (int)ne,
+          (4 * lm->nf + boundary) / 2);
+    for (int f = 0; f < lm->nf; f++)
+        for (int j = 0; j < 4; j++) {
+            int32_t e = lm->ce[4 * f + j], a = lm->fv[4 * f + j], b = lm->fv[4 * f + (j + 1) % 4];
+            if (e < 0 || e >= ne) { bad++; continue; }
+            used[e]++;
+            bad += !((lm->ev[2 * e] == a && lm->ev[2 * e + 1] == b) ||
+                     (lm->ev[2 * e] == b && lm->ev[2 * e + 1] == a));
+        }
+    for (int32_t e = 0; e < ne; e++) bad += used[e] < 1 || used[e] > 2;
+    CHECK(bad == 0, "%s: %d face corners or edges do not match the output edges", what, bad);
+    free(used);
     free(k);
     return boundary;
 }
