@@ -4,6 +4,7 @@
 #include "surface/tessellate.h"
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "surface/limit.h"
 
 #include <string.h>
@@ -171,54 +172,145 @@ static int push_sectors(ccn_plan *p, const ccn_mesh *mL, int32_t v, int32_t o,
     return 0;
 }
 
+/* The regular output vertices away from irregular ones (the tensor B-spline 3 x 3 stencil of
+ * surface/limit.c, at most FAST_MAX entries) are independent of each other: they are made in
+ * the plan's threads, each into FAST_MAX slots of the table; the others (near irregular
+ * vertices) one after the other, in output order, as they share the ring scratch, the EV choice
+ * cache and the sector arrays. The table is then packed in place (entries only move down). */
+#define FAST_MAX 9
+
+typedef struct {
+    const ccn_plan *p;
+    const ccn_mesh *mL;
+    int pinned;
+    uint8_t *irr;          /* per level-L vertex */
+    uint8_t *fast;         /* per output vertex */
+    const int32_t *slot;   /* per output vertex: its first entry in the unpacked table */
+    int32_t *len;          /* per output vertex: its entries */
+    const csr_buf *ib;     /* the irregular stencils, in output order */
+    const int32_t *istart; /* per output vertex: its first entry in ib (irregular ones) */
+    csr_buf *b;            /* the table */
+} stencil_job;
+
+static void irr_range(void *ctx, int32_t begin, int32_t end) {
+    stencil_job *j = ctx;
+    for (int32_t v = begin; v < end; v++)
+        j->irr[v] = ccn__limit_kind(j->mL, v, j->pinned) != CCN_LIMIT_REGULAR;
+}
+
+static void fast_range(void *ctx, int32_t begin, int32_t end) {
+    stencil_job *j = ctx;
+    for (int32_t o = begin; o < end; o++) j->fast[o] = !near_irregular(j->mL, j->p->out_vL[o], j->irr);
+}
+
+static void fill_range(void *ctx, int32_t begin, int32_t end) {
+    stencil_job *j = ctx;
+    ccn__stencil *s = malloc(sizeof *s);
+    csr_buf *b = j->b;
+    for (int32_t o = begin; o < end; o++) {
+        int32_t at = j->slot[o];
+        if (!j->fast[o]) { /* made serially: copied into place */
+            int32_t from = j->istart[o], n = j->len[o];
+            memcpy(b->v + at, j->ib->v + from, sizeof(int32_t) * (size_t)n);
+            memcpy(b->wp + at, j->ib->wp + from, sizeof(double) * (size_t)n);
+            memcpy(b->wu + at, j->ib->wu + from, sizeof(double) * (size_t)n);
+            memcpy(b->wv + at, j->ib->wv + from, sizeof(double) * (size_t)n);
+            continue;
+        }
+        j->len[o] = -1; /* failed: no scratch, or more than FAST_MAX entries */
+        if (!s) continue;
+        ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
+        if (s->n > FAST_MAX) continue;
+        memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
+        memcpy(b->wp + at, s->wp, sizeof(double) * (size_t)s->n);
+        memcpy(b->wu + at, s->wu, sizeof(double) * (size_t)s->n);
+        memcpy(b->wv + at, s->wv, sizeof(double) * (size_t)s->n);
+        j->len[o] = s->n;
+    }
+    free(s);
+}
+
 static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    int32_t nout = p->nout_v;
+    size_t nslot = (size_t)(nout ? nout : 1);
     ccn__stencil *s = malloc(sizeof *s);
     ccn__ring_limit *ring = malloc(sizeof *ring);
     ccn__ring_work *work = ccn__ring_work_create();
     if (work) ccn__ring_work_set_ev(work, p->opts.ev_polyhedron, p->ev_cache);
     csr_buf b = {0, 0, NULL, NULL, NULL, NULL}, sb = {0, 0, NULL, NULL, NULL, NULL};
+    csr_buf ib = {0, 0, NULL, NULL, NULL, NULL};
     int32_t cap_sv = 0, cap_sec = 0;
-    p->st_start = malloc(sizeof(int32_t) * ((size_t)p->nout_v + 1));
+    int32_t *slot = malloc(sizeof(int32_t) * (nslot + 1)), *len = malloc(sizeof(int32_t) * nslot);
+    int32_t *istart = malloc(sizeof(int32_t) * nslot);
+    stencil_job j = {p, mL, pinned, malloc((size_t)(mL->nv ? mL->nv : 1)), malloc(nslot), slot,
+                     len, &ib, istart, &b};
+    p->st_start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
     p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
-    uint8_t *irr = malloc((size_t)(mL->nv ? mL->nv : 1));
     ccn_status st = CCN_OK;
-    if (!s || !ring || !work || !p->st_start || !p->near || !irr) {
+    if (!s || !ring || !work || !p->st_start || !p->near || !slot || !len || !istart || !j.irr ||
+        !j.fast) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
-    /* sized for 3 x 3 stencils (every regular vertex): no regrowth, no copies, on most cages
-     * (issue 15: the doubling reallocs were ~20 % of plan creation on the 8k sphere) */
-    if (csr_reserve(&b, 9 * (int64_t)p->nout_v + 1024) &&
-        csr_reserve(&b, (int64_t)p->nout_v + 1024)) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
-        goto done;
-    }
-    p->st_start[0] = 0;
     p->nnear = 0;
-    for (int32_t v = 0; v < mL->nv; v++) irr[v] = ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_REGULAR;
-    for (int32_t o = 0; o < p->nout_v; o++) {
+    ccn__parallel_for(p->threads, mL->nv, irr_range, &j);
+    ccn__parallel_for(p->threads, nout, fast_range, &j);
+    /* the irregular ones, in output order */
+    for (int32_t o = 0; o < nout; o++) {
+        if (j.fast[o]) continue;
         int32_t v = p->out_vL[o];
-        if (!near_irregular(mL, v, irr)) {
-            ccn__limit_stencil(mL, v, pinned, s);
-        } else {
-            p->near[p->nnear++] = v;
-            st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, p->opts.crease_method, work,
-                                          s, ring, err);
-            if (st) goto done;
-            offset_stencil(s, mL->nv);
-            if (ring->nsec > 1 && push_sectors(p, mL, v, o, ring, &sb, &cap_sv, &cap_sec)) {
-                st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
-                goto done;
-            }
-        }
-        if (csr_push(&b, s)) {
+        p->near[p->nnear++] = v;
+        st = ccn__child_limit_stencil(mL, v, pinned, p->opts.scheme, p->opts.crease_method, work,
+                                      s, ring, err);
+        if (st) goto done;
+        offset_stencil(s, mL->nv);
+        if (ring->nsec > 1 && push_sectors(p, mL, v, o, ring, &sb, &cap_sv, &cap_sec)) {
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
             goto done;
         }
-        p->st_start[o + 1] = b.n;
+        istart[o] = ib.n;
+        len[o] = s->n;
+        if (csr_push(&ib, s)) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+            goto done;
+        }
     }
+    /* FAST_MAX slots per regular one, the irregular ones' own size; made, then packed */
+    slot[0] = 0;
+    for (int32_t o = 0; o < nout; o++) {
+        int64_t next = (int64_t)slot[o] + (j.fast[o] ? FAST_MAX : len[o]);
+        if (next > INT32_MAX) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "stencil table too large");
+            goto done;
+        }
+        slot[o + 1] = (int32_t)next;
+    }
+    if (csr_reserve(&b, (int64_t)slot[nout] + 1)) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+        goto done;
+    }
+    ccn__parallel_for(p->threads, nout, fill_range, &j);
+    for (int32_t o = 0; o < nout; o++)
+        if (len[o] < 0) {
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_VERTEX, o,
+                           "output vertex %d: out of memory, or a regular stencil above %d entries",
+                           (int)o, FAST_MAX);
+            goto done;
+        }
+    p->st_start[0] = 0;
+    for (int32_t o = 0; o < nout; o++) { /* entries move down only: slot[o] >= st_start[o] */
+        int32_t to = p->st_start[o], from = slot[o], n = len[o];
+        if (to != from) {
+            memmove(b.v + to, b.v + from, sizeof(int32_t) * (size_t)n);
+            memmove(b.wp + to, b.wp + from, sizeof(double) * (size_t)n);
+            memmove(b.wu + to, b.wu + from, sizeof(double) * (size_t)n);
+            memmove(b.wv + to, b.wv + from, sizeof(double) * (size_t)n);
+        }
+        p->st_start[o + 1] = to + n;
+    }
+    b.n = p->st_start[nout];
     if (p->nsec) {
         p->sec_nrm = malloc(sizeof(double) * 3 * (size_t)p->nsec);
         if (!p->sec_nrm) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
@@ -227,10 +319,11 @@ done:
     p->st_v = b.v; p->st_wp = b.wp; p->st_wu = b.wu; p->st_wv = b.wv;
     p->sec_v = sb.v; p->sec_wu = sb.wu; p->sec_wv = sb.wv;
     free(sb.wp);
+    free(ib.v); free(ib.wp); free(ib.wu); free(ib.wv);
+    free(slot); free(len); free(istart); free(j.irr); free(j.fast);
     free(s);
     free(ring);
     ccn__ring_work_destroy(work);
-    free(irr);
     return st;
 }
 
