@@ -79,16 +79,6 @@ static int push(wbuf *b, const ccn__stencil *s, int32_t off) {
     return 0;
 }
 
-static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irr) {
-    if (irr[v]) return 1;
-    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-        int32_t f = m->hface[m->vfan[k]];
-        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
-            if (irr[m->hvert[h]]) return 1;
-    }
-    return 0;
-}
-
 /* A value vertex u at an interior EV of the value mesh has the vertex's fan, intervals and
  * scheme: its child stencil is the positions' stencil of vertex v, renumbered (level L+1 face
  * points keep their index, the edge points of v's spokes and v's vertex point map to u's). */
@@ -161,7 +151,7 @@ static void fast_range(void *ctx, int32_t b, int32_t end) {
     ccn__stencil *s = malloc(sizeof *s);
     for (int32_t v = b; v < end; v++) {
         j->cnt[v] = -1;
-        if (!s || near_irregular(m, v, j->irr)) continue;
+        if (!s || ccn__near_irregular(m, v, j->irr)) continue;
         ccn__limit_stencil(m, v, 0, s);
         if (s->n > FAST_MAX) continue;
         for (int i = 0; i < s->n; i++) {
@@ -213,7 +203,7 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
         if (fj.cnt[v] >= 0) continue;
         int32_t off = 0;
         partner_semisharp(fl, v, p->opts.crease_method, &dep);
-        if (!near_irregular(m, v, fj.irr)) {
+        if (!ccn__near_irregular(m, v, fj.irr)) {
             ccn__limit_stencil(m, v, 0, s);
         } else if (dep > 0.0f) { /* the partner's sharpness as its own */
             c->near[c->nnear++] = v;

@@ -223,6 +223,16 @@ int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned) {
     return CCN_LIMIT_BOUNDARY_CURVE;
 }
 
+int ccn__near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irregular) {
+    if (irregular[v]) return 1;
+    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+        int32_t f = m->hface[m->vfan[k]];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
+            if (irregular[m->hvert[h]]) return 1;
+    }
+    return 0;
+}
+
 int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
     int kind = ccn__limit_kind(m, v, pinned);
     s->n = 0;

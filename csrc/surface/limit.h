@@ -44,6 +44,9 @@ void ccn__fan_sector(const ccn_mesh *m, int32_t v, int32_t k, int32_t *first, in
 int ccn__sector_regular(const ccn_mesh *m, int32_t v, int32_t k, int pinned);
 
 int ccn__limit_kind(const ccn_mesh *m, int32_t v, int pinned);
+/* Is v, or a vertex of one of its faces, flagged in `irregular` (then its level-L box does not
+ * refine by knot insertion and its limit needs level L+1)? */
+int ccn__near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irregular);
 /* Fills s for REGULAR / BOUNDARY_CURVE / ISOLATED vertices; returns the kind (for EV the
  * stencil is left empty). */
 int ccn__limit_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s);

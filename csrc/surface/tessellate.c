@@ -103,18 +103,6 @@ static int csr_push(csr_buf *b, const ccn__stencil *s) {
     return 0;
 }
 
-/* Is v, or a vertex of one of its faces, irregular (then its level-L box does not refine by
- * knot insertion and its limit needs level L+1)? */
-static int near_irregular(const ccn_mesh *m, int32_t v, const uint8_t *irregular) {
-    if (irregular[v]) return 1;
-    for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-        int32_t f = m->hface[m->vfan[k]];
-        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++)
-            if (irregular[m->hvert[h]]) return 1;
-    }
-    return 0;
-}
-
 static void offset_stencil(ccn__stencil *s, int32_t off) {
     for (int i = 0; i < s->n; i++) s->v[i] += off;
 }
@@ -200,7 +188,7 @@ static void irr_range(void *ctx, int32_t begin, int32_t end) {
 
 static void fast_range(void *ctx, int32_t begin, int32_t end) {
     stencil_job *j = ctx;
-    for (int32_t o = begin; o < end; o++) j->fast[o] = !near_irregular(j->mL, j->p->out_vL[o], j->irr);
+    for (int32_t o = begin; o < end; o++) j->fast[o] = !ccn__near_irregular(j->mL, j->p->out_vL[o], j->irr);
 }
 
 static void fill_range(void *ctx, int32_t begin, int32_t end) {
