@@ -47,34 +47,32 @@ scope=$(python3 tests/data/osd/extract_shapes.py --scope "$dir") || {
 [ -n "${OSD_SHAPES_ONLY:-}" ] && scope=$OSD_SHAPES_ONLY
 
 pass=0; fail=0; shapes=0
-for name in $scope; do
-  in="$dir/$name.obj"
-  grep -q '^vt' "$in" 2>/dev/null || continue
-  shapes=$((shapes + 1))
+# fvar_oracle on one OBJ ($1; $2 names it in a failure): its lines, and its counts added up
+oracle_run() {
+  in=$1
   $TO "$TOOL" --levels "${FVAR_LEVELS:-1 2 3}" --schemes "${FVAR_SCHEMES:-cc,eigen}" "$in" >"$tmp/out" 2>&1
   rc=$?
   grep -v 'passed, .* failed$' "$tmp/out"
   p=$(sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$tmp/out")
   f=$(sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$tmp/out")
   if [ -z "$p" ] || { [ "$rc" -ne 0 ] && [ "${f:-0}" -eq 0 ]; }; then
-    echo "FAIL $name fvar_oracle exited $rc"; fail=$((fail + 1)); p=${p:-0}; f=0
+    echo "FAIL $2 fvar_oracle exited $rc"; fail=$((fail + 1)); p=${p:-0}; f=0
   fi
   pass=$((pass + p)); fail=$((fail + f))
+}
+
+for name in $scope; do
+  in="$dir/$name.obj"
+  grep -q '^vt' "$in" 2>/dev/null || continue
+  shapes=$((shapes + 1))
+  oracle_run "$in" "$name"
 done
 [ "$shapes" -gt 0 ] || { echo "FAIL no shape with a UV map"; fail=$((fail + 1)); }
 
 # Two cages of our own for what the shapes lack: OpenSubdiv's dependent sharpness (a semi-sharp
 # crease ending at a seam, CORNERS_PLUS1/2) and its A, B, A, B sibling count (NONE).
 for in in tests/data/fvar_dependent.obj tests/data/fvar_abab.obj; do
-  $TO "$TOOL" --levels "${FVAR_LEVELS:-1 2 3}" --schemes "${FVAR_SCHEMES:-cc,eigen}" "$in" >"$tmp/out" 2>&1
-  rc=$?
-  grep -v 'passed, .* failed$' "$tmp/out"
-  p=$(sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$tmp/out")
-  f=$(sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$tmp/out")
-  if [ -z "$p" ] || { [ "$rc" -ne 0 ] && [ "${f:-0}" -eq 0 ]; }; then
-    echo "FAIL $in fvar_oracle exited $rc"; fail=$((fail + 1)); p=${p:-0}; f=0
-  fi
-  pass=$((pass + p)); fail=$((fail + f))
+  oracle_run "$in" "$in"
 done
 
 # The CLI's UV path (OBJ vt in, refined / limit vt out) on a few shapes, against osd_refine's
