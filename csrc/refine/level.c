@@ -43,13 +43,15 @@
 
 typedef struct { const ccn__level *c; double *fp, *ep, *vp; } points_job;
 
+static void one_face_point(const ccn__level *c, int32_t f, double *fp) {
+    const ccn_mesh *m = c->m;
+    if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
+    else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
+}
+
 static void face_range(void *ctx, int32_t b, int32_t e) {
     const points_job *j = ctx;
-    const ccn_mesh *m = j->c->m;
-    for (int32_t f = b; f < e; f++) {
-        if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, j->c->pinned, j->fp + 3 * (size_t)f);
-        else ccn__ngon_face_point(m, f, j->fp + 3 * (size_t)f);
-    }
+    for (int32_t f = b; f < e; f++) one_face_point(j->c, f, j->fp);
 }
 
 /* Edge point of a sharp interior edge e (OpenSubdiv's ComputeEdgeVertexMask with the
@@ -144,22 +146,23 @@ static void creased_vertex_point(const ccn__level *c, int32_t v, const double *f
     if (ps != sbuf) free(ps);
 }
 
+static void one_vertex_point(const ccn__level *c, int32_t v, const double *fp, double *vp) {
+    const ccn_mesh *m = c->m;
+    double *out = vp + 3 * (size_t)v;
+    if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
+        memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
+    } else if (m->esharp) {
+        creased_vertex_point(c, v, fp, out);
+    } else if (m->vboundary[v]) {
+        ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
+    } else {
+        ccn__nurss_vertex_point(m, v, c->H, fp, out);
+    }
+}
+
 static void vertex_range(void *ctx, int32_t b, int32_t e) {
     const points_job *j = ctx;
-    const ccn__level *c = j->c;
-    const ccn_mesh *m = c->m;
-    for (int32_t v = b; v < e; v++) {
-        double *out = j->vp + 3 * (size_t)v;
-        if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
-            memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
-        } else if (m->esharp) {
-            creased_vertex_point(c, v, j->fp, out);
-        } else if (m->vboundary[v]) {
-            ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
-        } else {
-            ccn__nurss_vertex_point(m, v, c->H, j->fp, out);
-        }
-    }
+    for (int32_t v = b; v < e; v++) one_vertex_point(j->c, v, j->fp, j->vp);
 }
 
 /* ---- red points: the eigen matrix M at each EV ------------------------------------ */
@@ -396,6 +399,40 @@ void ccn__level_points(const ccn__level *c, double *out) {
     ccn__parallel_for(c->threads, m->ne, edge_range, &j);
     apply_red(c, 1, fp, ep, vp);
     ccn__parallel_for(c->threads, m->nv, vertex_range, &j);
+    apply_red(c, 2, fp, ep, vp);
+}
+
+/* The listed points only (face-varying probes, surface/fvar_compose.c). */
+typedef struct { const ccn__level *c; double *fp, *ep, *vp; const int32_t *list; } list_job;
+
+static void face_list_range(void *ctx, int32_t b, int32_t e) {
+    const list_job *j = ctx;
+    for (int32_t i = b; i < e; i++) one_face_point(j->c, j->list[i], j->fp);
+}
+
+static void edge_list_range(void *ctx, int32_t b, int32_t e) {
+    const list_job *j = ctx;
+    for (int32_t i = b; i < e; i++) one_edge_point(j->c, j->list[i], j->fp, j->ep + 3 * (size_t)j->list[i]);
+}
+
+static void vertex_list_range(void *ctx, int32_t b, int32_t e) {
+    const list_job *j = ctx;
+    for (int32_t i = b; i < e; i++) one_vertex_point(j->c, j->list[i], j->fp, j->vp);
+}
+
+void ccn__level_points_lists(const ccn__level *c, const int32_t *faces, int32_t nfaces,
+                             const int32_t *edges, int32_t nedges, const int32_t *verts,
+                             int32_t nverts, double *out) {
+    const ccn_mesh *m = c->m;
+    double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
+    list_job j = {c, fp, ep, vp, faces};
+    ccn__parallel_for(c->threads, nfaces, face_list_range, &j);
+    apply_red(c, 0, fp, ep, vp);
+    j.list = edges;
+    ccn__parallel_for(c->threads, nedges, edge_list_range, &j);
+    apply_red(c, 1, fp, ep, vp);
+    j.list = verts;
+    ccn__parallel_for(c->threads, nverts, vertex_list_range, &j);
     apply_red(c, 2, fp, ep, vp);
 }
 

@@ -40,6 +40,11 @@ void ccn__level_points(const ccn__level *c, double *out);
 /* Next-level points around the listed vertices only (see refine/level.c). */
 void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
                               double *out);
+/* The next-level points of the listed faces, edges and vertices only (each once; every EV's
+ * red points too). A point is right when the old points its rule reads are. */
+void ccn__level_points_lists(const ccn__level *c, const int32_t *faces, int32_t nfaces,
+                             const int32_t *edges, int32_t nedges, const int32_t *verts,
+                             int32_t nverts, double *out);
 /* Topology and intervals of the next level (positions uninitialised). */
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
 void ccn__level_free(ccn__level *c);
