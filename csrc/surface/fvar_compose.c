@@ -16,6 +16,11 @@
  * stencil's weights must sum to 1 (affine invariance), which checks the neighbourhood bound.
  * Evaluation is then one sparse product per channel, and the levels are freed. Mode ALL
  * (bilinear) composes the same way from its level-L values.
+ *
+ * Outputs on a cage face whose value mesh is a regular grid around it get their weights
+ * written down instead (the bicubic B-spline patch, surface/fvar_direct.c); the probes then
+ * compute only the points the other outputs read (probe_lists) and colour only the value
+ * vertices around the other faces.
  */
 #include "surface/fvar_compose.h"
 
@@ -23,10 +28,14 @@
 #include "base/parallel.h"
 #include "refine/fvar.h"
 #include "rules/crease.h"
+#include "surface/fvar_direct.h"
 #include "surface/limit.h"
 
 #include <math.h>
 #include <string.h>
+
+/* The points of one level that the probes compute: those the composed outputs read. */
+typedef struct { int32_t nf, ne, nv, *f, *e, *v; } probe_list;
 
 /* The channel's refinement, kept while its stencils are composed. */
 typedef struct {
@@ -40,6 +49,11 @@ typedef struct {
     double *st_w;
     double *posS;             /* level-(L+1) points, 3 * (nf + ne + nv) of level L */
     int32_t *value_of;        /* level-0 value vertex -> cage value */
+    int32_t *fo;              /* level-L value vertex -> the cage face it lies on */
+    uint8_t *direct;          /* level-L value vertex: weights written down (surface/fvar_direct.c) */
+    ccn__fvar_direct dir;
+    probe_list *pl;           /* L levels' points the probes need (NULL: all) */
+    int32_t nouts, *outs;     /* the outputs composed by probing */
 } builder;
 
 static void builder_free(builder *c) {
@@ -47,7 +61,10 @@ static void builder_free(builder *c) {
     for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
     if (c->has_sub) ccn__level_free(&c->sub);
     free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
-    free(c->posS); free(c->value_of);
+    free(c->posS); free(c->value_of); free(c->fo); free(c->direct); free(c->outs);
+    ccn__fvar_direct_free(&c->dir);
+    for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
+    free(c->pl);
     memset(c, 0, sizeof *c);
 }
 
@@ -131,6 +148,7 @@ static int partner_semisharp(const ccn__fvar_level *fl, int32_t v, int method, f
 typedef struct {
     const ccn__fvar_level *fl;
     int method;
+    const uint8_t *skip; /* outputs with written-down weights: no limit stencil */
     uint8_t *irr;
     int32_t *cnt;     /* entries of a vertex's fast stencil; -1: made serially */
     int32_t *sv;      /* FAST_MAX slots per vertex */
@@ -141,8 +159,9 @@ static void irr_range(void *ctx, int32_t b, int32_t end) {
     const fast_job *j = ctx;
     const ccn_mesh *m = j->fl->m;
     float dep;
-    for (int32_t v = b; v < end; v++)
-        j->irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(j->fl, v, j->method, &dep);
+    for (int32_t v = b; v < end; v++) /* a written-down output lies inside a regular block */
+        j->irr[v] = !j->skip[v] && (ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR ||
+                                    partner_semisharp(j->fl, v, j->method, &dep));
 }
 
 static void fast_range(void *ctx, int32_t b, int32_t end) {
@@ -151,6 +170,7 @@ static void fast_range(void *ctx, int32_t b, int32_t end) {
     ccn__stencil *s = malloc(sizeof *s);
     for (int32_t v = b; v < end; v++) {
         j->cnt[v] = -1;
+        if (j->skip[v]) { j->cnt[v] = 0; continue; }
         if (!s || ccn__near_irregular(m, v, j->irr)) continue;
         ccn__limit_stencil(m, v, 0, s);
         if (s->n > FAST_MAX) continue;
@@ -185,7 +205,7 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
     ccn__ring_limit *ring = malloc(sizeof *ring);
     ccn__ring_work *work = ccn__ring_work_create();
     wbuf b = {0, 0, NULL, NULL};
-    fast_job fj = {fl, p->opts.crease_method, malloc(nv), malloc(sizeof(int32_t) * nv),
+    fast_job fj = {fl, p->opts.crease_method, c->direct, malloc(nv), malloc(sizeof(int32_t) * nv),
                    malloc(sizeof(int32_t) * FAST_MAX * nv), malloc(sizeof(double) * FAST_MAX * nv)};
     int32_t *sstart = malloc(sizeof(int32_t) * nv); /* a serial stencil's start in b */
     c->st_start = malloc(sizeof(int32_t) * ((size_t)m->nv + 1));
@@ -258,6 +278,40 @@ done:
     return st;
 }
 
+/* The cage face a level-L value vertex o lies on, through its first face, and o's coordinates
+ * there when that face is a quad: each level's face is the child quad (V_j, E(h_j), F,
+ * E(h_j-1)) at corner j of its parent (refine/level.c), a quarter of the parent's unit square. */
+static int32_t origin(const ccn_plan *p, const ccn_mesh *mL, int32_t o, double uv[2]) {
+    static const double C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    int32_t h = mL->vfan[mL->vfan_start[o]], g = mL->hface[h], j = h - mL->fstart[g];
+    double s = C[j & 3][0], t = C[j & 3][1];
+    for (int32_t l = p->L; l > 0; l--) {
+        const ccn_mesh *m = p->lev[l - 1];
+        int32_t f = m->hface[g], k = g - m->fstart[f];
+        if (uv && ccn__fsize(m, f) == 4) {
+            const double *c0 = C[k], *c1 = C[(k + 1) & 3], *cm = C[(k + 3) & 3];
+            double x = c0[0] + 0.5 * (s * (c1[0] - c0[0]) + t * (cm[0] - c0[0]));
+            double y = c0[1] + 0.5 * (s * (c1[1] - c0[1]) + t * (cm[1] - c0[1]));
+            s = x; t = y;
+        }
+        g = f;
+    }
+    if (uv) { uv[0] = s; uv[1] = t; }
+    return g;
+}
+
+typedef struct { const ccn_plan *p; builder *c; } origin_job;
+
+static void origin_range(void *ctx, int32_t b, int32_t end) {
+    const origin_job *j = ctx;
+    builder *c = j->c;
+    const ccn_mesh *mL = c->lev[c->L].m;
+    for (int32_t o = b; o < end; o++) {
+        c->fo[o] = origin(j->p, mL, o, NULL);
+        c->direct[o] = c->dir.slot && c->dir.slot[c->fo[o]] >= 0;
+    }
+}
+
 static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *c, ccn_error *err) {
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     c->L = p->L;
@@ -279,6 +333,18 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
             return st;
     }
     const ccn_mesh *mL = c->lev[c->L].m;
+    c->fo = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    c->direct = malloc((size_t)(mL->nv ? mL->nv : 1));
+    if (!c->fo || !c->direct || (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir)))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    origin_job oj = {p, c};
+    ccn__parallel_for(p->threads, mL->nv, origin_range, &oj);
+    for (int32_t o = 0; o < mL->nv; o++) c->nouts += !c->direct[o];
+    if (!(c->outs = malloc(sizeof(int32_t) * (size_t)(c->nouts + 1))))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    c->nouts = 0;
+    for (int32_t o = 0; o < mL->nv; o++)
+        if (!c->direct[o]) c->outs[c->nouts++] = o;
     if (!c->bilinear && (st = limit_stencils(p, c, err))) return st;
     if (c->nnear) {
         if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method,
@@ -294,7 +360,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
 /* One probe pass's limit values, read off as they are made: output o's limit of the level-L
  * values (3 components: colours 3b .. 3b+2 set to 1) is the weight of each of o's candidates
  * (row start[o] .. start[o+1]) with one of those colours. */
-typedef struct { const builder *c; const int32_t *start, *ccol; double *cw; int32_t b; } limit_job;
+typedef struct { const builder *c; const int32_t *start, *ccol, *outs; double *cw; int32_t b; } limit_job;
 
 static void limit_range(void *ctx, int32_t b, int32_t end) {
     const limit_job *j = ctx;
@@ -303,7 +369,8 @@ static void limit_range(void *ctx, int32_t b, int32_t end) {
     const double *PL = mL->pos, *PS = c->posS;
     const int32_t *start = j->start, *ccol = j->ccol, c0 = 3 * j->b;
     int32_t nvL = mL->nv;
-    for (int32_t o = b; o < end; o++) {
+    for (int32_t i = b; i < end; i++) {
+        int32_t o = j->outs ? j->outs[i] : i;
         double x[3];
         if (c->bilinear) memcpy(x, PL + 3 * (size_t)o, sizeof x);
         else {
@@ -328,8 +395,8 @@ static void limit_range(void *ctx, int32_t b, int32_t end) {
 typedef struct { int32_t *start, *list; } csr;
 
 /* K(f): the value vertices at the corners of the faces that share a value vertex with face f
- * (level 0), each once. */
-static int neighbourhoods(const ccn_mesh *m, csr *K) {
+ * (level 0), each once; empty for a regular face (skip[f] >= 0: its weights are written down). */
+static int neighbourhoods(const ccn_mesh *m, const int32_t *skip, csr *K) {
     int32_t cap = 64, n = 0;
     K->start = malloc(sizeof(int32_t) * ((size_t)m->nf + 1));
     K->list = malloc(sizeof(int32_t) * (size_t)cap);
@@ -338,7 +405,7 @@ static int neighbourhoods(const ccn_mesh *m, csr *K) {
     for (int32_t v = 0; v < m->nv; v++) seen[v] = -1;
     K->start[0] = 0;
     for (int32_t f = 0; f < m->nf; f++) {
-        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1] && !(skip && skip[f] >= 0); h++) {
             int32_t u = m->hvert[h];
             for (int32_t q = m->vfan_start[u]; q < m->vfan_start[u + 1]; q++) {
                 int32_t g = m->hface[m->vfan[q]];
@@ -411,13 +478,68 @@ static int32_t colour(const ccn_mesh *m, const csr *K, int32_t *col) {
     return ncol;
 }
 
-/* The cage face each level-L value vertex lies on (through one of its faces). */
-static void origin_faces(const ccn_plan *p, const ccn_mesh *mL, int32_t *fo) {
-    for (int32_t o = 0; o < mL->nv; o++) {
-        int32_t g = mL->hface[mL->vfan[mL->vfan_start[o]]];
-        for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];
-        fo[o] = g;
+/* The points the probes need, level by level, when some outputs have written-down weights.
+ * The outputs composed by probing lie on the cage faces that are not regular, and their limit
+ * stencils read level-L points on those faces and the faces around them (A_0: the faces that
+ * share a vertex with a face that is not regular; A_l: their descendants). Level l computes
+ * the next level's points of the faces around the vertices V_l of A_l, of those vertices'
+ * edges and of the vertices themselves: each reads only level-l corners of faces around V_l,
+ * which the level before computed (level 0 is the input), and an EV's eigen rows read its
+ * ring, where a level-l EV next to V_l is in V_l itself for l >= 1. So the points read at
+ * level L are right. */
+static int probe_lists(builder *c) {
+    int32_t L = c->L, maxf = 0, maxv = 0, maxe = 0;
+    for (int32_t l = 0; l <= L; l++) {
+        const ccn_mesh *m = c->lev[l].m;
+        if (m->nf > maxf) maxf = m->nf;
+        if (m->nv > maxv) maxv = m->nv;
+        if (m->ne > maxe) maxe = m->ne;
     }
+    c->pl = calloc((size_t)(L ? L : 1), sizeof *c->pl);
+    uint8_t *act = malloc((size_t)maxf + 1), *nact = malloc((size_t)maxf + 1);
+    uint8_t *vm = malloc((size_t)maxv + 1), *fm = malloc((size_t)maxf + 1), *em = malloc((size_t)maxe + 1);
+    int ok = c->pl && act && nact && vm && fm && em;
+    const ccn_mesh *m0 = c->lev[0].m;
+    if (ok) {
+        memset(vm, 0, (size_t)m0->nv);
+        for (int32_t f = 0; f < m0->nf; f++)
+            if (c->dir.slot[f] < 0)
+                for (int32_t h = m0->fstart[f]; h < m0->fstart[f + 1]; h++) vm[m0->hvert[h]] = 1;
+        for (int32_t f = 0; f < m0->nf; f++) {
+            act[f] = 0;
+            for (int32_t h = m0->fstart[f]; h < m0->fstart[f + 1]; h++) act[f] |= vm[m0->hvert[h]];
+        }
+    }
+    for (int32_t l = 0; ok && l < L; l++) {
+        const ccn_mesh *m = c->lev[l].m;
+        probe_list *q = &c->pl[l];
+        memset(vm, 0, (size_t)m->nv);
+        memset(fm, 0, (size_t)m->nf);
+        memset(em, 0, (size_t)m->ne);
+        for (int32_t f = 0; f < m->nf; f++)
+            if (act[f])
+                for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) vm[m->hvert[h]] = 1;
+        for (int32_t v = 0; v < m->nv; v++) {
+            if (!vm[v]) continue;
+            q->nv++;
+            for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) fm[m->hface[m->vfan[k]]] = 1;
+            for (int32_t k = 0, n = ccn__valence(m, v); k < n; k++) em[ccn__fan_edge(m, v, k)] = 1;
+        }
+        for (int32_t f = 0; f < m->nf; f++) q->nf += fm[f];
+        for (int32_t e = 0; e < m->ne; e++) q->ne += em[e];
+        q->v = malloc(sizeof(int32_t) * (size_t)(q->nv + 1));
+        q->f = malloc(sizeof(int32_t) * (size_t)(q->nf + 1));
+        q->e = malloc(sizeof(int32_t) * (size_t)(q->ne + 1));
+        if (!q->v || !q->f || !q->e) { ok = 0; break; }
+        q->nv = q->nf = q->ne = 0;
+        for (int32_t v = 0; v < m->nv; v++) if (vm[v]) q->v[q->nv++] = v;
+        for (int32_t f = 0; f < m->nf; f++) if (fm[f]) q->f[q->nf++] = f;
+        for (int32_t e = 0; e < m->ne; e++) if (em[e]) q->e[q->ne++] = e;
+        for (int32_t h = 0; h < m->nh; h++) nact[h] = act[m->hface[h]]; /* child face h */
+        uint8_t *t = act; act = nact; nact = t;
+    }
+    free(act); free(nact); free(vm); free(fm); free(em);
+    return ok ? 0 : -1;
 }
 
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
@@ -427,22 +549,41 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
     ccn_mesh *m0 = c->lev[0].m;
     for (int32_t v = 0; v < m0->nv; v++)
         for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
-    for (int32_t l = 0; l < c->L; l++) ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
+    for (int32_t l = 0; l < c->L; l++) {
+        const probe_list *q = c->pl ? &c->pl[l] : NULL;
+        if (q) ccn__level_points_lists(&c->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, c->lev[l + 1].m->pos);
+        else ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
+    }
     if (c->has_sub) ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
-    limit_job j = {c, start, ccol, cw, b};
-    ccn__parallel_for(p->threads, c->lev[c->L].m->nv, limit_range, &j);
+    limit_job j = {c, start, ccol, c->outs, cw, b};
+    ccn__parallel_for(p->threads, c->nouts, limit_range, &j);
 }
 
 typedef struct {
+    const ccn_plan *p; const builder *c;
     const csr *K; const int32_t *fo, *col, *start;
     int32_t *idx, *ccol;
+    double *w;
 } cand_job;
 
-/* The candidates of each output: the value vertices of its cage face's neighbourhood. */
+/* The candidates of each output: the value vertices of its cage face's neighbourhood; on a
+ * regular face (its 16) with their written-down weights. */
 static void cand_range(void *ctx, int32_t b, int32_t end) {
     const cand_job *j = ctx;
+    const ccn__fvar_direct *d = &j->c->dir;
+    const ccn_mesh *mL = j->c->lev[j->c->L].m;
     for (int32_t o = b; o < end; o++) {
         int32_t n = j->start[o];
+        if (j->c->direct[o]) {
+            double uv[2];
+            int32_t f = origin(j->p, mL, o, uv), sl = d->slot[f];
+            ccn__fvar_direct_weights(d, sl, uv[0], uv[1], j->w + n);
+            for (int k = 0; k < 16; k++) {
+                j->idx[n + k] = d->verts[16 * (size_t)sl + k];
+                j->ccol[n + k] = -1;
+            }
+            continue;
+        }
         for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) {
             j->ccol[n] = j->col[j->K->list[k]];
             j->idx[n] = j->K->list[k];
@@ -450,7 +591,7 @@ static void cand_range(void *ctx, int32_t b, int32_t end) {
     }
 }
 
-typedef struct { ccn__fvar_stencils *s; const int32_t *value_of; int32_t *len; double *sum; } merge_job;
+typedef struct { ccn__fvar_stencils *s; const int32_t *value_of; int32_t *len; double *sum; int unique; } merge_job;
 
 /* Row o in place: zero weights dropped, value vertices -> the caller's values (summed where two
  * value vertices carry one value); len[o] its new length, -1 if the weights do not sum to 1. */
@@ -465,7 +606,7 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
             double we = w[e];
             if (we == 0.0) continue;
             sum += we;
-            int32_t val = j->value_of[idx[e]], q = first;
+            int32_t val = j->value_of[idx[e]], q = j->unique ? n : first;
             while (q < n && idx[q] != val) q++;
             if (q < n) w[q] += we;
             else { idx[n] = val; w[n++] = we; }
@@ -479,19 +620,19 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
     int32_t nout = mL->nv;
     csr K = {NULL, NULL};
-    int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv), *fo = malloc(sizeof(int32_t) * (size_t)nout);
+    int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv);
+    const int32_t *fo = c->fo;
     int32_t ncol = -1, *ccol = NULL;
     ccn_status st = CCN_OK;
-    if (col && fo && !neighbourhoods(m0, &K)) ncol = colour(m0, &K, col);
+    if (col && fo && !neighbourhoods(m0, c->dir.slot, &K)) ncol = colour(m0, &K, col);
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
     if (ncol < 0 || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
     /* the candidates: for each output, the value vertices of its cage face's neighbourhood */
-    origin_faces(p, mL, fo);
     int64_t total = 0;
-    for (int32_t o = 0; o < nout; o++) total += K.start[fo[o] + 1] - K.start[fo[o]];
+    for (int32_t o = 0; o < nout; o++) total += c->direct[o] ? 16 : K.start[fo[o] + 1] - K.start[fo[o]];
     if (total > INT32_MAX) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large"); goto done; }
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     s->w = calloc((size_t)(total ? total : 1), sizeof(double));
@@ -499,9 +640,15 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     ccol = malloc(sizeof(int32_t) * (size_t)(total ? total : 1)); /* each candidate's colour */
     if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
     s->start[0] = 0;
-    for (int32_t o = 0; o < nout; o++) s->start[o + 1] = s->start[o] + K.start[fo[o] + 1] - K.start[fo[o]];
-    cand_job cj = {&K, fo, col, s->start, s->idx, ccol};
+    for (int32_t o = 0; o < nout; o++)
+        s->start[o + 1] = s->start[o] + (c->direct[o] ? 16 : K.start[fo[o] + 1] - K.start[fo[o]]);
+    cand_job cj = {p, c, &K, fo, col, s->start, s->idx, ccol, s->w};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
+    if (c->dir.count > 0) { /* probes of the other outputs: their points only, the rest zero */
+        if (probe_lists(c)) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+        for (int32_t l = 1; l <= c->L; l++)
+            memset(c->lev[l].m->pos, 0, sizeof(double) * 3 * (size_t)c->lev[l].m->nv);
+    }
     for (int32_t b = 0, npass = (ncol + 2) / 3; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
     free(ccol);
     ccol = NULL;
@@ -515,7 +662,15 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
-    merge_job mj = {s, c->value_of, len, sums};
+    /* a row's candidates are distinct value vertices: they need merging only where two value
+     * vertices carry one of the caller's values */
+    int32_t maxval = 0;
+    for (int32_t v = 0; v < m0->nv; v++) if (c->value_of[v] > maxval) maxval = c->value_of[v];
+    uint8_t *used = calloc((size_t)maxval + 1, 1);
+    int unique = used != NULL;
+    for (int32_t v = 0; unique && v < m0->nv; v++) unique = !used[c->value_of[v]]++;
+    free(used);
+    merge_job mj = {s, c->value_of, len, sums, unique};
     ccn__parallel_for(p->threads, nout, merge_range, &mj);
     int32_t n = 0;
     for (int32_t o = 0; o < nout && !st; o++) {
@@ -541,7 +696,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         if (b) s->w = b;
     }
 done:
-    free(K.start); free(K.list); free(col); free(fo); free(ccol);
+    free(K.start); free(K.list); free(col); free(ccol);
     return st;
 }
 

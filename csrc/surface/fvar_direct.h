@@ -1,0 +1,24 @@
+/* Face-varying limit weights written down directly where the value mesh is a regular grid
+ * (internal; surface/fvar_direct.c). */
+#ifndef CCN_SURFACE_FVAR_DIRECT_H
+#define CCN_SURFACE_FVAR_DIRECT_H
+
+#include "refine/fvar.h"
+
+/* The level-0 faces of a channel whose limit is a bicubic tensor-product B-spline patch. */
+typedef struct {
+    int32_t *slot;  /* nf: the face's slot below (the face itself), -1: composed by probing */
+    int32_t *verts; /* 16 per slot: value vertex P_ij at i + 4 j (corner 0 of the face is P_11) */
+    double *knots;  /* 12 per slot: the knot vectors U[0..5], V[0..5] (span [U2, U3] x [V2, V3]) */
+    int32_t count;
+} ccn__fvar_direct;
+
+/* Classifies the faces of level 0 (see surface/fvar_direct.c). Returns 0, or -1 out of memory. */
+int ccn__fvar_direct_build(const ccn__fvar_level *f0, ccn__fvar_direct *d);
+void ccn__fvar_direct_free(ccn__fvar_direct *d);
+
+/* The 16 weights at (u, v) in [0,1]^2 of slot s's face (u along its first half-edge, v along
+ * the reversed last one), w[i + 4 j] for verts[16 s + i + 4 j]. */
+void ccn__fvar_direct_weights(const ccn__fvar_direct *d, int32_t s, double u, double v, double w[16]);
+
+#endif
