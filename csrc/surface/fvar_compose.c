@@ -71,6 +71,7 @@ static void builder_free(builder *c) {
 void ccn__fvar_stencils_free(ccn__fvar_stencils *s) {
     if (!s) return;
     free(s->start); free(s->idx); free(s->w); free(s->face_values);
+    free(s->dface); free(s->dab); free(s->dvals); free(s->dN);
     memset(s, 0, sizeof *s);
 }
 
@@ -561,29 +562,27 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
 
 typedef struct {
     const ccn_plan *p; const builder *c;
-    const csr *K; const int32_t *fo, *col, *start;
+    const csr *K; const int32_t *fo, *col, *start, *compact;
     int32_t *idx, *ccol;
-    double *w;
+    ccn__fvar_stencils *s;
 } cand_job;
 
 /* The candidates of each output: the value vertices of its cage face's neighbourhood; on a
- * regular face (its 16) with their written-down weights. */
+ * regular face none, but the face and the grid point. */
 static void cand_range(void *ctx, int32_t b, int32_t end) {
     const cand_job *j = ctx;
-    const ccn__fvar_direct *d = &j->c->dir;
     const ccn_mesh *mL = j->c->lev[j->c->L].m;
+    double scale = (double)(j->s->side - 1);
     for (int32_t o = b; o < end; o++) {
         int32_t n = j->start[o];
         if (j->c->direct[o]) {
             double uv[2];
-            int32_t f = origin(j->p, mL, o, uv), sl = d->slot[f];
-            ccn__fvar_direct_weights(d, sl, uv[0], uv[1], j->w + n);
-            for (int k = 0; k < 16; k++) {
-                j->idx[n + k] = d->verts[16 * (size_t)sl + k];
-                j->ccol[n + k] = -1;
-            }
+            int32_t f = origin(j->p, mL, o, uv);
+            j->s->dface[o] = j->compact[f];
+            j->s->dab[o] = (int32_t)lround(uv[0] * scale) + ((int32_t)lround(uv[1] * scale) << 16);
             continue;
         }
+        if (j->s->dface) j->s->dface[o] = -1;
         for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) {
             j->ccol[n] = j->col[j->K->list[k]];
             j->idx[n] = j->K->list[k];
@@ -602,6 +601,11 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
     for (int32_t o = b; o < end; o++) {
         int32_t first = j->s->start[o], n = first;
         double sum = 0.0;
+        if (j->s->dface && j->s->dface[o] >= 0) { /* a regular face's point: no row */
+            j->len[o] = 0;
+            j->sum[o] = 1.0;
+            continue;
+        }
         for (int32_t e = first; e < j->s->start[o + 1]; e++) {
             double we = w[e];
             if (we == 0.0) continue;
@@ -614,6 +618,35 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
         j->len[o] = fabs(sum - 1.0) <= 1e-9 ? n - first : -1;
         j->sum[o] = sum;
     }
+}
+
+/* The regular faces' part of the stencils: per face its 16 caller values and basis tables,
+ * compact[f] its index (nf, malloc'd). Each table row sums to 1 (affine invariance). */
+static ccn_status direct_tables(const builder *c, ccn__fvar_stencils *s, int32_t **compact, ccn_error *err) {
+    const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
+    int32_t nd = c->dir.count, side = (1 << c->L) + 1;
+    s->nd = nd;
+    s->side = side;
+    *compact = malloc(sizeof(int32_t) * (size_t)(m0->nf ? m0->nf : 1));
+    s->dface = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    s->dab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    s->dvals = malloc(sizeof(int32_t) * 16 * (size_t)nd);
+    s->dN = malloc(sizeof(double) * 8 * (size_t)side * (size_t)nd);
+    if (!*compact || !s->dface || !s->dab || !s->dvals || !s->dN)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+    for (int32_t f = 0, k = 0; f < m0->nf; f++) {
+        (*compact)[f] = -1;
+        if (c->dir.slot[f] < 0) continue;
+        for (int i = 0; i < 16; i++) s->dvals[16 * (size_t)k + i] = c->value_of[c->dir.verts[16 * (size_t)c->dir.slot[f] + i]];
+        double *N = s->dN + 8 * (size_t)side * k;
+        ccn__fvar_direct_table(&c->dir, c->dir.slot[f], side, N);
+        for (int32_t r = 0; r < 2 * side; r++)
+            if (fabs(N[4 * r] + N[4 * r + 1] + N[4 * r + 2] + N[4 * r + 3] - 1.0) > 1e-9)
+                return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, f,
+                                 "face %d: its B-spline basis does not sum to 1", (int)f);
+        (*compact)[f] = k++;
+    }
+    return CCN_OK;
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
@@ -632,7 +665,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     }
     /* the candidates: for each output, the value vertices of its cage face's neighbourhood */
     int64_t total = 0;
-    for (int32_t o = 0; o < nout; o++) total += c->direct[o] ? 16 : K.start[fo[o] + 1] - K.start[fo[o]];
+    for (int32_t o = 0; o < nout; o++) total += c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]];
     if (total > INT32_MAX) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large"); goto done; }
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     s->w = calloc((size_t)(total ? total : 1), sizeof(double));
@@ -641,9 +674,12 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
     s->start[0] = 0;
     for (int32_t o = 0; o < nout; o++)
-        s->start[o + 1] = s->start[o] + (c->direct[o] ? 16 : K.start[fo[o] + 1] - K.start[fo[o]]);
-    cand_job cj = {p, c, &K, fo, col, s->start, s->idx, ccol, s->w};
+        s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
+    int32_t *compact = NULL;
+    if (c->dir.count > 0 && (st = direct_tables(c, s, &compact, err))) { free(compact); goto done; }
+    cand_job cj = {p, c, &K, fo, col, s->start, compact, s->idx, ccol, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
+    free(compact);
     if (c->dir.count > 0) { /* probes of the other outputs: their points only, the rest zero */
         if (probe_lists(c)) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
         for (int32_t l = 1; l <= c->L; l++)

@@ -168,11 +168,11 @@ static void basis(const double U[6], double x, double N[4]) {
     }
 }
 
-void ccn__fvar_direct_weights(const ccn__fvar_direct *d, int32_t s, double u, double v, double w[16]) {
+void ccn__fvar_direct_table(const ccn__fvar_direct *d, int32_t s, int32_t side, double *N) {
     const double *U = d->knots + 12 * (size_t)s, *V = U + 6;
-    double Nu[4], Nv[4];
-    basis(U, u * U[3], Nu);
-    basis(V, v * V[3], Nv);
-    for (int j = 0; j < 4; j++)
-        for (int i = 0; i < 4; i++) w[i + 4 * j] = Nu[i] * Nv[j];
+    double step = 1.0 / (double)(side > 1 ? side - 1 : 1);
+    for (int32_t a = 0; a < side; a++) {
+        basis(U, (double)a * step * U[3], N + 4 * (size_t)a);
+        basis(V, (double)a * step * V[3], N + 4 * ((size_t)side + a));
+    }
 }

@@ -17,8 +17,9 @@ typedef struct {
 int ccn__fvar_direct_build(const ccn__fvar_level *f0, ccn__fvar_direct *d);
 void ccn__fvar_direct_free(ccn__fvar_direct *d);
 
-/* The 16 weights at (u, v) in [0,1]^2 of slot s's face (u along its first half-edge, v along
- * the reversed last one), w[i + 4 j] for verts[16 s + i + 4 j]. */
-void ccn__fvar_direct_weights(const ccn__fvar_direct *d, int32_t s, double u, double v, double w[16]);
+/* The basis functions of slot s's face at the grid points a / (side - 1), a = 0 .. side - 1, of
+ * u (along its first half-edge) and v (along the reversed last one): N[4 a + i] = N_i(u_a),
+ * then N[4 side + 4 b + j] = N_j(v_b); the weight of verts[16 s + i + 4 j] is their product. */
+void ccn__fvar_direct_table(const ccn__fvar_direct *d, int32_t s, int32_t side, double *N);
 
 #endif

@@ -124,13 +124,46 @@ static void apply_range(void *ctx, int32_t b, int32_t end) {
 
 typedef struct { const ccn__fvar_stencils *s; const double *vals; double *out; int32_t width; } spmv_job;
 
+/* Output o on a regular face: sum_j N_j(v_b) sum_i N_i(u_a) value(P_ij) (surface/fvar_compose.h). */
+static void direct_value(const ccn__fvar_stencils *s, int32_t o, const double *vals, int32_t w,
+                         double *dst) {
+    int32_t f = s->dface[o], a = s->dab[o] & 0xffff, bb = s->dab[o] >> 16;
+    const double *Nu = s->dN + 8 * (size_t)s->side * f + 4 * (size_t)a;
+    const double *Nv = s->dN + 8 * (size_t)s->side * f + 4 * ((size_t)s->side + bb);
+    const int32_t *P = s->dvals + 16 * (size_t)f;
+    if (w == 2) {
+        double x = 0, y = 0;
+        for (int jj = 0; jj < 4; jj++) {
+            double rx = 0, ry = 0;
+            for (int i = 0; i < 4; i++) {
+                const double *v = vals + 2 * (size_t)P[i + 4 * jj];
+                rx += Nu[i] * v[0];
+                ry += Nu[i] * v[1];
+            }
+            x += Nv[jj] * rx;
+            y += Nv[jj] * ry;
+        }
+        dst[0] = x;
+        dst[1] = y;
+        return;
+    }
+    for (int32_t c = 0; c < w; c++) dst[c] = 0.0;
+    for (int jj = 0; jj < 4; jj++)
+        for (int i = 0; i < 4; i++) {
+            double wt = Nu[i] * Nv[jj];
+            const double *v = vals + (size_t)w * P[i + 4 * jj];
+            for (int32_t c = 0; c < w; c++) dst[c] += wt * v[c];
+        }
+}
+
 static void spmv_range(void *ctx, int32_t b, int32_t end) {
     const spmv_job *j = ctx;
-    const int32_t *start = j->s->start, *idx = j->s->idx, w = j->width;
+    const int32_t *start = j->s->start, *idx = j->s->idx, w = j->width, *dface = j->s->dface;
     const double *wt = j->s->w, *vals = j->vals;
     double *out = j->out;
     if (w == 2) { /* UV maps */
         for (int32_t o = b; o < end; o++) {
+            if (dface && dface[o] >= 0) { direct_value(j->s, o, vals, w, out + 2 * (size_t)o); continue; }
             double x = 0, y = 0;
             for (int32_t k = start[o]; k < start[o + 1]; k++) {
                 const double *v = vals + 2 * (size_t)idx[k];
@@ -144,6 +177,7 @@ static void spmv_range(void *ctx, int32_t b, int32_t end) {
     }
     for (int32_t o = b; o < end; o++) {
         double *dst = out + (size_t)w * o;
+        if (dface && dface[o] >= 0) { direct_value(j->s, o, vals, w, dst); continue; }
         for (int32_t c = 0; c < w; c++) dst[c] = 0.0;
         for (int32_t k = start[o]; k < start[o + 1]; k++) {
             const double *v = vals + (size_t)w * idx[k];
