@@ -105,6 +105,8 @@ static int reuse_ev_stencil(const ccn_plan *p, const ccn_mesh *fm, int32_t u, in
     const ccn_mesh *vm = p->lev[p->L];
     int32_t o = p->vmapL[v], nvL = vm->nv;
     if (o < 0) return 0;
+    const double *wp, *wu, *wv;
+    ccn__plan_row_weights(p, o, &wp, &wu, &wv);
     s->n = 0;
     for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
         int32_t i = p->st_v[k] - nvL, j = -1;
@@ -115,7 +117,7 @@ static int reuse_ev_stencil(const ccn_plan *p, const ccn_mesh *fm, int32_t u, in
             for (int32_t q = vm->vfan_start[v]; q < vm->vfan_start[v + 1] && j < 0; q++)
                 if (vm->hedge[vm->vfan[q]] == i - vm->nf) j = fm->nf + fm->hedge[vm->vfan[q]];
         if (j < 0) return 0;
-        s->v[s->n] = j; s->wp[s->n] = p->st_wp[k]; s->wu[s->n] = s->wv[s->n] = 0.0;
+        s->v[s->n] = j; s->wp[s->n] = wp[k - p->st_start[o]]; s->wu[s->n] = s->wv[s->n] = 0.0;
         s->n++;
     }
     return 1;

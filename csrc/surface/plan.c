@@ -39,6 +39,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->vmapL); free(p->out_vL); free(p->out_fv); free(p->out_origin); free(p->out_eorigin);
     free(p->out_ev); free(p->out_ce);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
+    free(p->st_w); free(p->ws);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
@@ -202,15 +203,18 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     const double *PL = p->lev[p->L]->pos, *PS = p->posS;
     int32_t nvL = p->lev[p->L]->nv;
     for (int32_t o = begin; o < end; o++) {
-        double x[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
-        for (int32_t k = p->st_start[o]; k < p->st_start[o + 1]; k++) {
-            const double *q = SPOINT(p->st_v[k]);
-            for (int i = 0; i < 3; i++) {
-                x[i] += p->st_wp[k] * q[i];
-                du[i] += p->st_wu[k] * q[i];
-                dv[i] += p->st_wv[k] * q[i];
-            }
+        const double *wp, *wu, *wv;
+        ccn__plan_row_weights(p, o, &wp, &wu, &wv);
+        const int32_t *idx = p->st_v + p->st_start[o];
+        double x0 = 0, x1 = 0, x2 = 0, u0 = 0, u1 = 0, u2 = 0, v0 = 0, v1 = 0, v2 = 0;
+        for (int32_t k = 0, n = p->st_start[o + 1] - p->st_start[o]; k < n; k++) {
+            const double *q = SPOINT(idx[k]);
+            double a = wp[k], b = wu[k], c = wv[k];
+            x0 += a * q[0]; x1 += a * q[1]; x2 += a * q[2];
+            u0 += b * q[0]; u1 += b * q[1]; u2 += b * q[2];
+            v0 += c * q[0]; v1 += c * q[1]; v2 += c * q[2];
         }
+        double x[3] = {x0, x1, x2}, du[3] = {u0, u1, u2}, dv[3] = {v0, v1, v2};
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
         if (!out->normals) continue;
         double *n = out->normals + 3 * (size_t)o;

@@ -94,7 +94,7 @@ static ccn_status check_values(const double *v, int32_t w, int32_t n, ccn_error 
 }
 
 typedef struct {
-    const int32_t *start, *idx; const double *w;
+    const ccn_plan *p;
     const double *PL, *PS; int32_t nvL;
     double *out; int32_t width, c0;
     double up; /* the power-of-two scale back */
@@ -103,13 +103,16 @@ typedef struct {
 /* Level-L points and level-(L+1) points (index >= nvL) through stencils (vertex data). */
 static void apply_range(void *ctx, int32_t b, int32_t end) {
     const apply_job *j = ctx;
-    const int32_t *start = j->start, *idx = j->idx, nvL = j->nvL, width = j->width, c0 = j->c0;
-    const double *w = j->w, *PL = j->PL, *PS = j->PS, up = j->up;
+    const int32_t *start = j->p->st_start, nvL = j->nvL, width = j->width, c0 = j->c0;
+    const double *PL = j->PL, *PS = j->PS, up = j->up;
     double *out = j->out;
     int nk = width - c0 < 3 ? width - c0 : 3;
     for (int32_t o = b; o < end; o++) {
         double x0 = 0, x1 = 0, x2 = 0;
-        for (int32_t k = start[o]; k < start[o + 1]; k++) {
+        const double *w, *wu, *wv;
+        ccn__plan_row_weights(j->p, o, &w, &wu, &wv);
+        const int32_t *idx = j->p->st_v + start[o];
+        for (int32_t k = 0, n = start[o + 1] - start[o]; k < n; k++) {
             int32_t i = idx[k];
             const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
             double wk = w[k];
@@ -240,7 +243,7 @@ ccn_status ccn_plan_evaluate_vertex_data(ccn_plan *p, int32_t width, const doubl
                 m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * data[(size_t)width * v + c0 + k] : 0.0;
         for (int32_t l = 0; l < top; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
         if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, PS);
-        apply_job j = {p->st_start, p->st_v, p->st_wp, mL->pos, PS, mL->nv, out, width, c0, up};
+        apply_job j = {p, mL->pos, PS, mL->nv, out, width, c0, up};
         ccn__parallel_for(p->threads, p->nout_v, apply_range, &j);
     }
     for (int32_t l = 0; l <= top; l++) p->lev[l]->pos = saved[l];

@@ -51,6 +51,13 @@ struct ccn_plan {
      * is a level-(L+1) point (face points, edge points, vertex points) */
     int32_t *st_start, *st_v;
     double *st_wp, *st_wu, *st_wv;
+    /* st_w[o] >= 0: output o's own weights start at st_wp/st_wu/st_wv + st_w[o] (its row's
+     * length); < 0: they are the shared weight set -1 - st_w[o], 27 doubles in ws (wp, wu, wv
+     * of up to 9 entries): the regular outputs' 3 x 3 stencils, each distinct one once (with
+     * uniform intervals, or inside a cage face at level >= 2, they are all alike) */
+    int32_t *st_w;
+    double *ws;
+    int32_t nws;
     /* sharp features: output vertices whose faces see more than one tangent plane (creases,
      * corners). Their sectors' tangent stencils (indices as st_v), CSR; each output face
      * corner names its sector (-1: the vertex normal). The vertex normal of such a vertex is
@@ -89,5 +96,18 @@ struct ccn_plan {
     ccn_cache *op_cache;     /* the caller's bi-5 operators (ccn_plan_create_cached), or NULL:
                                 then ops holds the plan's own */
 };
+
+/* The weights of output o's stencil row (see ccn_plan.st_w); entry k of the row is index
+ * st_v[st_start[o] + k]. */
+static inline void ccn__plan_row_weights(const ccn_plan *p, int32_t o, const double **wp,
+                                         const double **wu, const double **wv) {
+    int32_t w = p->st_w[o];
+    if (w >= 0) {
+        *wp = p->st_wp + w; *wu = p->st_wu + w; *wv = p->st_wv + w;
+    } else {
+        const double *s = p->ws + 27 * (size_t)(-1 - w);
+        *wp = s; *wu = s + 9; *wv = s + 18;
+    }
+}
 
 #endif

@@ -178,7 +178,28 @@ typedef struct {
     const csr_buf *ib;     /* the irregular stencils, in output order */
     const int32_t *istart; /* per output vertex: its first entry in ib (irregular ones) */
     csr_buf *b;            /* the table */
+    uint64_t *hash;        /* per regular output vertex: a hash of its weights (ref < 0) */
+    int32_t *ref;          /* per regular output vertex: an earlier one with the same weights,
+                              or -1 (its weights are in the table) */
 } stencil_job;
+
+/* FNV-1a over the bits of the position weights and the first derivative weights (and their
+ * count), finalised; equal weights are then told by comparing them all. */
+static uint64_t weights_hash(int32_t n, const double *wp, const double *wu, const double *wv) {
+    uint64_t h = 1469598103934665603ull ^ (uint64_t)n, x;
+    for (int32_t k = 0; k < n; k++) {
+        memcpy(&x, &wp[k], sizeof x);
+        h = (h ^ x) * 1099511628211ull;
+    }
+    memcpy(&x, &wu[0], sizeof x);
+    h = (h ^ x) * 1099511628211ull;
+    memcpy(&x, &wv[0], sizeof x);
+    h = (h ^ x) * 1099511628211ull;
+    h ^= h >> 33; /* the low bits, which index the table, from all of them (splitmix64) */
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return h;
+}
 
 static void irr_range(void *ctx, int32_t begin, int32_t end) {
     stencil_job *j = ctx;
@@ -191,9 +212,22 @@ static void fast_range(void *ctx, int32_t begin, int32_t end) {
     for (int32_t o = begin; o < end; o++) j->fast[o] = !ccn__near_irregular(j->mL, j->p->out_vL[o], j->irr);
 }
 
+/* The last distinct weights a range made (most regular outputs repeat one of them). */
+#define RECENT 8
+typedef struct { int32_t o, n; uint64_t h; double w[3 * FAST_MAX]; } recent_weights;
+
+static int same_weights(const recent_weights *r, const ccn__stencil *s) {
+    size_t z = sizeof(double) * (size_t)s->n;
+    return r->n == s->n && !memcmp(r->w, s->wp, z) && !memcmp(r->w + FAST_MAX, s->wu, z) &&
+           !memcmp(r->w + 2 * FAST_MAX, s->wv, z);
+}
+
 static void fill_range(void *ctx, int32_t begin, int32_t end) {
     stencil_job *j = ctx;
     ccn__stencil *s = malloc(sizeof *s);
+    recent_weights *rc = malloc(sizeof *rc * RECENT);
+    int nrc = 0, last = 0, put = 0;
+    int32_t tried = 0, made = 0; /* a range whose weights are mostly new stops looking */
     csr_buf *b = j->b;
     for (int32_t o = begin; o < end; o++) {
         int32_t at = j->slot[o];
@@ -206,16 +240,122 @@ static void fill_range(void *ctx, int32_t begin, int32_t end) {
             continue;
         }
         j->len[o] = -1; /* failed: no scratch, or more than FAST_MAX entries */
-        if (!s) continue;
+        if (!s || !rc) continue;
         ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
         if (s->n > FAST_MAX) continue;
         memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
-        memcpy(b->wp + at, s->wp, sizeof(double) * (size_t)s->n);
+        j->len[o] = s->n;
+        j->ref[o] = -1;
+        if (tried >= 512 && 2 * made > tried) { /* non-uniform intervals: each its own */
+            memcpy(b->wp + at, s->wp, sizeof(double) * (size_t)s->n);
+            memcpy(b->wu + at, s->wu, sizeof(double) * (size_t)s->n);
+            memcpy(b->wv + at, s->wv, sizeof(double) * (size_t)s->n);
+            j->ref[o] = -2; /* no hash */
+            continue;
+        }
+        tried++;
+        if (nrc && same_weights(&rc[last], s)) { j->ref[o] = rc[last].o; continue; }
+        uint64_t h = weights_hash(s->n, s->wp, s->wu, s->wv);
+        for (int i = 0; i < nrc && j->ref[o] < 0; i++)
+            if (rc[i].h == h && same_weights(&rc[i], s)) { j->ref[o] = rc[i].o; last = i; }
+        if (j->ref[o] >= 0) continue;
+        made++;
+        memcpy(b->wp + at, s->wp, sizeof(double) * (size_t)s->n); /* new here: into the table */
         memcpy(b->wu + at, s->wu, sizeof(double) * (size_t)s->n);
         memcpy(b->wv + at, s->wv, sizeof(double) * (size_t)s->n);
-        j->len[o] = s->n;
+        j->hash[o] = h;
+        recent_weights *r = &rc[put];
+        r->o = o; r->n = s->n; r->h = h;
+        memcpy(r->w, s->wp, sizeof(double) * (size_t)s->n);
+        memcpy(r->w + FAST_MAX, s->wu, sizeof(double) * (size_t)s->n);
+        memcpy(r->w + 2 * FAST_MAX, s->wv, sizeof(double) * (size_t)s->n);
+        last = put;
+        put = (put + 1) % RECENT;
+        if (nrc < RECENT) nrc++;
     }
     free(s);
+    free(rc);
+}
+
+/* The regular outputs' weight sets (ccn_plan.st_w, ws): each distinct (n, wp, wu, wv) once.
+ * An output whose range had made its weights already takes that one's set; the others are
+ * found through an open-addressing table on the hashes fill_range made. */
+static ccn_status weight_sets(ccn_plan *p, const stencil_job *j, int32_t nout, ccn_error *err) {
+    csr_buf *b = j->b;
+    int64_t nfast = 0, heads = 0;
+    for (int32_t o = 0; o < nout; o++) {
+        nfast += j->fast[o];
+        heads += j->fast[o] && j->ref[o] < 0;
+    }
+    if (2 * heads > nfast) { /* mostly distinct (non-uniform intervals): every row its own */
+        for (int32_t o = 0; o < nout; o++) {
+            if (!j->fast[o] || j->ref[o] < 0) continue;
+            int32_t at = j->slot[o], from = j->slot[j->ref[o]], n = j->len[o];
+            memcpy(b->wp + at, b->wp + from, sizeof(double) * (size_t)n);
+            memcpy(b->wu + at, b->wu + from, sizeof(double) * (size_t)n);
+            memcpy(b->wv + at, b->wv + from, sizeof(double) * (size_t)n);
+        }
+        p->nws = 0;
+        return CCN_OK;
+    }
+    size_t size = 16;
+    while (size < 2 * (size_t)nfast) size *= 2;
+    int32_t *table = malloc(sizeof(int32_t) * size), cap = 16;
+    uint64_t *sh = malloc(sizeof(uint64_t) * (size_t)cap);
+    int32_t *sn = malloc(sizeof(int32_t) * (size_t)cap);
+    p->ws = malloc(sizeof(double) * 27 * (size_t)cap);
+    p->nws = 0;
+    ccn_status st = CCN_OK;
+    if (!table || !sh || !sn || !p->ws) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+        goto done;
+    }
+    for (size_t i = 0; i < size; i++) table[i] = -1;
+    for (int32_t o = 0; o < nout; o++) {
+        if (!j->fast[o]) continue;
+        if (j->ref[o] >= 0) { p->st_w[o] = p->st_w[j->ref[o]]; continue; } /* an earlier one's */
+        int32_t at = j->slot[o], n = j->len[o], set = -1;
+        const double *wp = b->wp + at, *wu = b->wu + at, *wv = b->wv + at;
+        uint64_t h = j->ref[o] == -2 ? weights_hash(n, wp, wu, wv) : j->hash[o];
+        size_t i = (size_t)h & (size - 1);
+        for (; table[i] >= 0; i = (i + 1) & (size - 1)) {
+            int32_t t = table[i];
+            const double *w = p->ws + 27 * (size_t)t;
+            if (sh[t] == h && sn[t] == n && !memcmp(w, wp, sizeof(double) * (size_t)n) &&
+                !memcmp(w + 9, wu, sizeof(double) * (size_t)n) && !memcmp(w + 18, wv, sizeof(double) * (size_t)n)) {
+                set = t;
+                break;
+            }
+        }
+        if (set < 0) {
+            if (p->nws == cap) {
+                cap *= 2;
+                uint64_t *a = realloc(sh, sizeof(uint64_t) * (size_t)cap);
+                if (a) sh = a;
+                int32_t *c = realloc(sn, sizeof(int32_t) * (size_t)cap);
+                if (c) sn = c;
+                double *d = realloc(p->ws, sizeof(double) * 27 * (size_t)cap);
+                if (d) p->ws = d;
+                if (!a || !c || !d) {
+                    st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+                    goto done;
+                }
+            }
+            set = p->nws++;
+            double *w = p->ws + 27 * (size_t)set;
+            memset(w, 0, sizeof(double) * 27);
+            memcpy(w, wp, sizeof(double) * (size_t)n);
+            memcpy(w + 9, wu, sizeof(double) * (size_t)n);
+            memcpy(w + 18, wv, sizeof(double) * (size_t)n);
+            sh[set] = h;
+            sn[set] = n;
+            table[i] = set;
+        }
+        p->st_w[o] = -1 - set;
+    }
+done:
+    free(table); free(sh); free(sn);
+    return st;
 }
 
 static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
@@ -233,12 +373,13 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     int32_t *slot = malloc(sizeof(int32_t) * (nslot + 1)), *len = malloc(sizeof(int32_t) * nslot);
     int32_t *istart = malloc(sizeof(int32_t) * nslot);
     stencil_job j = {p, mL, pinned, malloc((size_t)(mL->nv ? mL->nv : 1)), malloc(nslot), slot,
-                     len, &ib, istart, &b};
+                     len, &ib, istart, &b, malloc(sizeof(uint64_t) * nslot), malloc(sizeof(int32_t) * nslot)};
     p->st_start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
+    p->st_w = malloc(sizeof(int32_t) * nslot);
     p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     ccn_status st = CCN_OK;
     if (!s || !ring || !work || !p->st_start || !p->near || !slot || !len || !istart || !j.irr ||
-        !j.fast) {
+        !j.fast || !j.hash || !j.ref || !p->st_w) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
@@ -287,18 +428,36 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
                            (int)o, FAST_MAX);
             goto done;
         }
+    if ((st = weight_sets(p, &j, nout, err))) goto done;
+    /* packed: every row's indices; the weights of the irregular rows only (the regular ones'
+     * are in their sets). Entries move down only: slot[o] >= st_start[o] >= own */
     p->st_start[0] = 0;
-    for (int32_t o = 0; o < nout; o++) { /* entries move down only: slot[o] >= st_start[o] */
+    int32_t own = 0;
+    for (int32_t o = 0; o < nout; o++) {
         int32_t to = p->st_start[o], from = slot[o], n = len[o];
-        if (to != from) {
-            memmove(b.v + to, b.v + from, sizeof(int32_t) * (size_t)n);
-            memmove(b.wp + to, b.wp + from, sizeof(double) * (size_t)n);
-            memmove(b.wu + to, b.wu + from, sizeof(double) * (size_t)n);
-            memmove(b.wv + to, b.wv + from, sizeof(double) * (size_t)n);
+        if (to != from) memmove(b.v + to, b.v + from, sizeof(int32_t) * (size_t)n);
+        if (!j.fast[o] || !p->nws) {
+            if (own != from) {
+                memmove(b.wp + own, b.wp + from, sizeof(double) * (size_t)n);
+                memmove(b.wu + own, b.wu + from, sizeof(double) * (size_t)n);
+                memmove(b.wv + own, b.wv + from, sizeof(double) * (size_t)n);
+            }
+            p->st_w[o] = own;
+            own += n;
         }
         p->st_start[o + 1] = to + n;
     }
     b.n = p->st_start[nout];
+    { /* the tables to their size */
+        int32_t *v = realloc(b.v, sizeof(int32_t) * (size_t)(b.n ? b.n : 1));
+        double *a = realloc(b.wp, sizeof(double) * (size_t)(own ? own : 1));
+        double *c = realloc(b.wu, sizeof(double) * (size_t)(own ? own : 1));
+        double *d = realloc(b.wv, sizeof(double) * (size_t)(own ? own : 1));
+        if (v) b.v = v;
+        if (a) b.wp = a;
+        if (c) b.wu = c;
+        if (d) b.wv = d;
+    }
     if (p->nsec) {
         p->sec_nrm = malloc(sizeof(double) * 3 * (size_t)p->nsec);
         if (!p->sec_nrm) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
@@ -308,7 +467,7 @@ done:
     p->sec_v = sb.v; p->sec_wu = sb.wu; p->sec_wv = sb.wv;
     free(sb.wp);
     free(ib.v); free(ib.wp); free(ib.wu); free(ib.wv);
-    free(slot); free(len); free(istart); free(j.irr); free(j.fast);
+    free(slot); free(len); free(istart); free(j.irr); free(j.fast); free(j.hash); free(j.ref);
     free(s);
     free(ring);
     ccn__ring_work_destroy(work);
