@@ -45,7 +45,8 @@ typedef struct { const ccn__level *c; double *fp, *ep, *vp; } points_job;
 
 static void one_face_point(const ccn__level *c, int32_t f, double *fp) {
     const ccn_mesh *m = c->m;
-    if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
+    if (ccn__fsize(m, f) == 4 && c->tf) ccn__quad_face_blend(m, f, c->tf + 2 * (size_t)f, fp + 3 * (size_t)f);
+    else if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
     else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
 }
 
@@ -74,6 +75,13 @@ static void creased_edge_point(const ccn__level *c, int32_t e, const double *fp,
 }
 
 static void one_edge_point(const ccn__level *c, int32_t e, const double *fp, double *ep) {
+    if (c->te) {
+        const double *t = c->te + 3 * (size_t)e;
+        ccn__curve_edge_blend(c->m, c->erep[e], t[0], c->H + 3 * (size_t)e);
+        if (ccn__edge_sharp(c->m, e) && c->m->htwin[c->erep[e]] >= 0) creased_edge_point(c, e, fp, ep);
+        else ccn__edge_blend(c->m, c->erep[e], t[1], t[2], c->H, fp, ep);
+        return;
+    }
     ccn__curve_edge_point(c->m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
     if (ccn__edge_sharp(c->m, e) && c->m->htwin[c->erep[e]] >= 0) creased_edge_point(c, e, fp, ep);
     else ccn__edge_point(c->m, c->erep[e], c->H, fp, ep);
@@ -155,9 +163,63 @@ static void one_vertex_point(const ccn__level *c, int32_t v, const double *fp, d
         creased_vertex_point(c, v, fp, out);
     } else if (m->vboundary[v]) {
         ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
+    } else if (c->tv) {
+        ccn__nurss_vertex_blend(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v, c->H,
+                                fp, out);
     } else {
         ccn__nurss_vertex_point(m, v, c->H, fp, out);
     }
+}
+
+/* ---- the rules' weights, tabulated (ccn__level.tf ...) ------------------------------- */
+
+static void tab_face_range(void *ctx, int32_t b, int32_t e) {
+    const ccn__level *c = ctx;
+    for (int32_t f = b; f < e; f++)
+        if (ccn__fsize(c->m, f) == 4) ccn__quad_face_weights(c->m, f, c->pinned, c->tf + 2 * (size_t)f);
+}
+
+static void tab_edge_range(void *ctx, int32_t b, int32_t end) {
+    const ccn__level *c = ctx;
+    const ccn_mesh *m = c->m;
+    for (int32_t e = b; e < end; e++) {
+        int32_t h = c->erep[e], t = m->htwin[h];
+        double *o = c->te + 3 * (size_t)e;
+        o[0] = ccn__curve_edge_weight(m, h, c->pinned);
+        o[1] = t < 0 ? 0.0 : ccn__transverse(m, h);
+        o[2] = t < 0 ? 0.0 : ccn__transverse(m, t);
+    }
+}
+
+static void tab_vertex_range(void *ctx, int32_t b, int32_t e) {
+    const ccn__level *c = ctx;
+    const ccn_mesh *m = c->m;
+    for (int32_t v = b; v < e; v++)
+        if (m->vfan_start[v + 1] > m->vfan_start[v] && !m->vboundary[v])
+            ccn__nurss_vertex_weights(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v);
+}
+
+/* Once per level; out of memory: no tables (the rules run). The face and edge weights come
+ * from the crease-aware look-ups, so they hold on creased meshes too (the sharp edges' own rule
+ * still runs); the vertex weights are the smooth rule's, tabulated without creases only. */
+static void tabulate(ccn__level *c) {
+    const ccn_mesh *m = c->m;
+    if (c->tab_tried) return;
+    c->tab_tried = 1;
+    c->tf = malloc(sizeof(double) * 2 * (size_t)(m->nf ? m->nf : 1));
+    c->te = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
+    if (!m->esharp) {
+        c->tv = malloc(sizeof(double) * 2 * (size_t)(m->nv ? m->nv : 1));
+        c->th = malloc(sizeof(double) * 2 * (size_t)(m->nh ? m->nh : 1));
+    }
+    if (!c->tf || !c->te || (!m->esharp && (!c->tv || !c->th))) {
+        free(c->tf); free(c->te); free(c->tv); free(c->th);
+        c->tf = c->te = c->tv = c->th = NULL;
+        return;
+    }
+    ccn__parallel_for(c->threads, m->nf, tab_face_range, c);
+    ccn__parallel_for(c->threads, m->ne, tab_edge_range, c);
+    if (c->tv) ccn__parallel_for(c->threads, m->nv, tab_vertex_range, c);
 }
 
 static void vertex_range(void *ctx, int32_t b, int32_t e) {
@@ -355,6 +417,7 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
 
 void ccn__level_free(ccn__level *c) {
     if (!c) return;
+    free(c->tf); free(c->te); free(c->tv); free(c->th);
     free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
     memset(c, 0, sizeof *c);
 }
@@ -390,8 +453,9 @@ ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, i
     return st;
 }
 
-void ccn__level_points(const ccn__level *c, double *out) {
+void ccn__level_points(ccn__level *c, double *out) {
     const ccn_mesh *m = c->m;
+    tabulate(c);
     double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
     points_job j = {c, fp, ep, vp};
     ccn__parallel_for(c->threads, m->nf, face_range, &j);
@@ -420,10 +484,11 @@ static void vertex_list_range(void *ctx, int32_t b, int32_t e) {
     for (int32_t i = b; i < e; i++) one_vertex_point(j->c, j->list[i], j->fp, j->vp);
 }
 
-void ccn__level_points_lists(const ccn__level *c, const int32_t *faces, int32_t nfaces,
+void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces,
                              const int32_t *edges, int32_t nedges, const int32_t *verts,
                              int32_t nverts, double *out) {
     const ccn_mesh *m = c->m;
+    tabulate(c);
     double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
     list_job j = {c, fp, ep, vp, faces};
     ccn__parallel_for(c->threads, nfaces, face_list_range, &j);

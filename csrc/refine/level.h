@@ -28,6 +28,12 @@ typedef struct {
     ccn__ev_cache *ev_cache; /* the owner's cache of eigen polyhedron choices (may be NULL) */
     int32_t ev_poly;     /* ccn_options.ev_polyhedron */
     int32_t ev_verified, ev_outside; /* EVs of this level verified / outside the G1 range */
+    /* The rules' weights, tabulated by the first ccn__level_points on a mesh without creases
+     * (they depend on topology and intervals only): quad face (s, t), edge (curve weight and
+     * the two transverse intervals), interior vertex ((n-3)/n, 3/(n sum)) and its fan's
+     * (m_i, f_i) at the fan's half-edge positions. NULL: computed per call. */
+    int tab_tried;
+    double *tf, *te, *tv, *th;
 } ccn__level;
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                               int crease_method, ccn_error *err);
@@ -36,13 +42,13 @@ ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, i
                                  int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
                                  ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
-void ccn__level_points(const ccn__level *c, double *out);
+void ccn__level_points(ccn__level *c, double *out);
 /* Next-level points around the listed vertices only (see refine/level.c). */
 void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
                               double *out);
 /* The next-level points of the listed faces, edges and vertices only (each once; every EV's
  * red points too). A point is right when the old points its rule reads are. */
-void ccn__level_points_lists(const ccn__level *c, const int32_t *faces, int32_t nfaces,
+void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces,
                              const int32_t *edges, int32_t nedges, const int32_t *verts,
                              int32_t nverts, double *out);
 /* Topology and intervals of the next level (positions uninitialised). */

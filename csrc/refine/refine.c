@@ -128,7 +128,7 @@ void ccn_fvar_destroy(ccn_fvar *f) {
 }
 
 /* Values of level f (width w, chunks of 3 through the rules) into next (w * nf->nv). */
-static void fvar_points(const ccn__level *c, ccn_mesh *m, ccn_mesh *next, const double *vals,
+static void fvar_points(ccn__level *c, ccn_mesh *m, ccn_mesh *next, const double *vals,
                         int32_t w, double *out) {
     for (int32_t c0 = 0; c0 < w; c0 += 3) {
         for (int32_t v = 0; v < m->nv; v++)

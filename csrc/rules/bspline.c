@@ -111,37 +111,61 @@ static void lerp3(const double *a, const double *b, double w, double out[3]) {
     for (int k = 0; k < 3; k++) out[k] = (1.0 - w) * a[k] + w * b[k];
 }
 
-void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]) {
-    int32_t a = m->hvert[h], nh = ccn__next(m, h), b = m->hvert[nh];
+double ccn__curve_edge_weight(const ccn_mesh *m, int32_t h, int pinned) {
+    int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
     double dp = ccn__beyond(m, a, m->hfanpos[h], pinned);
     double dn = ccn__beyond(m, b, ccn__pos_at_end(m, h), pinned);
-    double w = ccn__edge_weight(dp, m->eknot[m->hedge[h]], dn);
-    lerp3(m->pos + 3 * (size_t)a, m->pos + 3 * (size_t)b, w, out);
+    return ccn__edge_weight(dp, m->eknot[m->hedge[h]], dn);
 }
 
-void ccn__quad_face_point(const ccn_mesh *m, int32_t f, int pinned, double out[3]) {
+void ccn__curve_edge_blend(const ccn_mesh *m, int32_t h, double w, double out[3]) {
+    lerp3(m->pos + 3 * (size_t)m->hvert[h], m->pos + 3 * (size_t)m->hvert[ccn__next(m, h)], w, out);
+}
+
+void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]) {
+    ccn__curve_edge_blend(m, h, ccn__curve_edge_weight(m, h, pinned), out);
+}
+
+void ccn__quad_face_weights(const ccn_mesh *m, int32_t f, int pinned, double st[2]) {
+    int32_t h0 = m->fstart[f];
+    double a = m->eknot[m->hedge[h0]], b = m->eknot[m->hedge[h0 + 1]];
+    st[0] = ccn__edge_weight(ccn__side(m, h0 + 3, pinned), a, ccn__side(m, h0 + 1, pinned));
+    st[1] = ccn__edge_weight(ccn__side(m, h0, pinned), b, ccn__side(m, h0 + 2, pinned));
+}
+
+void ccn__quad_face_blend(const ccn_mesh *m, int32_t f, const double st[2], double out[3]) {
     int32_t h0 = m->fstart[f];
     const double *p0 = m->pos + 3 * (size_t)m->hvert[h0], *p1 = m->pos + 3 * (size_t)m->hvert[h0 + 1],
                  *p2 = m->pos + 3 * (size_t)m->hvert[h0 + 2], *p3 = m->pos + 3 * (size_t)m->hvert[h0 + 3];
-    double a = m->eknot[m->hedge[h0]], b = m->eknot[m->hedge[h0 + 1]];
-    double s = ccn__edge_weight(ccn__side(m, h0 + 3, pinned), a, ccn__side(m, h0 + 1, pinned));
-    double t = ccn__edge_weight(ccn__side(m, h0, pinned), b, ccn__side(m, h0 + 2, pinned));
+    double s = st[0], t = st[1];
     double w0 = (1 - s) * (1 - t), w1 = s * (1 - t), w2 = s * t, w3 = (1 - s) * t;
     for (int k = 0; k < 3; k++) out[k] = w0 * p0[k] + w1 * p1[k] + w2 * p2[k] + w3 * p3[k];
 }
 
-void ccn__edge_point(const ccn_mesh *m, int32_t h, const double *H, const double *fp,
-                     double out[3]) {
+void ccn__quad_face_point(const ccn_mesh *m, int32_t f, int pinned, double out[3]) {
+    double st[2];
+    ccn__quad_face_weights(m, f, pinned, st);
+    ccn__quad_face_blend(m, f, st, out);
+}
+
+void ccn__edge_blend(const ccn_mesh *m, int32_t h, double bl, double br, const double *H,
+                     const double *fp, double out[3]) {
     int32_t t = m->htwin[h], e = m->hedge[h];
     const double *he = H + 3 * (size_t)e;
     if (t < 0) {
         for (int k = 0; k < 3; k++) out[k] = he[k];
         return;
     }
-    double bl = ccn__transverse(m, h), br = ccn__transverse(m, t);
     const double *fl = fp + 3 * (size_t)m->hface[h], *fr = fp + 3 * (size_t)m->hface[t];
     double s = 1.0 / (2.0 * (bl + br));
     for (int k = 0; k < 3; k++) out[k] = 0.5 * he[k] + s * (br * fl[k] + bl * fr[k]);
+}
+
+void ccn__edge_point(const ccn_mesh *m, int32_t h, const double *H, const double *fp,
+                     double out[3]) {
+    int32_t t = m->htwin[h];
+    double bl = t < 0 ? 0.0 : ccn__transverse(m, h), br = t < 0 ? 0.0 : ccn__transverse(m, t);
+    ccn__edge_blend(m, h, bl, br, H, fp, out);
 }
 
 void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, int pinned,

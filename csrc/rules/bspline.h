@@ -28,13 +28,22 @@ static inline int ccn__is_ev(const ccn_mesh *m, int32_t v) {
  * B-spline with intervals D_-2, D_-1, D_0, D_1 around it. */
 void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
                               double dw[3]);
-/* Curve edge point of edge(h) (knot insertion along the edge). */
+/* Curve edge point of edge(h) (knot insertion along the edge): its weight w (topology and
+ * intervals only) and the blend (1-w) P_a + w P_b of the current positions. */
 void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]);
-/* Tensor-product face point of quad face f (knot insertion in both directions). */
+double ccn__curve_edge_weight(const ccn_mesh *m, int32_t h, int pinned);
+void ccn__curve_edge_blend(const ccn_mesh *m, int32_t h, double w, double out[3]);
+/* Tensor-product face point of quad face f (knot insertion in both directions): its weights
+ * (s, t) along f's first and second edge, and their bilinear blend of f's corners. */
 void ccn__quad_face_point(const ccn_mesh *m, int32_t f, int pinned, double out[3]);
-/* Edge point of an interior edge: H/2 + transverse blend of the two new face points. */
+void ccn__quad_face_weights(const ccn_mesh *m, int32_t f, int pinned, double st[2]);
+void ccn__quad_face_blend(const ccn_mesh *m, int32_t f, const double st[2], double out[3]);
+/* Edge point of an interior edge: H/2 + transverse blend of the two new face points (bl, br:
+ * the transverse intervals of the faces of h and of its twin; H itself on the boundary). */
 void ccn__edge_point(const ccn_mesh *m, int32_t h, const double *H, const double *fp,
                      double out[3]);
+void ccn__edge_blend(const ccn_mesh *m, int32_t h, double bl, double br, const double *H,
+                     const double *fp, double out[3]);
 /* Boundary vertex: the curve vertex rule along the boundary (or pinned corner). */
 void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, int pinned,
                                 double out[3]);

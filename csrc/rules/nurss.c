@@ -35,6 +35,39 @@ void ccn__ngon_face_point(const ccn_mesh *m, int32_t f, double out[3]) {
 
 /* Eqs. 16-18: V' = (n-3)/n V + (3/n) sum(m_i M_i + f_i F_i) / sum(m_i + f_i), M_i the curve
  * edge points of the spokes (H), F_i the new face points. n = 4 is Li 2016 eq. (7). */
+void ccn__nurss_vertex_weights(const ccn_mesh *m, int32_t v, double *mf, double ab[2]) {
+    int32_t n = ccn__valence(m, v), s0 = m->vfan_start[v];
+    double sw = 0.0;
+    const double *ek = m->eknot;
+    for (int32_t i = 0; i < n; i++) {
+        double dm1 = ek[m->hedge[m->vfan[s0 + (i + n - 1) % n]]];
+        double dp1 = ek[m->hedge[m->vfan[s0 + (i + 1) % n]]];
+        double dm2 = ek[m->hedge[m->vfan[s0 + (i + n - 2) % n]]];
+        double dp2 = ek[m->hedge[m->vfan[s0 + (i + 2) % n]]];
+        double mi = 0.5 * (dm1 + dp1) * (dm2 + dp2), fi = dm1 * dp2;
+        mf[2 * i] = mi;
+        mf[2 * i + 1] = fi;
+        sw += mi + fi;
+    }
+    ab[0] = (double)(n - 3) / n;
+    ab[1] = 3.0 / (n * sw);
+}
+
+void ccn__nurss_vertex_blend(const ccn_mesh *m, int32_t v, const double *mf, const double ab[2],
+                             const double *H, const double *fp, double out[3]) {
+    int32_t n = ccn__valence(m, v), s0 = m->vfan_start[v];
+    double acc[3] = {0, 0, 0};
+    for (int32_t i = 0; i < n; i++) {
+        int32_t hi = m->vfan[s0 + i];
+        double mi = mf[2 * i], fi = mf[2 * i + 1];
+        const double *hp = H + 3 * (size_t)m->hedge[hi], *fpp = fp + 3 * (size_t)m->hface[hi];
+        for (int k = 0; k < 3; k++) acc[k] += mi * hp[k] + fi * fpp[k];
+    }
+    const double *p = m->pos + 3 * (size_t)v;
+    for (int k = 0; k < 3; k++) out[k] = ab[0] * p[k] + ab[1] * acc[k];
+}
+
+/* The same arithmetic in one pass (no scratch for the fan's weights). */
 void ccn__nurss_vertex_point(const ccn_mesh *m, int32_t v, const double *H, const double *fp,
                              double out[3]) {
     int32_t n = ccn__valence(m, v), s0 = m->vfan_start[v];
