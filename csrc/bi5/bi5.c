@@ -210,12 +210,17 @@ static void centre_point(int32_t n, const double *X, double ctr[3]) {
  * and the 6 weights per sector of its n sectors (the centre-point and normal terms are the
  * caller's). */
 static inline void stencil_row(const double *row, const double *X, int32_t n, int32_t s, double acc[3]) {
-    acc[0] = row[0] * X[0], acc[1] = row[0] * X[1], acc[2] = row[0] * X[2];
-    for (int32_t k = 0; k < n; k++) {
-        const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ((k + s) % n));
-        for (int32_t q = 0; q < 6; q++)
-            for (int c = 0; c < 3; c++) acc[c] += w[q] * x[3 * q + c];
+    double a0 = row[0] * X[0], a1 = row[0] * X[1], a2 = row[0] * X[2]; /* in registers */
+    for (int32_t k = 0, ks = s; k < n; k++, ks = ks + 1 == n ? 0 : ks + 1) {
+        const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ks);
+        for (int32_t q = 0; q < 6; q++) {
+            double wq = w[q];
+            a0 += wq * x[3 * q];
+            a1 += wq * x[3 * q + 1];
+            a2 += wq * x[3 * q + 2];
+        }
     }
+    acc[0] = a0; acc[1] = a1; acc[2] = a2;
 }
 
 /* Uniform operator: sector s = stencil applied to the net relabelled so that s becomes 0. */
