@@ -3,6 +3,7 @@
 #include "io/cad.h"
 
 #include "base/error.h"
+#include "rules/bspline.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -93,19 +94,9 @@ void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi)
 static int32_t basis(const ccn__cad_surface *f, int dir, double t, double *N) {
     int32_t p = f->degree[dir], n = f->num_poles[dir], span = p;
     while (span + 1 < n && flat_knot(f, dir, span + 1) <= t) span++;
-    double left[CCN_CAD_MAX_DEGREE + 1], right[CCN_CAD_MAX_DEGREE + 1];
-    N[0] = 1;
-    for (int32_t j = 1; j <= p; j++) {
-        left[j] = t - flat_knot(f, dir, span + 1 - j);
-        right[j] = flat_knot(f, dir, span + j) - t;
-        double saved = 0;
-        for (int32_t r = 0; r < j; r++) {
-            double tmp = N[r] / (right[r + 1] + left[j - r]);
-            N[r] = saved + right[r + 1] * tmp;
-            saved = left[j - r] * tmp;
-        }
-        N[j] = saved;
-    }
+    double U[2 * CCN_CAD_MAX_DEGREE];
+    for (int32_t k = 0; k < 2 * p; k++) U[k] = flat_knot(f, dir, span - p + 1 + k);
+    ccn__bspline_basis(p, U, t, N);
     return span;
 }
 

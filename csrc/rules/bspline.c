@@ -182,6 +182,22 @@ void ccn__boundary_vertex_point(const ccn_mesh *m, int32_t v, const double *H, i
     for (int k = 0; k < 3; k++) out[k] = 0.5 * p[k] + s * (dout * hi[k] + din * ho[k]);
 }
 
+void ccn__bspline_basis(int p, const double *U, double x, double *N) {
+    double left[64], right[64]; /* p <= 63 (OpenCASCADE's limit is 25) */
+    N[0] = 1.0;
+    for (int j = 1; j <= p && j < 64; j++) {
+        left[j] = x - U[p - j];
+        right[j] = U[p - 1 + j] - x;
+        double saved = 0.0;
+        for (int r = 0; r < j; r++) {
+            double t = N[r] / (right[r + 1] + left[j - r]);
+            N[r] = saved + right[r + 1] * t;
+            saved = left[j - r] * t;
+        }
+        N[j] = saved;
+    }
+}
+
 /* 1-D limit at knot t_0 of a cubic B-spline with control points P_-1, P_0, P_1 (blossoms
  * f(t_-2,t_-1,t_0), f(t_-1,t_0,t_1), f(t_0,t_1,t_2)) and intervals D_-2, D_-1, D_0, D_1:
  *   A = f(t_-1,t_0,t_0) = P_-1 + a (P_0 - P_-1),  a = (D_-2 + D_-1)/(D_-2 + D_-1 + D_0)

@@ -24,6 +24,10 @@ static inline int ccn__is_ev(const ccn_mesh *m, int32_t v) {
     return !m->vboundary[v] && m->vfan_start[v + 1] > m->vfan_start[v] && ccn__valence(m, v) != 4;
 }
 
+/* The p + 1 nonzero B-spline basis functions of degree p at x in a span [U[p-1], U[p]] of the
+ * 2p knots U around it (Piegl & Tiller A2.2): N[i] for the control point of knots U[i] .. */
+void ccn__bspline_basis(int p, const double *U, double x, double *N);
+
 /* 1-D limit value (w) and derivative (dw) weights on (P_-1, P_0, P_1) at knot t_0 of a cubic
  * B-spline with intervals D_-2, D_-1, D_0, D_1 around it. */
 void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],

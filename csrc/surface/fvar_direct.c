@@ -16,6 +16,8 @@
  */
 #include "surface/fvar_direct.h"
 
+#include "rules/bspline.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -151,21 +153,9 @@ int ccn__fvar_direct_build(const ccn__fvar_level *f0, ccn__fvar_direct *d) {
     return 0;
 }
 
-/* The four cubic B-spline basis functions of span [U2, U3] at x (Piegl & Tiller A2.2). */
+/* The four cubic B-spline basis functions of span [U2, U3] at x. */
 static void basis(const double U[6], double x, double N[4]) {
-    double left[4], right[4];
-    N[0] = 1.0;
-    for (int j = 1; j <= 3; j++) {
-        left[j] = x - U[3 - j];
-        right[j] = U[2 + j] - x;
-        double saved = 0.0;
-        for (int r = 0; r < j; r++) {
-            double t = N[r] / (right[r + 1] + left[j - r]);
-            N[r] = saved + right[r + 1] * t;
-            saved = left[j - r] * t;
-        }
-        N[j] = saved;
-    }
+    ccn__bspline_basis(3, U, x, N);
 }
 
 void ccn__fvar_direct_table(const ccn__fvar_direct *d, int32_t s, int32_t side, double *N) {
