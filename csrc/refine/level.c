@@ -509,11 +509,8 @@ void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t
     double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
     for (int32_t i = 0; i < nverts; i++) {
         int32_t v = verts[i];
-        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-            int32_t f = m->hface[m->vfan[k]];
-            if (ccn__fsize(m, f) == 4) ccn__quad_face_point(m, f, c->pinned, fp + 3 * (size_t)f);
-            else ccn__ngon_face_point(m, f, fp + 3 * (size_t)f);
-        }
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++)
+            one_face_point(c, m->hface[m->vfan[k]], fp);
     }
     apply_red(c, 0, fp, ep, vp);
     for (int32_t i = 0; i < nverts; i++) {
@@ -524,14 +521,7 @@ void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t
         }
     }
     apply_red(c, 1, fp, ep, vp);
-    for (int32_t i = 0; i < nverts; i++) {
-        int32_t v = verts[i];
-        double *o = vp + 3 * (size_t)v;
-        if (m->vfan_start[v + 1] == m->vfan_start[v]) memcpy(o, m->pos + 3 * (size_t)v, sizeof(double) * 3);
-        else if (m->esharp) creased_vertex_point(c, v, fp, o);
-        else if (m->vboundary[v]) ccn__boundary_vertex_point(m, v, c->H, c->pinned, o);
-        else ccn__nurss_vertex_point(m, v, c->H, fp, o);
-    }
+    for (int32_t i = 0; i < nverts; i++) one_vertex_point(c, verts[i], fp, vp);
     apply_red(c, 2, fp, ep, vp);
 }
 
