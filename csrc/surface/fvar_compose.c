@@ -50,6 +50,7 @@ typedef struct {
     double *posS;             /* level-(L+1) points, 3 * (nf + ne + nv) of level L */
     int32_t *value_of;        /* level-0 value vertex -> cage value */
     int32_t *fo;              /* level-L value vertex -> the cage face it lies on */
+    int32_t *ab;              /* its grid point there, a + (b << 16) (quad cage faces) */
     uint8_t *direct;          /* level-L value vertex: weights written down (surface/fvar_direct.c) */
     ccn__fvar_direct dir;
     probe_list *pl;           /* L levels' points the probes need (NULL: all) */
@@ -61,7 +62,7 @@ static void builder_free(builder *c) {
     for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
     if (c->has_sub) ccn__level_free(&c->sub);
     free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
-    free(c->posS); free(c->value_of); free(c->fo); free(c->direct); free(c->outs);
+    free(c->posS); free(c->value_of); free(c->fo); free(c->ab); free(c->direct); free(c->outs);
     ccn__fvar_direct_free(&c->dir);
     for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
     free(c->pl);
@@ -309,8 +310,10 @@ static void origin_range(void *ctx, int32_t b, int32_t end) {
     const origin_job *j = ctx;
     builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
+    double scale = (double)(1 << c->L), uv[2];
     for (int32_t o = b; o < end; o++) {
-        c->fo[o] = origin(j->p, mL, o, NULL);
+        c->fo[o] = origin(j->p, mL, o, uv);
+        c->ab[o] = (int32_t)lround(uv[0] * scale) + ((int32_t)lround(uv[1] * scale) << 16);
         c->direct[o] = c->dir.slot && c->dir.slot[c->fo[o]] >= 0;
     }
 }
@@ -337,8 +340,9 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     }
     const ccn_mesh *mL = c->lev[c->L].m;
     c->fo = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    c->ab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     c->direct = malloc((size_t)(mL->nv ? mL->nv : 1));
-    if (!c->fo || !c->direct || (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir)))
+    if (!c->fo || !c->ab || !c->direct || (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir)))
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     origin_job oj = {p, c};
     ccn__parallel_for(p->threads, mL->nv, origin_range, &oj);
@@ -563,7 +567,7 @@ static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, 
 }
 
 typedef struct {
-    const ccn_plan *p; const builder *c;
+    const builder *c;
     const csr *K; const int32_t *fo, *col, *start, *compact;
     int32_t *idx, *ccol;
     ccn__fvar_stencils *s;
@@ -573,15 +577,10 @@ typedef struct {
  * regular face none, but the face and the grid point. */
 static void cand_range(void *ctx, int32_t b, int32_t end) {
     const cand_job *j = ctx;
-    const ccn_mesh *mL = j->c->lev[j->c->L].m;
-    double scale = (double)(j->s->side - 1);
     for (int32_t o = b; o < end; o++) {
         int32_t n = j->start[o];
         if (j->c->direct[o]) {
-            double uv[2];
-            int32_t f = origin(j->p, mL, o, uv);
-            j->s->dface[o] = j->compact[f];
-            j->s->dab[o] = (int32_t)lround(uv[0] * scale) + ((int32_t)lround(uv[1] * scale) << 16);
+            j->s->dface[o] = j->compact[j->fo[o]];
             continue;
         }
         if (j->s->dface) j->s->dface[o] = -1;
@@ -624,14 +623,15 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
 
 /* The regular faces' part of the stencils: per face its 16 caller values and basis tables,
  * compact[f] its index (nf, malloc'd). Each table row sums to 1 (affine invariance). */
-static ccn_status direct_tables(const builder *c, ccn__fvar_stencils *s, int32_t **compact, ccn_error *err) {
+static ccn_status direct_tables(builder *c, ccn__fvar_stencils *s, int32_t **compact, ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
     int32_t nd = c->dir.count, side = (1 << c->L) + 1;
     s->nd = nd;
     s->side = side;
     *compact = malloc(sizeof(int32_t) * (size_t)(m0->nf ? m0->nf : 1));
     s->dface = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
-    s->dab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    s->dab = c->ab; /* the outputs' grid points (origin_range) */
+    c->ab = NULL;
     s->dvals = malloc(sizeof(int32_t) * 16 * (size_t)nd);
     s->dN = malloc(sizeof(double) * 8 * (size_t)side * (size_t)nd);
     if (!*compact || !s->dface || !s->dab || !s->dvals || !s->dN)
@@ -679,7 +679,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
     int32_t *compact = NULL;
     if (c->dir.count > 0 && (st = direct_tables(c, s, &compact, err))) { free(compact); goto done; }
-    cand_job cj = {p, c, &K, fo, col, s->start, compact, s->idx, ccol, s};
+    cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, ccol, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);
     if (c->dir.count > 0) { /* probes of the other outputs: their points only, the rest zero */
