@@ -10,6 +10,8 @@ typedef struct {
     int32_t *slot;  /* nf: the face's slot below (the face itself), -1: composed by probing */
     int32_t *verts; /* 16 per slot: value vertex P_ij at i + 4 j (corner 0 of the face is P_11) */
     double *knots;  /* 12 per slot: the knot vectors U[0..5], V[0..5] (span [U2, U3] x [V2, V3]) */
+    uint8_t *fold;  /* per slot: missing end points, point-reflected (1: P_0j, 2: P_3j, 4: P_i0,
+                     * 8: P_i3; their slots hold a real value with weight 0) */
     int32_t count;
 } ccn__fvar_direct;
 
