@@ -297,44 +297,57 @@ static void apply_red(const ccn__level *c, int which, double *fp, double *ep, do
 
 /* ---- topology of the refined mesh -------------------------------------------------- */
 
-static int32_t child_edge(const ccn_mesh *m, int32_t e, int32_t v) {
-    return m->everts[2 * e] == v ? 2 * e : 2 * e + 1;
+/* Child edge of e at its end v: 2e from everts[2e], 2e + 1 from the other end. */
+static int32_t child_edge(const int32_t *everts, int32_t e, int32_t v) {
+    return everts[2 * e] == v ? 2 * e : 2 * e + 1;
 }
 
-static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand) {
-    int32_t nf = m->nf, ne = m->ne;
+void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
+                                const int32_t *hedge, const int32_t *everts, int32_t *chvert,
+                                int32_t *chedge, int32_t *ceverts) {
+    int32_t nf = m->nf;
     for (int32_t e = 0; e < ne; e++) {
         int32_t ep = nf + e;
-        r->everts[4 * e + 0] = nf + ne + m->everts[2 * e];
-        r->everts[4 * e + 1] = ep;
-        r->everts[4 * e + 2] = ep;
-        r->everts[4 * e + 3] = nf + ne + m->everts[2 * e + 1];
-        cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
+        ceverts[4 * e + 0] = nf + ne + everts[2 * e];
+        ceverts[4 * e + 1] = ep;
+        ceverts[4 * e + 2] = ep;
+        ceverts[4 * e + 3] = nf + ne + everts[2 * e + 1];
     }
     for (int32_t f = 0; f < nf; f++) {
         int32_t s = m->fstart[f], n = ccn__fsize(m, f);
         for (int32_t j = 0; j < n; j++) {
-            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n;
-            int32_t v = m->hvert[h], q = 4 * h, inner = 2 * ne + h;
-            int32_t innerp = 2 * ne + hp;
-            r->hvert[q + 0] = nf + ne + v;
-            r->hvert[q + 1] = nf + m->hedge[h];
-            r->hvert[q + 2] = f;
-            r->hvert[q + 3] = nf + m->hedge[hp];
-            r->hedge[q + 0] = child_edge(m, m->hedge[h], v);
-            r->hedge[q + 1] = inner;
-            r->hedge[q + 2] = innerp;
-            r->hedge[q + 3] = child_edge(m, m->hedge[hp], v);
+            int32_t h = s + j, hp = s + (j + n - 1) % n;
+            int32_t v = hvert[h], q = 4 * h, inner = 2 * ne + h;
+            chvert[q + 0] = nf + ne + v;
+            chvert[q + 1] = nf + hedge[h];
+            chvert[q + 2] = f;
+            chvert[q + 3] = nf + hedge[hp];
+            chedge[q + 0] = child_edge(everts, hedge[h], v);
+            chedge[q + 1] = inner;
+            chedge[q + 2] = 2 * ne + hp;
+            chedge[q + 3] = child_edge(everts, hedge[hp], v);
+            ceverts[2 * inner] = f;
+            ceverts[2 * inner + 1] = nf + hedge[h];
+        }
+    }
+}
+
+static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand) {
+    int32_t nf = m->nf, ne = m->ne;
+    ccn__level_child_numbering(m, ne, m->hvert, m->hedge, m->everts, r->hvert, r->hedge, r->everts);
+    for (int32_t e = 0; e < ne; e++) cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
+        for (int32_t j = 0; j < n; j++) {
+            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n, q = 4 * h;
             int32_t t = m->htwin[h], tp = m->htwin[hp];
             r->htwin[q + 0] = t >= 0 ? 4 * ccn__next(m, t) + 3 : -1;
             r->htwin[q + 1] = 4 * hn + 2;
             r->htwin[q + 2] = 4 * hp + 1;
             r->htwin[q + 3] = tp >= 0 ? 4 * tp : -1;
-            r->everts[2 * inner] = f;
-            r->everts[2 * inner + 1] = nf + m->hedge[h];
             /* NURSS Fig. 10: half the mean of the two sides adjacent to edge j (for a quad
              * with consistent rings: half the parallel ring's interval) */
-            cand[inner] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
+            cand[2 * ne + h] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
             for (int k = 0; k < 4; k++) r->hface[q + k] = h;
         }
     }

@@ -55,6 +55,10 @@ typedef struct {
     ccn__fvar_direct dir;
     probe_list *pl;           /* L levels' points the probes need (NULL: all) */
     int32_t nouts, *outs;     /* the outputs composed by probing */
+    /* every output written down: levels 1..L as numbering only (numbered()) */
+    int numbered_only;
+    int32_t nvL, nsharpL;     /* level L's value vertices, those kept sharp */
+    int32_t *hvL, *firstL;    /* level L: value vertex per corner; each one's first fan corner */
 } builder;
 
 static void builder_free(builder *c) {
@@ -63,6 +67,7 @@ static void builder_free(builder *c) {
     if (c->has_sub) ccn__level_free(&c->sub);
     free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
     free(c->posS); free(c->value_of); free(c->fo); free(c->ab); free(c->direct); free(c->outs);
+    free(c->hvL); free(c->firstL);
     ccn__fvar_direct_free(&c->dir);
     for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
     free(c->pl);
@@ -285,9 +290,10 @@ done:
 /* The cage face a level-L value vertex o lies on, through its first face, and o's coordinates
  * there when that face is a quad: each level's face is the child quad (V_j, E(h_j), F,
  * E(h_j-1)) at corner j of its parent (refine/level.c), a quarter of the parent's unit square. */
-static int32_t origin(const ccn_plan *p, const ccn_mesh *mL, int32_t o, double uv[2]) {
+static int32_t origin(const ccn_plan *p, int32_t h, double uv[2]) {
     static const double C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    int32_t h = mL->vfan[mL->vfan_start[o]], g = mL->hface[h], j = h - mL->fstart[g];
+    const ccn_mesh *mL = p->lev[p->L]; /* the value mesh's faces and corners are the vertices' */
+    int32_t g = mL->hface[h], j = h - mL->fstart[g];
     double s = C[j & 3][0], t = C[j & 3][1];
     for (int32_t l = p->L; l > 0; l--) {
         const ccn_mesh *m = p->lev[l - 1];
@@ -309,13 +315,86 @@ typedef struct { const ccn_plan *p; builder *c; } origin_job;
 static void origin_range(void *ctx, int32_t b, int32_t end) {
     const origin_job *j = ctx;
     builder *c = j->c;
-    const ccn_mesh *mL = c->lev[c->L].m;
+    const ccn_mesh *mL = c->numbered_only ? NULL : c->lev[c->L].m;
     double scale = (double)(1 << c->L), uv[2];
     for (int32_t o = b; o < end; o++) {
-        c->fo[o] = origin(j->p, mL, o, uv);
+        c->fo[o] = origin(j->p, mL ? mL->vfan[mL->vfan_start[o]] : c->firstL[o], uv);
         c->ab[o] = (int32_t)lround(uv[0] * scale) + ((int32_t)lround(uv[1] * scale) << 16);
         c->direct[o] = c->dir.slot && c->dir.slot[c->fo[o]] >= 0;
     }
+}
+
+/* Every output written down: of levels 1..L only the numbering of the value vertices is needed
+ * (refine/level.c's, through ccn__level_child_numbering from level 0's value vertices and
+ * edges), each level-L value vertex's first fan corner as the value mesh would have it (its
+ * outgoing boundary corner, else its first corner: topology/mesh.c) for origin(), and the
+ * count of values kept sharp (vertex points keep their value's flag; under BOUNDARIES the
+ * points of boundary edges are sharp too). */
+static ccn_status numbered(const ccn_plan *p, builder *c, ccn_error *err) {
+    const ccn_mesh *m0 = c->lev[0].m;
+    int32_t nv = m0->nv, ne = m0->ne, *hv = NULL, *he = NULL, *ev = NULL, *cnt = NULL;
+    int64_t nsharp = ccn__fvar_num_sharp(&c->lev[0]);
+    int bnd = c->lev[0].linear == CCN_FVAR_LINEAR_BOUNDARIES;
+    ccn_status st = CCN_OK;
+    for (int32_t l = 0; l < c->L && !st; l++) {
+        const ccn_mesh *vm = p->lev[l];
+        const int32_t *hv0 = l ? hv : m0->hvert, *he0 = l ? he : m0->hedge, *ev0 = l ? ev : m0->everts;
+        int64_t nh2 = 4 * (int64_t)vm->nh, ne2 = 2 * (int64_t)ne + vm->nh, nv2 = (int64_t)vm->nf + ne + nv;
+        int32_t *hv2 = nh2 < INT32_MAX / 8 ? malloc(sizeof(int32_t) * (size_t)nh2) : NULL;
+        int32_t *he2 = nh2 < INT32_MAX / 8 ? malloc(sizeof(int32_t) * (size_t)nh2) : NULL;
+        int32_t *ev2 = ne2 < INT32_MAX / 8 ? malloc(sizeof(int32_t) * 2 * (size_t)ne2) : NULL;
+        if (bnd) { /* boundary value edges: one corner each */
+            cnt = calloc((size_t)(ne ? ne : 1), sizeof(int32_t));
+            for (int32_t h = 0; cnt && h < vm->nh; h++) cnt[he0[h]]++;
+            for (int32_t e = 0; cnt && e < ne; e++) nsharp += cnt[e] == 1;
+        }
+        if (!hv2 || !he2 || !ev2 || (bnd && !cnt))
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying levels)");
+        else
+            ccn__level_child_numbering(vm, ne, hv0, he0, ev0, hv2, he2, ev2);
+        free(cnt);
+        cnt = NULL;
+        if (l) { free(hv); free(he); free(ev); }
+        hv = hv2; he = he2; ev = ev2; /* freed below on failure */
+        nv = (int32_t)nv2; ne = (int32_t)ne2;
+    }
+    if (st) { free(hv); free(he); free(ev); return st; }
+    int32_t nh = p->lev[c->L]->nh;
+    if (!st && c->L == 0) { /* level 0 is the value mesh itself */
+        hv = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+        he = malloc(sizeof(int32_t) * (size_t)(nh ? nh : 1));
+        if (hv && he) { memcpy(hv, m0->hvert, sizeof(int32_t) * (size_t)nh); memcpy(he, m0->hedge, sizeof(int32_t) * (size_t)nh); }
+        else st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying levels)");
+    }
+    if (!st) {
+        c->firstL = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1));
+        cnt = calloc((size_t)(ne ? ne : 1), sizeof(int32_t));
+        if (!c->firstL || !cnt) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying levels)");
+    }
+    if (!st) {
+        for (int32_t h = 0; h < nh; h++) cnt[he[h]]++;
+        for (int32_t v = 0; v < nv; v++) c->firstL[v] = -1;
+        for (int32_t h = 0; h < nh; h++) {
+            int32_t v = hv[h];
+            if (c->firstL[v] < 0 || cnt[he[h]] == 1) c->firstL[v] = h;
+        }
+        for (int32_t v = 0; v < nv && !st; v++)
+            if (c->firstL[v] < 0) st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "face-varying level %d: value %d has no face", (int)c->L, (int)v);
+    }
+    free(cnt); free(he); free(ev);
+    c->hvL = hv;
+    c->nvL = nv;
+    c->nsharpL = nsharp > INT32_MAX ? INT32_MAX : (int32_t)nsharp;
+    if (st) return st;
+    c->fo = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1));
+    c->ab = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1));
+    c->direct = malloc((size_t)(nv ? nv : 1));
+    c->outs = malloc(sizeof(int32_t));
+    if (!c->fo || !c->ab || !c->direct || !c->outs)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    origin_job oj = {p, c};
+    ccn__parallel_for(p->threads, nv, origin_range, &oj);
+    return CCN_OK;
 }
 
 static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *c, ccn_error *err) {
@@ -328,6 +407,12 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
     if (st) return st;
+    if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    if (!c->bilinear && c->dir.count == c->lev[0].m->nf) { /* nothing to probe */
+        c->numbered_only = 1;
+        return numbered(p, c, err);
+    }
     for (int32_t l = 0; l < c->L; l++) {
         if ((st = ccn__fvar_prepare(&c->prep[l], &c->lev[l], p->opts.scheme, p->opts.crease_method,
                                       p->opts.ev_polyhedron, p->ev_cache, err))) {
@@ -342,7 +427,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     c->fo = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     c->ab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     c->direct = malloc((size_t)(mL->nv ? mL->nv : 1));
-    if (!c->fo || !c->ab || !c->direct || (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir)))
+    if (!c->fo || !c->ab || !c->direct)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     origin_job oj = {p, c};
     ccn__parallel_for(p->threads, mL->nv, origin_range, &oj);
@@ -624,12 +709,12 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
 /* The regular faces' part of the stencils: per face its 16 caller values and basis tables,
  * compact[f] its index (nf, malloc'd). Each table row sums to 1 (affine invariance). */
 static ccn_status direct_tables(builder *c, ccn__fvar_stencils *s, int32_t **compact, ccn_error *err) {
-    const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
-    int32_t nd = c->dir.count, side = (1 << c->L) + 1;
+    const ccn_mesh *m0 = c->lev[0].m;
+    int32_t nd = c->dir.count, side = (1 << c->L) + 1, nout = s->nout;
     s->nd = nd;
     s->side = side;
     *compact = malloc(sizeof(int32_t) * (size_t)(m0->nf ? m0->nf : 1));
-    s->dface = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    s->dface = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
     s->dab = c->ab; /* the outputs' grid points (origin_range) */
     c->ab = NULL;
     s->dvals = malloc(sizeof(int32_t) * 16 * (size_t)nd);
@@ -652,14 +737,14 @@ static ccn_status direct_tables(builder *c, ccn__fvar_stencils *s, int32_t **com
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
-    const ccn_mesh *m0 = c->lev[0].m, *mL = c->lev[c->L].m;
-    int32_t nout = mL->nv;
+    const ccn_mesh *m0 = c->lev[0].m;
+    int32_t nout = s->nout;
     csr K = {NULL, NULL};
     int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv);
     const int32_t *fo = c->fo;
     int32_t ncol = -1, *ccol = NULL;
     ccn_status st = CCN_OK;
-    if (col && fo && !neighbourhoods(m0, c->dir.slot, &K)) ncol = colour(m0, &K, col);
+    if (col && fo && !neighbourhoods(m0, c->dir.slot, &K)) ncol = c->nouts ? colour(m0, &K, col) : 0;
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
     if (ncol < 0 || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
@@ -682,12 +767,12 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, ccol, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);
-    if (c->dir.count > 0) { /* probes of the other outputs: their points only, the rest zero */
+    if (c->dir.count > 0 && c->nouts) { /* probes of the other outputs: their points only, the rest zero */
         if (probe_lists(c)) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
         for (int32_t l = 1; l <= c->L; l++)
             memset(c->lev[l].m->pos, 0, sizeof(double) * 3 * (size_t)c->lev[l].m->nv);
     }
-    for (int32_t b = 0, npass = (ncol + 2) / 3; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
+    for (int32_t b = 0, npass = c->nouts ? (ncol + 2) / 3 : 0; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
     free(ccol);
     ccol = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
@@ -744,7 +829,13 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
     memset(&c, 0, sizeof c);
     memset(s, 0, sizeof *s);
     ccn_status st = build(p, ch, &c, err);
-    if (!st) {
+    if (!st && c.numbered_only) { /* level L's numbering is all that was made */
+        s->nout = c.nvL;
+        s->num_seams = c.lev[0].num_seams;
+        s->num_sharp = c.nsharpL;
+        s->face_values = c.hvL;
+        c.hvL = NULL;
+    } else if (!st) {
         const ccn_mesh *mL = c.lev[c.L].m;
         s->nout = mL->nv;
         s->num_seams = c.lev[0].num_seams;
