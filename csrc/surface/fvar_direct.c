@@ -70,12 +70,6 @@ static int put(int32_t P[16], int32_t v, int i, int j) {
     return 0;
 }
 
-static int find(const int32_t P[16], int32_t v, int *i, int *j) {
-    for (int k = 0; k < 16; k++)
-        if (P[k] == v) { *i = k & 3; *j = k >> 2; return 0; }
-    return -1;
-}
-
 /* The fan position of w's edge towards a (0 .. valence - 1), -1 if none. */
 static int spoke_of(const ccn_mesh *m, int32_t w, int32_t a) {
     for (int32_t k = 0, n = ccn__valence(m, w); k < n; k++) {
@@ -101,65 +95,65 @@ static double beyond(const ccn_mesh *m, int32_t w, int32_t a) {
 }
 
 /* Block, knot vectors and folds of face f, 0 if it is written down. The faces around f's
- * corners are laid on the integer grid from f (corners (1,1), (2,1), (2,2), (1,2)), each from
- * an edge already laid: every face lies to the left of its half-edges. A boundary edge of a
+ * corners are laid on the integer grid from f (corners (1,1), (2,1), (2,2), (1,2)), each by its
+ * place in the corner's fan (quarter turns about it). A boundary edge of a
  * laid face is a boundary line (u_lo: column 0 or 1, the faces to its right; u_hi: 2 or 3;
  * v_lo / v_hi: rows): on a line at column 1 (2), column 0 (3) is missing and is the point
- * reflection 2 P_1j - P_2j (2 P_2j - P_1j) with the mirrored intervals (Li 2016's boundary
- * curve with the point-reflected ends: tests/c/bspline_oracle.h); on a line at column 0 (3)
+ * reflection 2 P_1j - P_2j (2 P_2j - P_1j) with the mirrored intervals (DESIGN §4.2's boundary
+ * curve with point-reflected ends, as tests/c/bspline_oracle.h has it); on a line at column 0 (3)
  * the interval beyond it is mirrored. A vertex on no line must be interior, on one a
  * boundary vertex, on two a pinned corner. */
 static int block(const ccn__fvar_level *fl, const uint8_t *kind, int32_t f, int32_t P[16],
                  double kn[12], uint8_t *fold) {
     const ccn_mesh *m = fl->m;
     if (ccn__fsize(m, f) != 4) return -1;
-    int32_t h0 = m->fstart[f], faces[16];
-    int nfaces = 0;
-    uint8_t laid[16];
+    int32_t h0 = m->fstart[f], faces[13];
+    int8_t gi[13][4], gj[13][4]; /* each laid face's corners on the grid, in its own order */
+    int nfaces = 1;
     static const int ci[4] = {1, 2, 2, 1}, cj[4] = {1, 1, 2, 2};
     for (int k = 0; k < 16; k++) P[k] = -1;
+    faces[0] = f;
     for (int k = 0; k < 4; k++) {
         int32_t c = m->hvert[h0 + k];
         if (kind[c] == K_NONE || put(P, c, ci[k], cj[k])) return -1;
-        for (int32_t q = m->vfan_start[c]; q < m->vfan_start[c + 1]; q++) {
-            int32_t g = m->hface[m->vfan[q]], known = g == f;
-            for (int t = 0; t < nfaces && !known; t++) known = faces[t] == g;
-            if (known) continue;
-            if (nfaces == 15) return -1;
-            laid[nfaces] = 0;
-            faces[nfaces++] = g;
-        }
+        gi[0][k] = (int8_t)ci[k];
+        gj[0][k] = (int8_t)cj[k];
     }
-    for (int progress = 1, left = nfaces; progress && left;) { /* lay the faces edge by edge */
-        progress = 0;
-        for (int t = 0; t < nfaces; t++) {
-            if (laid[t]) continue;
-            int32_t g = faces[t], s = m->fstart[g];
-            for (int k = 0; k < 4 && !laid[t]; k++) {
-                int32_t p = m->hvert[s + k], q = m->hvert[s + (k + 1) % 4];
-                int pi, pj, qi, qj;
-                if (find(P, p, &pi, &pj) || find(P, q, &qi, &qj)) continue;
-                int di = qi - pi, dj = qj - pj;
-                if (di * di + dj * dj != 1) return -1;
-                if (put(P, m->hvert[s + (k + 2) % 4], qi - dj, qj + di) ||
-                    put(P, m->hvert[s + (k + 3) % 4], pi - dj, pj + di))
-                    return -1;
-                laid[t] = 1;
-                left--;
-                progress = 1;
-            }
+    /* the faces around corner c_k, counter-clockwise from f in c_k's fan (the next one is
+     * across f's edge to c_k-1): the t-th lies on the grid square spanned by R^t a, R^t+1 a
+     * from c_k, a the direction of f's edge to c_k+1, R the quarter turn (x, y) -> (-y, x) */
+    for (int k = 0; k < 4; k++) {
+        int32_t c = m->hvert[h0 + k], s = m->vfan_start[c], nfan = m->vfan_start[c + 1] - s;
+        int32_t pf = m->hfanpos[h0 + k];
+        for (int32_t p = 0; p < nfan; p++) {
+            if (p == pf) continue;
+            int t = (int)(((p - pf) % 4 + 4) % 4), x = ci[(k + 1) & 3] - ci[k], y = cj[(k + 1) & 3] - cj[k];
+            for (int r = 0; r < t; r++) { int z = x; x = -y; y = z; }
+            int x2 = -y, y2 = x; /* R^t+1 a */
+            int32_t hg = m->vfan[s + p], g = m->hface[hg], q = hg - m->fstart[g];
+            int32_t hn = ccn__next(m, hg), ho = ccn__next(m, hn), hp = ccn__prev(m, hg);
+            if (put(P, m->hvert[hn], ci[k] + x, cj[k] + y) || put(P, m->hvert[ho], ci[k] + x + x2, cj[k] + y + y2) ||
+                put(P, m->hvert[hp], ci[k] + x2, cj[k] + y2))
+                return -1;
+            int known = 0;
+            for (int u = 1; u < nfaces && !known; u++) known = faces[u] == g;
+            if (known) continue;
+            if (nfaces == 13) return -1;
+            faces[nfaces] = g;
+            gi[nfaces][q] = (int8_t)ci[k];             gj[nfaces][q] = (int8_t)cj[k];
+            gi[nfaces][(q + 1) & 3] = (int8_t)(ci[k] + x); gj[nfaces][(q + 1) & 3] = (int8_t)(cj[k] + y);
+            gi[nfaces][(q + 2) & 3] = (int8_t)(ci[k] + x + x2); gj[nfaces][(q + 2) & 3] = (int8_t)(cj[k] + y + y2);
+            gi[nfaces][(q + 3) & 3] = (int8_t)(ci[k] + x2); gj[nfaces][(q + 3) & 3] = (int8_t)(cj[k] + y2);
+            nfaces++;
         }
-        if (!progress) return -1;
     }
     /* the boundary lines */
     int ul = -9, uh = -9, vl = -9, vh = -9;
-    for (int t = -1; t < nfaces; t++) {
-        int32_t g = t < 0 ? f : faces[t], s = m->fstart[g];
+    for (int t = 0; t < nfaces; t++) {
+        int32_t s = m->fstart[faces[t]];
         for (int k = 0; k < 4; k++) {
             if (m->htwin[s + k] >= 0) continue;
-            int pi = 0, pj = 0, qi = 0, qj = 0; /* every laid face's vertices are on the grid */
-            find(P, m->hvert[s + k], &pi, &pj);
-            find(P, m->hvert[s + (k + 1) % 4], &qi, &qj);
+            int pi = gi[t][k], pj = gj[t][k], qi = gi[t][(k + 1) & 3], qj = gj[t][(k + 1) & 3];
             int *line = qj < pj ? &ul : qj > pj ? &uh : qi > pi ? &vl : &vh;
             int at = pi == qi ? pi : pj;
             if (*line != -9 && *line != at) return -1;
@@ -169,12 +163,10 @@ static int block(const ccn__fvar_level *fl, const uint8_t *kind, int32_t f, int3
     if ((ul != -9 && ul > 1) || (uh != -9 && uh < 2) || (vl != -9 && vl > 1) || (vh != -9 && vh < 2) ||
         (ul == 1 && uh == 2) || (vl == 1 && vh == 2))
         return -1;
-    for (int t = -1; t < nfaces; t++) { /* a line's edges are all boundary edges */
-        int32_t g = t < 0 ? f : faces[t], s = m->fstart[g];
+    for (int t = 0; t < nfaces; t++) { /* a line's edges are all boundary edges */
+        int32_t s = m->fstart[faces[t]];
         for (int k = 0; k < 4; k++) {
-            int pi = 0, pj = 0, qi = 0, qj = 0; /* every laid face's vertices are on the grid */
-            find(P, m->hvert[s + k], &pi, &pj);
-            find(P, m->hvert[s + (k + 1) % 4], &qi, &qj);
+            int pi = gi[t][k], pj = gj[t][k], qi = gi[t][(k + 1) & 3], qj = gj[t][(k + 1) & 3];
             int on = (pi == qi && (pi == ul || pi == uh)) || (pj == qj && (pj == vl || pj == vh));
             if (on && m->htwin[s + k] >= 0) return -1;
         }
