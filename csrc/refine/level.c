@@ -160,7 +160,11 @@ static void one_vertex_point(const ccn__level *c, int32_t v, const double *fp, d
     if (m->vfan_start[v + 1] == m->vfan_start[v]) { /* isolated: carried along */
         memcpy(out, m->pos + 3 * (size_t)v, sizeof(double) * 3);
     } else if (m->esharp) {
-        creased_vertex_point(c, v, fp, out);
+        if (c->tvs && c->tvs[v]) /* its creased rule is the smooth one, tabulated */
+            ccn__nurss_vertex_blend(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v, c->H,
+                                    fp, out);
+        else
+            creased_vertex_point(c, v, fp, out);
     } else if (m->vboundary[v]) {
         ccn__boundary_vertex_point(m, v, c->H, c->pinned, out);
     } else if (c->tv) {
@@ -194,32 +198,46 @@ static void tab_edge_range(void *ctx, int32_t b, int32_t end) {
 static void tab_vertex_range(void *ctx, int32_t b, int32_t e) {
     const ccn__level *c = ctx;
     const ccn_mesh *m = c->m;
-    for (int32_t v = b; v < e; v++)
-        if (m->vfan_start[v + 1] > m->vfan_start[v] && !m->vboundary[v])
-            ccn__nurss_vertex_weights(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v);
+    float ps[CREASE_STACK];
+    for (int32_t v = b; v < e; v++) {
+        if (m->vfan_start[v + 1] == m->vfan_start[v] || m->vboundary[v]) continue;
+        if (c->tvs) { /* creased mesh: where creased_vertex_point takes the smooth rule */
+            int32_t n = ccn__valence(m, v);
+            c->tvs[v] = 0;
+            if ((c->partner && c->partner[v] >= 0) || n > CREASE_STACK) continue;
+            ccn__fan_sharpness(m, v, ps);
+            int rule = ccn__sharp_rule(ccn__vertex_sharpness(m, v, c->pinned), n, ps);
+            if (rule != CCN_RULE_SMOOTH && rule != CCN_RULE_DART) continue;
+            c->tvs[v] = 1;
+        }
+        ccn__nurss_vertex_weights(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v);
+    }
 }
 
 /* Once per level; out of memory: no tables (the rules run). The face and edge weights come
  * from the crease-aware look-ups, so they hold on creased meshes too (the sharp edges' own rule
- * still runs); the vertex weights are the smooth rule's, tabulated without creases only. */
+ * still runs); the vertex weights are the smooth rule's, on a creased mesh for the interior
+ * vertices whose sharpness gives the smooth (or dart) rule (tvs), the same arithmetic as
+ * creased_vertex_point's. */
 static void tabulate(ccn__level *c) {
     const ccn_mesh *m = c->m;
     if (c->tab_tried) return;
     c->tab_tried = 1;
     c->tf = malloc(sizeof(double) * 2 * (size_t)(m->nf ? m->nf : 1));
     c->te = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
-    if (!m->esharp) {
-        c->tv = malloc(sizeof(double) * 2 * (size_t)(m->nv ? m->nv : 1));
-        c->th = malloc(sizeof(double) * 2 * (size_t)(m->nh ? m->nh : 1));
-    }
-    if (!c->tf || !c->te || (!m->esharp && (!c->tv || !c->th))) {
-        free(c->tf); free(c->te); free(c->tv); free(c->th);
+    c->tv = malloc(sizeof(double) * 2 * (size_t)(m->nv ? m->nv : 1));
+    c->th = malloc(sizeof(double) * 2 * (size_t)(m->nh ? m->nh : 1));
+    if (m->esharp) c->tvs = malloc((size_t)(m->nv ? m->nv : 1));
+    if (!c->tf || !c->te || !c->tv || !c->th || (m->esharp && !c->tvs)) {
+        free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs);
         c->tf = c->te = c->tv = c->th = NULL;
+        c->tvs = NULL;
         return;
     }
     ccn__parallel_for(c->threads, m->nf, tab_face_range, c);
     ccn__parallel_for(c->threads, m->ne, tab_edge_range, c);
-    if (c->tv) ccn__parallel_for(c->threads, m->nv, tab_vertex_range, c);
+    if (c->tvs) memset(c->tvs, 0, (size_t)m->nv);
+    ccn__parallel_for(c->threads, m->nv, tab_vertex_range, c);
 }
 
 static void vertex_range(void *ctx, int32_t b, int32_t e) {
@@ -430,7 +448,7 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
 
 void ccn__level_free(ccn__level *c) {
     if (!c) return;
-    free(c->tf); free(c->te); free(c->tv); free(c->th);
+    free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs);
     free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
     memset(c, 0, sizeof *c);
 }
