@@ -16,9 +16,7 @@ static void *run_job(void *arg) {
     return NULL;
 }
 
-void ccn__parallel_for(int threads, int32_t n, ccn__range_fn fn, void *ctx) {
-    if (threads > CCN_MAX_THREADS) threads = CCN_MAX_THREADS;
-    if (threads > n / CCN_MIN_PER_THREAD) threads = n / CCN_MIN_PER_THREAD;
+static void run(int threads, int32_t n, ccn__range_fn fn, void *ctx) {
     if (threads <= 1) {
         if (n > 0) fn(ctx, 0, n);
         return;
@@ -39,6 +37,18 @@ void ccn__parallel_for(int threads, int32_t n, ccn__range_fn fn, void *ctx) {
         if (started[t]) pthread_join(tid[t], NULL);
         else run_job(&jobs[t]);
     }
+}
+
+void ccn__parallel_for(int threads, int32_t n, ccn__range_fn fn, void *ctx) {
+    if (threads > CCN_MAX_THREADS) threads = CCN_MAX_THREADS;
+    if (threads > n / CCN_MIN_PER_THREAD) threads = n / CCN_MIN_PER_THREAD;
+    run(threads, n, fn, ctx);
+}
+
+void ccn__parallel_tasks(int threads, int32_t n, ccn__range_fn fn, void *ctx) {
+    if (threads > CCN_MAX_THREADS) threads = CCN_MAX_THREADS;
+    if (threads > n) threads = n;
+    run(threads, n, fn, ctx);
 }
 
 int ccn__thread_count(int32_t option) {

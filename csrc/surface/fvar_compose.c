@@ -452,13 +452,15 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
 /* One probe pass's limit values, read off as they are made: output o's limit of the level-L
  * values (3 components: colours 3b .. 3b+2 set to 1) is the weight of each of o's candidates
  * (row start[o] .. start[o+1]) with one of those colours. */
-typedef struct { const builder *c; const int32_t *start, *ccol, *outs; double *cw; int32_t b; } limit_job;
+typedef struct {
+    const builder *c; const double *PL, *PS; const int32_t *start, *ccol, *outs; double *cw; int32_t b;
+} limit_job;
 
 static void limit_range(void *ctx, int32_t b, int32_t end) {
     const limit_job *j = ctx;
     const builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
-    const double *PL = mL->pos, *PS = c->posS;
+    const double *PL = j->PL, *PS = j->PS;
     const int32_t *start = j->start, *ccol = j->ccol, c0 = 3 * j->b;
     int32_t nvL = mL->nv;
     for (int32_t i = b; i < end; i++) {
@@ -634,21 +636,118 @@ static int probe_lists(builder *c) {
     return ok ? 0 : -1;
 }
 
+/* What one probe pass writes: the levels' points (pos[l], the value mesh of level l's) and the
+ * rules' scratch (levels prep[0..L-1], sub). The builder's own, or a worker's copies sharing
+ * their topology, rules and tables (struct copies with their own points and scratch H; every
+ * table is made by the first pass, before the workers start). */
+typedef struct {
+    double **pos, *posS;
+    ccn__level *prep, *sub;
+    ccn_mesh *mcopy;          /* a worker's: the meshes its levels read their points from */
+    ccn__level subcopy;
+} probe_set;
+
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
  * stencil run; each candidate weight of those colours is read off (limit_range). */
-static void probe(const ccn_plan *p, builder *c, const int32_t *col, int32_t b, const int32_t *start,
-                  const int32_t *ccol, double *cw) {
-    ccn_mesh *m0 = c->lev[0].m;
-    for (int32_t v = 0; v < m0->nv; v++)
-        for (int k = 0; k < 3; k++) m0->pos[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
+static void probe(const builder *c, const probe_set *w, int threads, const int32_t *col, int32_t b,
+                  const int32_t *start, const int32_t *ccol, double *cw) {
+    double *P0 = w->pos[0];
+    for (int32_t v = 0; v < c->lev[0].m->nv; v++)
+        for (int k = 0; k < 3; k++) P0[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
     for (int32_t l = 0; l < c->L; l++) {
         const probe_list *q = c->pl ? &c->pl[l] : NULL;
-        if (q) ccn__level_points_lists(&c->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, c->lev[l + 1].m->pos);
-        else ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
+        if (q) ccn__level_points_lists(&w->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, w->pos[l + 1]);
+        else ccn__level_points(&w->prep[l], w->pos[l + 1]);
     }
-    if (c->has_sub) ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
-    limit_job j = {c, start, ccol, c->outs, cw, b};
-    ccn__parallel_for(p->threads, c->nouts, limit_range, &j);
+    if (c->has_sub) ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
+    limit_job j = {c, w->pos[c->L], w->posS, start, ccol, c->outs, cw, b};
+    ccn__parallel_for(threads, c->nouts, limit_range, &j);
+}
+
+static void probe_set_free(probe_set *w, int32_t L) {
+    for (int32_t l = 0; w->mcopy && l <= L; l++) free(w->mcopy[l].pos);
+    for (int32_t l = 0; w->prep && l < L; l++) free(w->prep[l].H);
+    free(w->subcopy.H); free(w->posS); free(w->mcopy); free(w->prep); free(w->pos);
+    memset(w, 0, sizeof *w);
+}
+
+/* A worker's copy of the builder's levels, its points zero (the probes leave the points they
+ * do not need at zero). Returns -1 out of memory. */
+static int probe_set_copy(const builder *c, probe_set *w) {
+    memset(w, 0, sizeof *w);
+    int32_t L = c->L;
+    w->mcopy = calloc((size_t)L + 1, sizeof *w->mcopy);
+    w->pos = calloc((size_t)L + 1, sizeof *w->pos);
+    w->prep = calloc((size_t)(L ? L : 1), sizeof *w->prep);
+    if (!w->mcopy || !w->pos || !w->prep) return -1;
+    for (int32_t l = 0; l <= L; l++) {
+        w->mcopy[l] = *c->lev[l].m;
+        w->mcopy[l].pos = w->pos[l] = calloc(3 * (size_t)(c->lev[l].m->nv ? c->lev[l].m->nv : 1), sizeof(double));
+        if (!w->pos[l]) return -1;
+    }
+    for (int32_t l = 0; l < L; l++) {
+        w->prep[l] = c->prep[l];
+        w->prep[l].m = &w->mcopy[l];
+        w->prep[l].threads = 1;
+        w->prep[l].H = calloc(3 * (size_t)(w->mcopy[l].ne ? w->mcopy[l].ne : 1), sizeof(double));
+        if (!w->prep[l].H) return -1;
+    }
+    if (c->has_sub) {
+        const ccn_mesh *mL = &w->mcopy[L];
+        w->subcopy = c->sub;
+        w->subcopy.m = mL;
+        w->subcopy.threads = 1;
+        w->subcopy.H = calloc(3 * (size_t)(mL->ne ? mL->ne : 1), sizeof(double));
+        w->posS = calloc(3 * ((size_t)mL->nf + mL->ne + mL->nv), sizeof(double));
+        w->sub = &w->subcopy;
+        if (!w->subcopy.H || !w->posS) return -1;
+    }
+    return 0;
+}
+
+typedef struct {
+    const builder *c; const probe_set *sets; int32_t nsets, npass;
+    const int32_t *col, *start, *ccol; double *cw;
+} pool_job;
+
+/* Worker t (one task each) runs passes t + 1, t + 1 + nsets, ... on its own set. */
+static void pool_range(void *ctx, int32_t b, int32_t end) {
+    const pool_job *j = ctx;
+    for (int32_t t = b; t < end; t++)
+        for (int32_t pass = 1 + t; pass < j->npass; pass += j->nsets)
+            probe(j->c, &j->sets[t], 1, j->col, pass, j->start, j->ccol, j->cw);
+}
+
+/* Every pass: the first on the builder's own set (threaded inside; it makes the levels'
+ * tables), the others spread over the threads, each on its own set: the passes write disjoint
+ * weights and compute the same numbers wherever they run. Without memory for the copies they
+ * run one after the other on the builder's set. */
+static int probe_all(const ccn_plan *p, builder *c, int32_t npass, const int32_t *col,
+                     const int32_t *start, const int32_t *ccol, double *cw) {
+    if (npass <= 0) return 0;
+    double **ownpos = malloc(sizeof(double *) * ((size_t)c->L + 1));
+    if (!ownpos) return -1;
+    for (int32_t l = 0; l <= c->L; l++) ownpos[l] = c->lev[l].m->pos;
+    probe_set own = {ownpos, c->posS, c->prep, &c->sub, NULL, {0}};
+    int32_t nsets = p->threads - 1 < npass - 1 ? p->threads - 1 : npass - 1, made = 0;
+    probe_set *sets = nsets > 0 ? calloc((size_t)nsets + 1, sizeof *sets) : NULL;
+    probe(c, &own, p->threads, col, 0, start, ccol, cw);
+    if (sets) { /* the builder's set is worker 0's too */
+        sets[0] = own;
+        for (made = 1; made <= nsets && !probe_set_copy(c, &sets[made]); made++) {}
+        if (made <= nsets) probe_set_free(&sets[made], c->L);
+    }
+    if (made >= 2) {
+        pool_job j = {c, sets, made, npass, col, start, ccol, cw};
+        for (int32_t l = 0; l < c->L; l++) c->prep[l].threads = 1; /* one thread per worker */
+        ccn__parallel_tasks(made, made, pool_range, &j);
+        for (int32_t l = 0; l < c->L; l++) c->prep[l].threads = p->threads;
+    } else
+        for (int32_t pass = 1; pass < npass; pass++) probe(c, &own, p->threads, col, pass, start, ccol, cw);
+    for (int32_t t = 1; t < made; t++) probe_set_free(&sets[t], c->L);
+    free(sets);
+    free(ownpos);
+    return 0;
 }
 
 typedef struct {
@@ -772,7 +871,10 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         for (int32_t l = 1; l <= c->L; l++)
             memset(c->lev[l].m->pos, 0, sizeof(double) * 3 * (size_t)c->lev[l].m->nv);
     }
-    for (int32_t b = 0, npass = c->nouts ? (ncol + 2) / 3 : 0; b < npass; b++) probe(p, c, col, b, s->start, ccol, s->w);
+    if (probe_all(p, c, c->nouts ? (ncol + 2) / 3 : 0, col, s->start, ccol, s->w)) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying probes)");
+        goto done;
+    }
     free(ccol);
     ccol = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
