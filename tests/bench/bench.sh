@@ -14,7 +14,7 @@ CACHE=${CCN_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/ccnurbs}
 mkdir -p "$D"
 python3 tests/bench/make_bench_cages.py "$D" > /dev/null || exit 2
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", (b > 0 ? a / b : 0) }'; }
-field() { grep -v '^ccn uv' | sed -n "s/.* $1 \([0-9.]*\) s.*/\1/p"; } # the plan's line, not the UV one
+field() { grep -v '^ccn uv' | sed -n "s/.*[;,] $1 \([0-9.]*\) s.*/\1/p"; } # the plan's line, not the UV one; ', plan' not 'first plan'
 kb() { sed -n "s/.*peak RSS \([0-9]*\) kB.*/\1/p"; }
 num() { sed -n "s/.*$1 \([0-9]*\).*/\1/p"; }
 verdict() { awk -v r="$1" -v t="$2" 'BEGIN { if (r <= t) print "met"; else printf "missed (%.2fx the target)\n", r / t }'; }
