@@ -287,26 +287,29 @@ done:
     return st;
 }
 
-/* The cage face a level-L value vertex o lies on, through its first face, and o's coordinates
- * there when that face is a quad: each level's face is the child quad (V_j, E(h_j), F,
- * E(h_j-1)) at corner j of its parent (refine/level.c), a quarter of the parent's unit square. */
-static int32_t origin(const ccn_plan *p, int32_t h, double uv[2]) {
-    static const double C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+/* The cage face a level-L value vertex lies on, through its corner h, and its grid point
+ * there, a + (b << 16) in level-L face sizes, when that face is a quad: each level's face is
+ * the child quad (V_j, E(h_j), F, E(h_j-1)) at corner j of its parent (refine/level.c), a
+ * quarter of the parent's square. Integers: (x, y) in level-L face sizes within a face of side
+ * z, so the parent's is (2 z c_0 + x (c_1 - c_0) + y (c_-1 - c_0)) with side 2 z. */
+static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) {
+    static const int32_t C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     const ccn_mesh *mL = p->lev[p->L]; /* the value mesh's faces and corners are the vertices' */
     int32_t g = mL->hface[h], j = h - mL->fstart[g];
-    double s = C[j & 3][0], t = C[j & 3][1];
+    int32_t x = C[j & 3][0], y = C[j & 3][1], z = 1;
     for (int32_t l = p->L; l > 0; l--) {
         const ccn_mesh *m = p->lev[l - 1];
         int32_t f = m->hface[g], k = g - m->fstart[f];
-        if (uv && ccn__fsize(m, f) == 4) {
-            const double *c0 = C[k], *c1 = C[(k + 1) & 3], *cm = C[(k + 3) & 3];
-            double x = c0[0] + 0.5 * (s * (c1[0] - c0[0]) + t * (cm[0] - c0[0]));
-            double y = c0[1] + 0.5 * (s * (c1[1] - c0[1]) + t * (cm[1] - c0[1]));
-            s = x; t = y;
+        if (ccn__fsize(m, f) == 4) {
+            const int32_t *c0 = C[k], *c1 = C[(k + 1) & 3], *cm = C[(k + 3) & 3];
+            int32_t nx = 2 * z * c0[0] + x * (c1[0] - c0[0]) + y * (cm[0] - c0[0]);
+            int32_t ny = 2 * z * c0[1] + x * (c1[1] - c0[1]) + y * (cm[1] - c0[1]);
+            x = nx; y = ny; z *= 2;
         }
         g = f;
     }
-    if (uv) { uv[0] = s; uv[1] = t; }
+    int32_t sc = (1 << p->L) / z;
+    *ab = x * sc + ((y * sc) << 16);
     return g;
 }
 
@@ -316,10 +319,8 @@ static void origin_range(void *ctx, int32_t b, int32_t end) {
     const origin_job *j = ctx;
     builder *c = j->c;
     const ccn_mesh *mL = c->numbered_only ? NULL : c->lev[c->L].m;
-    double scale = (double)(1 << c->L), uv[2];
     for (int32_t o = b; o < end; o++) {
-        c->fo[o] = origin(j->p, mL ? mL->vfan[mL->vfan_start[o]] : c->firstL[o], uv);
-        c->ab[o] = (int32_t)lround(uv[0] * scale) + ((int32_t)lround(uv[1] * scale) << 16);
+        c->fo[o] = origin(j->p, mL ? mL->vfan[mL->vfan_start[o]] : c->firstL[o], &c->ab[o]);
         c->direct[o] = c->dir.slot && c->dir.slot[c->fo[o]] >= 0;
     }
 }
