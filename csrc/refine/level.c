@@ -320,21 +320,32 @@ static int32_t child_edge(const int32_t *everts, int32_t e, int32_t v) {
     return everts[2 * e] == v ? 2 * e : 2 * e + 1;
 }
 
-void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
-                                const int32_t *hedge, const int32_t *everts, int32_t *chvert,
-                                int32_t *chedge, int32_t *ceverts) {
-    int32_t nf = m->nf;
-    for (int32_t e = 0; e < ne; e++) {
+typedef struct {
+    const ccn_mesh *m; int32_t ne; const int32_t *hvert, *hedge, *everts;
+    int32_t *chvert, *chedge, *ceverts;
+} numbering_job;
+
+static void numbering_edge_range(void *ctx, int32_t b, int32_t end) {
+    const numbering_job *j = ctx;
+    int32_t nf = j->m->nf, ne = j->ne;
+    for (int32_t e = b; e < end; e++) {
         int32_t ep = nf + e;
-        ceverts[4 * e + 0] = nf + ne + everts[2 * e];
-        ceverts[4 * e + 1] = ep;
-        ceverts[4 * e + 2] = ep;
-        ceverts[4 * e + 3] = nf + ne + everts[2 * e + 1];
+        j->ceverts[4 * e + 0] = nf + ne + j->everts[2 * e];
+        j->ceverts[4 * e + 1] = ep;
+        j->ceverts[4 * e + 2] = ep;
+        j->ceverts[4 * e + 3] = nf + ne + j->everts[2 * e + 1];
     }
-    for (int32_t f = 0; f < nf; f++) {
+}
+
+static void numbering_face_range(void *ctx, int32_t b, int32_t end) {
+    const numbering_job *j = ctx;
+    const ccn_mesh *m = j->m;
+    const int32_t *hvert = j->hvert, *hedge = j->hedge, *everts = j->everts;
+    int32_t nf = m->nf, ne = j->ne, *chvert = j->chvert, *chedge = j->chedge, *ceverts = j->ceverts;
+    for (int32_t f = b; f < end; f++) {
         int32_t s = m->fstart[f], n = ccn__fsize(m, f);
-        for (int32_t j = 0; j < n; j++) {
-            int32_t h = s + j, hp = s + (j + n - 1) % n;
+        for (int32_t k = 0; k < n; k++) {
+            int32_t h = s + k, hp = s + (k + n - 1) % n;
             int32_t v = hvert[h], q = 4 * h, inner = 2 * ne + h;
             chvert[q + 0] = nf + ne + v;
             chvert[q + 1] = nf + hedge[h];
@@ -350,9 +361,17 @@ void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hv
     }
 }
 
-static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand) {
+void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
+                                const int32_t *hedge, const int32_t *everts, int32_t *chvert,
+                                int32_t *chedge, int32_t *ceverts, int threads) {
+    numbering_job j = {m, ne, hvert, hedge, everts, chvert, chedge, ceverts};
+    ccn__parallel_for(threads, ne, numbering_edge_range, &j);
+    ccn__parallel_for(threads, m->nf, numbering_face_range, &j);
+}
+
+static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand, int threads) {
     int32_t nf = m->nf, ne = m->ne;
-    ccn__level_child_numbering(m, ne, m->hvert, m->hedge, m->everts, r->hvert, r->hedge, r->everts);
+    ccn__level_child_numbering(m, ne, m->hvert, m->hedge, m->everts, r->hvert, r->hedge, r->everts, threads);
     for (int32_t e = 0; e < ne; e++) cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
     for (int32_t f = 0; f < nf; f++) {
         int32_t s = m->fstart[f], n = ccn__fsize(m, f);
@@ -589,7 +608,7 @@ ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *e
                        "out of memory for a refined mesh of %lld face corners", (long long)nh2);
         goto done;
     }
-    refine_topology(m, r, cand);
+    refine_topology(m, r, cand, c->threads);
     if (ccn__mesh_build_fans(r)) {
         st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
         goto done;

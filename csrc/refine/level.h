@@ -56,10 +56,10 @@ void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces
 /* The next level's numbering (refine/level.c) for any numbering of m's corners by vertices
  * hvert and edges hedge (m->nh each; everts: their ne edges' ends), such as a face-varying
  * channel's values: child corner 4h + k's vertex and edge (4 * m->nh each) and the 2 ne + nh
- * child edges' ends. The child faces and corners are m's child's. */
+ * child edges' ends. The child faces and corners are m's child's. On up to `threads`. */
 void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
                                 const int32_t *hedge, const int32_t *everts, int32_t *chvert,
-                                int32_t *chedge, int32_t *ceverts);
+                                int32_t *chedge, int32_t *ceverts, int threads);
 /* Topology and intervals of the next level (positions uninitialised). */
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
 void ccn__level_free(ccn__level *c);

@@ -352,7 +352,7 @@ static ccn_status numbered(const ccn_plan *p, builder *c, ccn_error *err) {
         if (!hv2 || !he2 || !ev2 || (bnd && !cnt))
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying levels)");
         else
-            ccn__level_child_numbering(vm, ne, hv0, he0, ev0, hv2, he2, ev2);
+            ccn__level_child_numbering(vm, ne, hv0, he0, ev0, hv2, he2, ev2, p->threads);
         free(cnt);
         cnt = NULL;
         if (l) { free(hv); free(he); free(ev); }
@@ -408,7 +408,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
     if (st) return st;
-    if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], &c->dir))
+    if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], p->threads, &c->dir))
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     if (!c->bilinear && c->dir.count == c->lev[0].m->nf) { /* nothing to probe */
         c->numbered_only = 1;
@@ -806,34 +806,52 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
     }
 }
 
+typedef struct { const builder *c; ccn__fvar_stencils *s; const int32_t *compact; int32_t *bad; } table_job;
+
+static void table_range(void *ctx, int32_t b, int32_t e) {
+    const table_job *j = ctx;
+    const builder *c = j->c;
+    ccn__fvar_stencils *s = j->s;
+    int32_t side = s->side;
+    for (int32_t f = b; f < e; f++) {
+        int32_t k = j->compact[f];
+        if (k < 0) continue;
+        for (int i = 0; i < 16; i++) s->dvals[16 * (size_t)k + i] = c->value_of[c->dir.verts[16 * (size_t)c->dir.slot[f] + i]];
+        double *N = s->dN + 8 * (size_t)side * k;
+        ccn__fvar_direct_table(&c->dir, c->dir.slot[f], side, N);
+        for (int32_t r = 0; r < 2 * side; r++)
+            if (fabs(N[4 * r] + N[4 * r + 1] + N[4 * r + 2] + N[4 * r + 3] - 1.0) > 1e-9) j->bad[f] = 1;
+    }
+}
+
 /* The regular faces' part of the stencils: per face its 16 caller values and basis tables,
  * compact[f] its index (nf, malloc'd). Each table row sums to 1 (affine invariance). */
-static ccn_status direct_tables(builder *c, ccn__fvar_stencils *s, int32_t **compact, ccn_error *err) {
+static ccn_status direct_tables(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, int32_t **compact,
+                                ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m;
     int32_t nd = c->dir.count, side = (1 << c->L) + 1, nout = s->nout;
     s->nd = nd;
     s->side = side;
     *compact = malloc(sizeof(int32_t) * (size_t)(m0->nf ? m0->nf : 1));
+    int32_t *bad = calloc((size_t)(m0->nf ? m0->nf : 1), sizeof(int32_t));
     s->dface = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
     s->dab = c->ab; /* the outputs' grid points (origin_range) */
     c->ab = NULL;
     s->dvals = malloc(sizeof(int32_t) * 16 * (size_t)nd);
     s->dN = malloc(sizeof(double) * 8 * (size_t)side * (size_t)nd);
-    if (!*compact || !s->dface || !s->dab || !s->dvals || !s->dN)
+    if (!*compact || !bad || !s->dface || !s->dab || !s->dvals || !s->dN) {
+        free(bad);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-    for (int32_t f = 0, k = 0; f < m0->nf; f++) {
-        (*compact)[f] = -1;
-        if (c->dir.slot[f] < 0) continue;
-        for (int i = 0; i < 16; i++) s->dvals[16 * (size_t)k + i] = c->value_of[c->dir.verts[16 * (size_t)c->dir.slot[f] + i]];
-        double *N = s->dN + 8 * (size_t)side * k;
-        ccn__fvar_direct_table(&c->dir, c->dir.slot[f], side, N);
-        for (int32_t r = 0; r < 2 * side; r++)
-            if (fabs(N[4 * r] + N[4 * r + 1] + N[4 * r + 2] + N[4 * r + 3] - 1.0) > 1e-9)
-                return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, f,
-                                 "face %d: its B-spline basis does not sum to 1", (int)f);
-        (*compact)[f] = k++;
     }
-    return CCN_OK;
+    for (int32_t f = 0, k = 0; f < m0->nf; f++) (*compact)[f] = c->dir.slot[f] < 0 ? -1 : k++;
+    table_job j = {c, s, *compact, bad};
+    ccn__parallel_for(p->threads, m0->nf, table_range, &j);
+    ccn_status st = CCN_OK;
+    for (int32_t f = 0; f < m0->nf && !st; f++)
+        if (bad[f])
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, f, "face %d: its B-spline basis does not sum to 1", (int)f);
+    free(bad);
+    return st;
 }
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
@@ -863,7 +881,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     for (int32_t o = 0; o < nout; o++)
         s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
     int32_t *compact = NULL;
-    if (c->dir.count > 0 && (st = direct_tables(c, s, &compact, err))) { free(compact); goto done; }
+    if (c->dir.count > 0 && (st = direct_tables(p, c, s, &compact, err))) { free(compact); goto done; }
     cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, ccol, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);

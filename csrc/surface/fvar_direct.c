@@ -25,6 +25,7 @@
 
 #include "rules/bspline.h"
 #include "rules/crease.h"
+#include "base/parallel.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -212,21 +213,33 @@ static int block(const ccn__fvar_level *fl, const uint8_t *kind, int32_t f, int3
     return 0;
 }
 
-int ccn__fvar_direct_build(const ccn__fvar_level *f0, ccn__fvar_direct *d) {
+typedef struct { const ccn__fvar_level *f0; uint8_t *kind; ccn__fvar_direct *d; } direct_job;
+
+static void kind_range(void *ctx, int32_t b, int32_t e) {
+    const direct_job *j = ctx;
+    for (int32_t v = b; v < e; v++) j->kind[v] = (uint8_t)value_kind(j->f0, v);
+}
+
+static void block_range(void *ctx, int32_t b, int32_t e) {
+    const direct_job *j = ctx;
+    ccn__fvar_direct *d = j->d;
+    for (int32_t f = b; f < e; f++)
+        d->slot[f] = block(j->f0, j->kind, f, d->verts + 16 * (size_t)f, d->knots + 12 * (size_t)f, d->fold + f) ? -1 : f;
+}
+
+int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, ccn__fvar_direct *d) {
     const ccn_mesh *m = f0->m;
     memset(d, 0, sizeof *d);
     uint8_t *kind = malloc((size_t)(m->nv ? m->nv : 1));
     d->slot = malloc(sizeof(int32_t) * (size_t)(m->nf ? m->nf : 1));
-    if (!kind || !d->slot) { free(kind); ccn__fvar_direct_free(d); return -1; }
-    for (int32_t v = 0; v < m->nv; v++) kind[v] = (uint8_t)value_kind(f0, v);
     d->verts = malloc(sizeof(int32_t) * 16 * (size_t)(m->nf ? m->nf : 1)); /* slot = face */
     d->knots = malloc(sizeof(double) * 12 * (size_t)(m->nf ? m->nf : 1));
     d->fold = malloc((size_t)(m->nf ? m->nf : 1));
-    if (!d->verts || !d->knots || !d->fold) { free(kind); ccn__fvar_direct_free(d); return -1; }
-    for (int32_t f = 0; f < m->nf; f++) {
-        d->slot[f] = block(f0, kind, f, d->verts + 16 * (size_t)f, d->knots + 12 * (size_t)f, d->fold + f) ? -1 : f;
-        d->count += d->slot[f] >= 0;
-    }
+    if (!kind || !d->slot || !d->verts || !d->knots || !d->fold) { free(kind); ccn__fvar_direct_free(d); return -1; }
+    direct_job j = {f0, kind, d};
+    ccn__parallel_for(threads, m->nv, kind_range, &j);
+    ccn__parallel_for(threads, m->nf, block_range, &j);
+    for (int32_t f = 0; f < m->nf; f++) d->count += d->slot[f] >= 0;
     free(kind);
     return 0;
 }
