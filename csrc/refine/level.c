@@ -177,16 +177,29 @@ static void one_vertex_point(const ccn__level *c, int32_t v, const double *fp, d
 
 /* ---- the rules' weights, tabulated (ccn__level.tf ...) ------------------------------- */
 
+/* Over all elements (list NULL) or the listed ones; each tabulated once (tmask). */
+typedef struct { ccn__level *c; const int32_t *list; } tab_job;
+
 static void tab_face_range(void *ctx, int32_t b, int32_t e) {
-    const ccn__level *c = ctx;
-    for (int32_t f = b; f < e; f++)
+    const tab_job *j = ctx;
+    ccn__level *c = j->c;
+    for (int32_t i = b; i < e; i++) {
+        int32_t f = j->list ? j->list[i] : i;
+        if (c->tmask[f]) continue;
+        c->tmask[f] = 1;
         if (ccn__fsize(c->m, f) == 4) ccn__quad_face_weights(c->m, f, c->pinned, c->tf + 2 * (size_t)f);
+    }
 }
 
 static void tab_edge_range(void *ctx, int32_t b, int32_t end) {
-    const ccn__level *c = ctx;
+    const tab_job *j = ctx;
+    ccn__level *c = j->c;
     const ccn_mesh *m = c->m;
-    for (int32_t e = b; e < end; e++) {
+    uint8_t *mask = c->tmask + m->nf;
+    for (int32_t i = b; i < end; i++) {
+        int32_t e = j->list ? j->list[i] : i;
+        if (mask[e]) continue;
+        mask[e] = 1;
         int32_t h = c->erep[e], t = m->htwin[h];
         double *o = c->te + 3 * (size_t)e;
         o[0] = ccn__curve_edge_weight(m, h, c->pinned);
@@ -196,14 +209,18 @@ static void tab_edge_range(void *ctx, int32_t b, int32_t end) {
 }
 
 static void tab_vertex_range(void *ctx, int32_t b, int32_t e) {
-    const ccn__level *c = ctx;
+    const tab_job *j = ctx;
+    ccn__level *c = j->c;
     const ccn_mesh *m = c->m;
+    uint8_t *mask = c->tmask + m->nf + m->ne;
     float ps[CREASE_STACK];
-    for (int32_t v = b; v < e; v++) {
+    for (int32_t i = b; i < e; i++) {
+        int32_t v = j->list ? j->list[i] : i;
+        if (mask[v]) continue;
+        mask[v] = 1;
         if (m->vfan_start[v + 1] == m->vfan_start[v] || m->vboundary[v]) continue;
         if (c->tvs) { /* creased mesh: where creased_vertex_point takes the smooth rule */
             int32_t n = ccn__valence(m, v);
-            c->tvs[v] = 0;
             if ((c->partner && c->partner[v] >= 0) || n > CREASE_STACK) continue;
             ccn__fan_sharpness(m, v, ps);
             int rule = ccn__sharp_rule(ccn__vertex_sharpness(m, v, c->pinned), n, ps);
@@ -214,30 +231,52 @@ static void tab_vertex_range(void *ctx, int32_t b, int32_t e) {
     }
 }
 
-/* Once per level; out of memory: no tables (the rules run). The face and edge weights come
- * from the crease-aware look-ups, so they hold on creased meshes too (the sharp edges' own rule
- * still runs); the vertex weights are the smooth rule's, on a creased mesh for the interior
- * vertices whose sharpness gives the smooth (or dart) rule (tvs), the same arithmetic as
- * creased_vertex_point's. */
-static void tabulate(ccn__level *c) {
+/* The tables, allocated once per level (0: out of memory, no tables: the rules run). The face
+ * and edge weights come from the crease-aware look-ups, so they hold on creased meshes too (the
+ * sharp edges' own rule still runs); the vertex weights are the smooth rule's, on a creased
+ * mesh for the interior vertices whose sharpness gives the smooth (or dart) rule (tvs), the
+ * same arithmetic as creased_vertex_point's. */
+static int tab_alloc(ccn__level *c) {
     const ccn_mesh *m = c->m;
-    if (c->tab_tried) return;
+    if (c->tab_tried) return c->tf != NULL;
     c->tab_tried = 1;
     c->tf = malloc(sizeof(double) * 2 * (size_t)(m->nf ? m->nf : 1));
     c->te = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
     c->tv = malloc(sizeof(double) * 2 * (size_t)(m->nv ? m->nv : 1));
     c->th = malloc(sizeof(double) * 2 * (size_t)(m->nh ? m->nh : 1));
-    if (m->esharp) c->tvs = malloc((size_t)(m->nv ? m->nv : 1));
-    if (!c->tf || !c->te || !c->tv || !c->th || (m->esharp && !c->tvs)) {
-        free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs);
+    c->tmask = calloc((size_t)m->nf + m->ne + m->nv + 1, 1);
+    if (m->esharp) c->tvs = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    if (!c->tf || !c->te || !c->tv || !c->th || !c->tmask || (m->esharp && !c->tvs)) {
+        free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs); free(c->tmask);
         c->tf = c->te = c->tv = c->th = NULL;
-        c->tvs = NULL;
-        return;
+        c->tvs = c->tmask = NULL;
+        return 0;
     }
-    ccn__parallel_for(c->threads, m->nf, tab_face_range, c);
-    ccn__parallel_for(c->threads, m->ne, tab_edge_range, c);
-    if (c->tvs) memset(c->tvs, 0, (size_t)m->nv);
-    ccn__parallel_for(c->threads, m->nv, tab_vertex_range, c);
+    return 1;
+}
+
+/* Every element's weights, once per level (the first ccn__level_points). */
+static void tabulate(ccn__level *c) {
+    const ccn_mesh *m = c->m;
+    if (!tab_alloc(c) || c->tab_full) return;
+    tab_job j = {c, NULL};
+    ccn__parallel_for(c->threads, m->nf, tab_face_range, &j);
+    ccn__parallel_for(c->threads, m->ne, tab_edge_range, &j);
+    ccn__parallel_for(c->threads, m->nv, tab_vertex_range, &j);
+    c->tab_full = 1;
+}
+
+/* Only the listed elements' weights (ccn__level_points_lists: the face-varying probes compute a
+ * part of each level, the same part every pass). */
+static void tabulate_lists(ccn__level *c, const int32_t *faces, int32_t nfaces, const int32_t *edges,
+                           int32_t nedges, const int32_t *verts, int32_t nverts) {
+    if (!tab_alloc(c) || c->tab_full) return;
+    tab_job j = {c, faces};
+    ccn__parallel_for(c->threads, nfaces, tab_face_range, &j);
+    j.list = edges;
+    ccn__parallel_for(c->threads, nedges, tab_edge_range, &j);
+    j.list = verts;
+    ccn__parallel_for(c->threads, nverts, tab_vertex_range, &j);
 }
 
 static void vertex_range(void *ctx, int32_t b, int32_t e) {
@@ -467,7 +506,7 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
 
 void ccn__level_free(ccn__level *c) {
     if (!c) return;
-    free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs);
+    free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs); free(c->tmask);
     free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
     memset(c, 0, sizeof *c);
 }
@@ -538,7 +577,7 @@ void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces
                              const int32_t *edges, int32_t nedges, const int32_t *verts,
                              int32_t nverts, double *out) {
     const ccn_mesh *m = c->m;
-    tabulate(c);
+    tabulate_lists(c, faces, nfaces, edges, nedges, verts, nverts);
     double *fp = out, *ep = out + 3 * (size_t)m->nf, *vp = out + 3 * ((size_t)m->nf + m->ne);
     list_job j = {c, fp, ep, vp, faces};
     ccn__parallel_for(c->threads, nfaces, face_list_range, &j);

@@ -28,14 +28,14 @@ typedef struct {
     ccn__ev_cache *ev_cache; /* the owner's cache of eigen polyhedron choices (may be NULL) */
     int32_t ev_poly;     /* ccn_options.ev_polyhedron */
     int32_t ev_verified, ev_outside; /* EVs of this level verified / outside the G1 range */
-    /* The rules' weights, tabulated by the first ccn__level_points (they depend on topology
-     * and intervals only): quad face (s, t), edge (curve weight and
+    /* The rules' weights, tabulated by the first ccn__level_points, or for the listed elements
+     * by ccn__level_points_lists (they depend on topology and intervals only): quad face (s, t), edge (curve weight and
      * the two transverse intervals), interior vertex ((n-3)/n, 3/(n sum)) and its fan's
      * (m_i, f_i) at the fan's half-edge positions; on a creased mesh tvs[v] says which
      * vertices' (smooth) rule is in tv / th. NULL: computed per call. */
-    int tab_tried;
+    int tab_tried, tab_full;
     double *tf, *te, *tv, *th;
-    uint8_t *tvs;
+    uint8_t *tvs, *tmask; /* tmask: faces, edges, vertices tabulated (lists: a part) */
 } ccn__level;
 ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                               int crease_method, ccn_error *err);

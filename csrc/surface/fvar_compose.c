@@ -573,67 +573,105 @@ static int32_t colour(const ccn_mesh *m, const csr *K, int32_t *col) {
     return ncol;
 }
 
-/* The points the probes need, level by level, when some outputs have written-down weights.
- * The outputs composed by probing lie on the cage faces that are not regular, and their limit
- * stencils read level-L points on those faces and the faces around them (A_0: the faces that
- * share a vertex with a face that is not regular; A_l: their descendants). Level l computes
- * the next level's points of the faces around the vertices V_l of A_l, of those vertices'
- * edges and of the vertices themselves: each reads only level-l corners of faces around V_l,
- * which the level before computed (level 0 is the input), and an EV's eigen rows read its
- * ring, where a level-l EV next to V_l is in V_l itself for l >= 1. So the points read at
- * level L are right. */
+/* The points the probes need, level by level, when some outputs have written-down weights:
+ * found backwards from what the composed outputs' limit stencils read. Level L: the points
+ * of their stencils, and around each vertex the sub level refines (near[]) the corners of its
+ * faces. Level l computes the next level's points that are needed, closed under what the
+ * rules read of the same pass (refine/level.c: an edge point reads the face points of its
+ * faces, a vertex point those of its faces and the curve points H of its edges); the points
+ * of level l then needed are the corners of every listed face and the ends of every listed
+ * edge, and an EV's whole ring where one of its red points (the eigen rows overwriting the
+ * face points of its faces, the points of its spokes and its own) is listed or read. Every
+ * point a needed point's rule reads is thus right, and the others stay 0 unread. */
+static void mark_faces_around(const ccn_mesh *m, int32_t v, uint8_t *need) {
+    for (int32_t q = m->vfan_start[v]; q < m->vfan_start[v + 1]; q++) {
+        int32_t g = m->hface[m->vfan[q]];
+        for (int32_t h = m->fstart[g]; h < m->fstart[g + 1]; h++) need[m->hvert[h]] = 1;
+    }
+    need[v] = 1;
+}
+
+static int list_of(const uint8_t *mark, int32_t n, int32_t **out, int32_t *count) {
+    int32_t k = 0;
+    for (int32_t i = 0; i < n; i++) k += mark[i] != 0;
+    *out = malloc(sizeof(int32_t) * (size_t)(k + 1));
+    if (!*out) return -1;
+    *count = 0;
+    for (int32_t i = 0; i < n; i++)
+        if (mark[i]) (*out)[(*count)++] = i;
+    return 0;
+}
+
 static int probe_lists(builder *c) {
-    int32_t L = c->L, maxf = 0, maxv = 0, maxe = 0;
-    for (int32_t l = 0; l <= L; l++) {
-        const ccn_mesh *m = c->lev[l].m;
-        if (m->nf > maxf) maxf = m->nf;
-        if (m->nv > maxv) maxv = m->nv;
-        if (m->ne > maxe) maxe = m->ne;
-    }
+    int32_t L = c->L;
+    const ccn_mesh *mL = c->lev[L].m;
+    uint8_t *need = calloc((size_t)mL->nv + 1, 1);
     c->pl = calloc((size_t)(L ? L : 1), sizeof *c->pl);
-    uint8_t *act = malloc((size_t)maxf + 1), *nact = malloc((size_t)maxf + 1);
-    uint8_t *vm = malloc((size_t)maxv + 1), *fm = malloc((size_t)maxf + 1), *em = malloc((size_t)maxe + 1);
-    int ok = c->pl && act && nact && vm && fm && em;
-    const ccn_mesh *m0 = c->lev[0].m;
-    if (ok) {
-        memset(vm, 0, (size_t)m0->nv);
-        for (int32_t f = 0; f < m0->nf; f++)
-            if (c->dir.slot[f] < 0)
-                for (int32_t h = m0->fstart[f]; h < m0->fstart[f + 1]; h++) vm[m0->hvert[h]] = 1;
-        for (int32_t f = 0; f < m0->nf; f++) {
-            act[f] = 0;
-            for (int32_t h = m0->fstart[f]; h < m0->fstart[f + 1]; h++) act[f] |= vm[m0->hvert[h]];
-        }
+    if (!need || !c->pl) { free(need); return -1; }
+    for (int32_t i = 0; i < c->nouts; i++) {
+        int32_t o = c->outs[i];
+        for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++)
+            if (c->st_v[k] < mL->nv) need[c->st_v[k]] = 1;
     }
-    for (int32_t l = 0; ok && l < L; l++) {
+    if (c->has_sub) { /* the sub level's points around near[]: their faces' corners, EV rings */
+        uint8_t *isev = calloc((size_t)mL->nv + 1, 1);
+        if (!isev) { free(need); return -1; }
+        for (int32_t i = 0; i < c->sub.nev; i++) isev[c->sub.ev_list[i]] = 1;
+        for (int32_t i = 0; i < c->nnear; i++) {
+            int32_t v = c->near[i];
+            for (int32_t q = mL->vfan_start[v]; q < mL->vfan_start[v + 1]; q++) {
+                int32_t g = mL->hface[mL->vfan[q]];
+                for (int32_t h = mL->fstart[g]; h < mL->fstart[g + 1]; h++) {
+                    int32_t u = mL->hvert[h];
+                    need[u] = 1;
+                    if (isev[u]) mark_faces_around(mL, u, need);
+                }
+            }
+        }
+        free(isev);
+    }
+    int ok = 1;
+    for (int32_t l = L - 1; ok && l >= 0; l--) {
         const ccn_mesh *m = c->lev[l].m;
+        const ccn__level *pr = &c->prep[l];
         probe_list *q = &c->pl[l];
-        memset(vm, 0, (size_t)m->nv);
-        memset(fm, 0, (size_t)m->nf);
-        memset(em, 0, (size_t)m->ne);
-        for (int32_t f = 0; f < m->nf; f++)
-            if (act[f])
-                for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) vm[m->hvert[h]] = 1;
-        for (int32_t v = 0; v < m->nv; v++) {
+        uint8_t *fm = calloc((size_t)m->nf + 1, 1), *em = calloc((size_t)m->ne + 1, 1);
+        uint8_t *vm = calloc((size_t)m->nv + 1, 1), *prev = calloc((size_t)m->nv + 1, 1);
+        if (!fm || !em || !vm || !prev) { free(fm); free(em); free(vm); free(prev); ok = 0; break; }
+        for (int32_t x = 0; x < m->nf; x++) fm[x] = need[x];
+        for (int32_t x = 0; x < m->ne; x++) em[x] = need[m->nf + x];
+        for (int32_t x = 0; x < m->nv; x++) vm[x] = need[m->nf + m->ne + x];
+        for (int32_t v = 0; v < m->nv; v++) { /* a vertex point: its faces' points, its H */
             if (!vm[v]) continue;
-            q->nv++;
             for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) fm[m->hface[m->vfan[k]]] = 1;
             for (int32_t k = 0, n = ccn__valence(m, v); k < n; k++) em[ccn__fan_edge(m, v, k)] = 1;
         }
-        for (int32_t f = 0; f < m->nf; f++) q->nf += fm[f];
-        for (int32_t e = 0; e < m->ne; e++) q->ne += em[e];
-        q->v = malloc(sizeof(int32_t) * (size_t)(q->nv + 1));
-        q->f = malloc(sizeof(int32_t) * (size_t)(q->nf + 1));
-        q->e = malloc(sizeof(int32_t) * (size_t)(q->ne + 1));
-        if (!q->v || !q->f || !q->e) { ok = 0; break; }
-        q->nv = q->nf = q->ne = 0;
-        for (int32_t v = 0; v < m->nv; v++) if (vm[v]) q->v[q->nv++] = v;
-        for (int32_t f = 0; f < m->nf; f++) if (fm[f]) q->f[q->nf++] = f;
-        for (int32_t e = 0; e < m->ne; e++) if (em[e]) q->e[q->ne++] = e;
-        for (int32_t h = 0; h < m->nh; h++) nact[h] = act[m->hface[h]]; /* child face h */
-        uint8_t *t = act; act = nact; nact = t;
+        for (int32_t e = 0; e < m->ne; e++) { /* an edge point: its faces' points */
+            if (!em[e]) continue;
+            int32_t h = pr->erep[e], t = m->htwin[h];
+            fm[m->hface[h]] = 1;
+            if (t >= 0) fm[m->hface[t]] = 1;
+        }
+        for (int32_t f = 0; f < m->nf; f++)
+            if (fm[f])
+                for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) prev[m->hvert[h]] = 1;
+        for (int32_t e = 0; e < m->ne; e++)
+            if (em[e]) prev[m->everts[2 * e]] = prev[m->everts[2 * e + 1]] = 1;
+        for (int32_t v = 0; v < m->nv; v++) prev[v] |= vm[v];
+        for (int32_t i = 0; i < pr->nev; i++) { /* red points listed or read: the EV's ring */
+            int32_t w = pr->ev_list[i], hit = vm[w];
+            for (int32_t k = m->vfan_start[w]; k < m->vfan_start[w + 1] && !hit; k++)
+                hit = fm[m->hface[m->vfan[k]]] || em[m->hedge[m->vfan[k]]];
+            for (int32_t k = 0, n = ccn__valence(m, w); k < n && !hit; k++) hit = em[ccn__fan_edge(m, w, k)];
+            if (hit) mark_faces_around(m, w, prev);
+        }
+        ok = !list_of(fm, m->nf, &q->f, &q->nf) && !list_of(em, m->ne, &q->e, &q->ne) &&
+             !list_of(vm, m->nv, &q->v, &q->nv);
+        free(fm); free(em); free(vm);
+        free(need);
+        need = prev;
     }
-    free(act); free(nact); free(vm); free(fm); free(em);
+    free(need);
     return ok ? 0 : -1;
 }
 
