@@ -6,6 +6,7 @@
 #include "bi5/bi5.h"
 
 #include "base/error.h"
+#include "base/vec3.h"
 #include "bi5/bernstein.h"
 #include "bi5/cap.h"
 #include "bi5/charmap.h"
@@ -210,6 +211,23 @@ static void centre_point(int32_t n, const double *X, double ctr[3]) {
  * and the 6 weights per sector of its n sectors (the centre-point and normal terms are the
  * caller's). */
 static inline void stencil_row(const double *row, const double *X, int32_t n, int32_t s, double acc[3]) {
+#ifdef CCN_V2D /* x, y side by side: the same products and sums per lane (base/vec3.h) */
+    ccn__v2d x01, w0 = {row[0], row[0]};
+    memcpy(&x01, X, sizeof x01);
+    ccn__v2d a01 = w0 * x01;
+    double a2 = row[0] * X[2];
+    for (int32_t k = 0, ks = s; k < n; k++, ks = ks + 1 == n ? 0 : ks + 1) {
+        const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ks);
+        for (int32_t q = 0; q < 6; q++) {
+            double wq = w[q];
+            ccn__v2d wv = {wq, wq}, xq;
+            memcpy(&xq, x + 3 * q, sizeof xq);
+            a01 += wv * xq;
+            a2 += wq * x[3 * q + 2];
+        }
+    }
+    acc[0] = a01[0]; acc[1] = a01[1]; acc[2] = a2;
+#else
     double a0 = row[0] * X[0], a1 = row[0] * X[1], a2 = row[0] * X[2]; /* in registers */
     for (int32_t k = 0, ks = s; k < n; k++, ks = ks + 1 == n ? 0 : ks + 1) {
         const double *w = row + 1 + 6 * k, *x = X + 3 * (1 + 6 * ks);
@@ -221,6 +239,7 @@ static inline void stencil_row(const double *row, const double *X, int32_t n, in
         }
     }
     acc[0] = a0; acc[1] = a1; acc[2] = a2;
+#endif
 }
 
 /* Uniform operator: sector s = stencil applied to the net relabelled so that s becomes 0. */

@@ -9,7 +9,10 @@
  */
 #include "rules/nurss.h"
 
+#include "base/vec3.h"
 #include "rules/bspline.h"
+
+#include <string.h>
 
 /* Eq. 11: F = sum w_i P_i / sum w_i, w_i = A_i B_i, where A_i (B_i) averages the 1-D
  * insertion weights "own interval + 2 x interval beyond the far end" of P_i along edge i
@@ -56,6 +59,25 @@ void ccn__nurss_vertex_weights(const ccn_mesh *m, int32_t v, double *mf, double 
 void ccn__nurss_vertex_blend(const ccn_mesh *m, int32_t v, const double *mf, const double ab[2],
                              const double *H, const double *fp, double out[3]) {
     int32_t n = ccn__valence(m, v), s0 = m->vfan_start[v];
+    const double *p = m->pos + 3 * (size_t)v;
+#ifdef CCN_V2D /* x, y side by side: the same products and sums per lane (base/vec3.h) */
+    ccn__v2d a01 = {0, 0};
+    double a2 = 0;
+    for (int32_t i = 0; i < n; i++) {
+        int32_t hi = m->vfan[s0 + i];
+        double mi = mf[2 * i], fi = mf[2 * i + 1];
+        const double *hp = H + 3 * (size_t)m->hedge[hi], *fpp = fp + 3 * (size_t)m->hface[hi];
+        ccn__v2d h01, f01, mv = {mi, mi}, fv = {fi, fi};
+        memcpy(&h01, hp, sizeof h01);
+        memcpy(&f01, fpp, sizeof f01);
+        a01 += mv * h01 + fv * f01;
+        a2 += mi * hp[2] + fi * fpp[2];
+    }
+    ccn__v2d p01, w0 = {ab[0], ab[0]}, w1 = {ab[1], ab[1]};
+    memcpy(&p01, p, sizeof p01);
+    ccn__v2d o01 = w0 * p01 + w1 * a01;
+    out[0] = o01[0]; out[1] = o01[1]; out[2] = ab[0] * p[2] + ab[1] * a2;
+#else
     double acc[3] = {0, 0, 0};
     for (int32_t i = 0; i < n; i++) {
         int32_t hi = m->vfan[s0 + i];
@@ -63,8 +85,8 @@ void ccn__nurss_vertex_blend(const ccn_mesh *m, int32_t v, const double *mf, con
         const double *hp = H + 3 * (size_t)m->hedge[hi], *fpp = fp + 3 * (size_t)m->hface[hi];
         for (int k = 0; k < 3; k++) acc[k] += mi * hp[k] + fi * fpp[k];
     }
-    const double *p = m->pos + 3 * (size_t)v;
     for (int k = 0; k < 3; k++) out[k] = ab[0] * p[k] + ab[1] * acc[k];
+#endif
 }
 
 /* The same arithmetic in one pass (no scratch for the fan's weights). */

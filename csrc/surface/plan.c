@@ -206,6 +206,23 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
         const double *wp, *wu, *wv;
         ccn__plan_row_weights(p, o, &wp, &wu, &wv);
         const int32_t *idx = p->st_v + p->st_start[o];
+#ifdef CCN_V2D
+        /* x and y in one register pair, z alone: each lane the same products and sums as
+         * the scalar loop, so the result is bit-identical */
+        ccn__v2d xy = {0, 0}, uxy = {0, 0}, vxy = {0, 0};
+        double x2 = 0, u2 = 0, v2 = 0;
+        for (int32_t k = 0, n = p->st_start[o + 1] - p->st_start[o]; k < n; k++) {
+            const double *q = SPOINT(idx[k]);
+            ccn__v2d qxy;
+            memcpy(&qxy, q, sizeof qxy);
+            double a = wp[k], b = wu[k], c = wv[k];
+            ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c};
+            xy += av * qxy; x2 += a * q[2];
+            uxy += bv * qxy; u2 += b * q[2];
+            vxy += cv * qxy; v2 += c * q[2];
+        }
+        double x[3] = {xy[0], xy[1], x2}, du[3] = {uxy[0], uxy[1], u2}, dv[3] = {vxy[0], vxy[1], v2};
+#else
         double x0 = 0, x1 = 0, x2 = 0, u0 = 0, u1 = 0, u2 = 0, v0 = 0, v1 = 0, v2 = 0;
         for (int32_t k = 0, n = p->st_start[o + 1] - p->st_start[o]; k < n; k++) {
             const double *q = SPOINT(idx[k]);
@@ -215,6 +232,7 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
             v0 += c * q[0]; v1 += c * q[1]; v2 += c * q[2];
         }
         double x[3] = {x0, x1, x2}, du[3] = {u0, u1, u2}, dv[3] = {v0, v1, v2};
+#endif
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
         if (!out->normals) continue;
         double *n = out->normals + 3 * (size_t)o;
