@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/vec3.h"
 #include "refine/fvar.h"
 #include "surface/fvar_compose.h"
 
@@ -135,6 +136,21 @@ static void direct_value(const ccn__fvar_stencils *s, int32_t o, const double *v
     const double *Nv = s->dN + 8 * (size_t)s->side * f + 4 * ((size_t)s->side + bb);
     const int32_t *P = s->dvals + 16 * (size_t)f;
     if (w == 2) {
+#ifdef CCN_V2D /* u and v side by side: the same products and sums per lane (base/vec3.h) */
+        ccn__v2d xy = {0, 0};
+        for (int jj = 0; jj < 4; jj++) {
+            ccn__v2d r = {0, 0};
+            for (int i = 0; i < 4; i++) {
+                ccn__v2d v, n = {Nu[i], Nu[i]};
+                memcpy(&v, vals + 2 * (size_t)P[i + 4 * jj], sizeof v);
+                r += n * v;
+            }
+            ccn__v2d n = {Nv[jj], Nv[jj]};
+            xy += n * r;
+        }
+        dst[0] = xy[0];
+        dst[1] = xy[1];
+#else
         double x = 0, y = 0;
         for (int jj = 0; jj < 4; jj++) {
             double rx = 0, ry = 0;
@@ -148,6 +164,7 @@ static void direct_value(const ccn__fvar_stencils *s, int32_t o, const double *v
         }
         dst[0] = x;
         dst[1] = y;
+#endif
         return;
     }
     for (int32_t c = 0; c < w; c++) dst[c] = 0.0;
@@ -167,6 +184,15 @@ static void spmv_range(void *ctx, int32_t b, int32_t end) {
     if (w == 2) { /* UV maps */
         for (int32_t o = b; o < end; o++) {
             if (dface && dface[o] >= 0) { direct_value(j->s, o, vals, w, out + 2 * (size_t)o); continue; }
+#ifdef CCN_V2D
+            ccn__v2d xy = {0, 0};
+            for (int32_t k = start[o]; k < start[o + 1]; k++) {
+                ccn__v2d v, n = {wt[k], wt[k]};
+                memcpy(&v, vals + 2 * (size_t)idx[k], sizeof v);
+                xy += n * v;
+            }
+            memcpy(out + 2 * (size_t)o, &xy, sizeof xy);
+#else
             double x = 0, y = 0;
             for (int32_t k = start[o]; k < start[o + 1]; k++) {
                 const double *v = vals + 2 * (size_t)idx[k];
@@ -175,6 +201,7 @@ static void spmv_range(void *ctx, int32_t b, int32_t end) {
             }
             out[2 * (size_t)o] = x;
             out[2 * (size_t)o + 1] = y;
+#endif
         }
         return;
     }
