@@ -430,7 +430,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
 typedef struct {
     const builder *c;
     const ccn__fvar_csr *K; const int32_t *fo, *col, *start, *compact;
-    int32_t *idx, *ccol;
+    int32_t *idx;
     ccn__fvar_stencils *s;
 } cand_job;
 
@@ -445,10 +445,7 @@ static void cand_range(void *ctx, int32_t b, int32_t end) {
             continue;
         }
         if (j->s->dface) j->s->dface[o] = -1;
-        for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) {
-            j->ccol[n] = j->col[j->K->list[k]];
-            j->idx[n] = j->K->list[k];
-        }
+        for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) j->idx[n] = j->K->list[k];
     }
 }
 
@@ -536,7 +533,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     ccn__fvar_csr K = {NULL, NULL};
     int32_t *col = malloc(sizeof(int32_t) * (size_t)m0->nv);
     const int32_t *fo = c->fo;
-    int32_t ncol = -1, *ccol = NULL;
+    int32_t ncol = -1, *kperm = NULL, *kcol = NULL;
     ccn_status st = CCN_OK;
     if (col && fo && !ccn__fvar_neighbourhoods(m0, c->dir.slot, &K)) ncol = c->nouts ? ccn__fvar_colour(m0, &K, col) : 0;
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
@@ -551,14 +548,23 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     s->w = calloc((size_t)(total ? total : 1), sizeof(double));
     if (!s->idx || !s->w) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
-    ccol = malloc(sizeof(int32_t) * (size_t)(total ? total : 1)); /* each candidate's colour */
-    if (!ccol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    int32_t nk = K.start[m0->nf]; /* each K row's entries by colour (ccn__fvar_cands) */
+    kperm = malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
+    kcol = malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
+    if (!kperm || !kcol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    for (int32_t f = 0; f < m0->nf; f++)
+        for (int32_t a = K.start[f], i = a; i < K.start[f + 1]; i++) { /* insertion sort by colour */
+            int32_t cv = col[K.list[i]], q = i;
+            for (; q > a && kcol[q - 1] > cv; q--) { kcol[q] = kcol[q - 1]; kperm[q] = kperm[q - 1]; }
+            kcol[q] = cv;
+            kperm[q] = i - a;
+        }
     s->start[0] = 0;
     for (int32_t o = 0; o < nout; o++)
         s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
     int32_t *compact = NULL;
     if (c->dir.count > 0 && (st = direct_tables(p, c, s, &compact, err))) { free(compact); goto done; }
-    cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, ccol, s};
+    cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);
     if (c->dir.count > 0 && c->nouts) { /* probes of the other outputs: their points only, the rest zero */
@@ -566,12 +572,13 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         for (int32_t l = 1; l <= c->L; l++)
             memset(c->lev[l].m->pos, 0, sizeof(double) * 3 * (size_t)c->lev[l].m->nv);
     }
-    if (ccn__fvar_probe_all(p, c, c->nouts ? (ncol + 2) / 3 : 0, col, s->start, ccol, s->w)) {
+    ccn__fvar_cands cd = {s->start, K.start, kperm, kcol};
+    if (ccn__fvar_probe_all(p, c, c->nouts ? (ncol + 2) / 3 : 0, col, &cd, s->w)) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying probes)");
         goto done;
     }
-    free(ccol);
-    ccol = NULL;
+    free(kperm); free(kcol);
+    kperm = kcol = NULL;
     /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
      * value vertices once), and every stencil sums to 1; each row within its own entries (in
      * parallel), then the rows moved together */
@@ -616,7 +623,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         if (b) s->w = b;
     }
 done:
-    free(K.start); free(K.list); free(col); free(ccol);
+    free(K.start); free(K.list); free(col); free(kperm); free(kcol);
     return st;
 }
 

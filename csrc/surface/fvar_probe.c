@@ -14,7 +14,7 @@ typedef ccn__fvar_probe_list probe_list;
  * values (3 components: colours 3b .. 3b+2 set to 1) is the weight of each of o's candidates
  * (row start[o] .. start[o+1]) with one of those colours. */
 typedef struct {
-    const builder *c; const double *PL, *PS; const int32_t *start, *ccol, *outs; double *cw; int32_t b;
+    const builder *c; const double *PL, *PS; const ccn__fvar_cands *cd; const int32_t *outs; double *cw; int32_t b;
 } limit_job;
 
 static void limit_range(void *ctx, int32_t b, int32_t end) {
@@ -22,7 +22,7 @@ static void limit_range(void *ctx, int32_t b, int32_t end) {
     const builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
     const double *PL = j->PL, *PS = j->PS;
-    const int32_t *start = j->start, *ccol = j->ccol, c0 = 3 * j->b;
+    const int32_t *start = j->cd->start, *kst = j->cd->kstart, *kp = j->cd->perm, *kc = j->cd->col, c0 = 3 * j->b;
     int32_t nvL = mL->nv;
     for (int32_t i = b; i < end; i++) {
         int32_t o = j->outs ? j->outs[i] : i;
@@ -38,10 +38,13 @@ static void limit_range(void *ctx, int32_t b, int32_t end) {
             }
             x[0] = x0; x[1] = x1; x[2] = x2;
         }
-        for (int32_t e = start[o]; e < start[o + 1]; e++) {
-            uint32_t k = (uint32_t)(ccol[e] - c0);
-            if (k < 3) j->cw[e] = x[k];
+        int32_t a = kst[c->fo[o]], n = kst[c->fo[o] + 1] - a, lo = 0, hi = n;
+        while (lo < hi) { /* the first of o's candidates with colour >= c0 */
+            int32_t mid = (lo + hi) / 2;
+            if (kc[a + mid] < c0) lo = mid + 1;
+            else hi = mid;
         }
+        for (int32_t q = lo; q < n && kc[a + q] < c0 + 3; q++) j->cw[start[o] + kp[a + q]] = x[kc[a + q] - c0];
     }
 }
 
@@ -246,7 +249,7 @@ typedef struct {
 /* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
  * stencil run; each candidate weight of those colours is read off (limit_range). */
 static void probe(const builder *c, const probe_set *w, int threads, const int32_t *col, int32_t b,
-                  const int32_t *start, const int32_t *ccol, double *cw) {
+                  const ccn__fvar_cands *cd, double *cw) {
     double *P0 = w->pos[0];
     for (int32_t v = 0; v < c->lev[0].m->nv; v++)
         for (int k = 0; k < 3; k++) P0[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
@@ -256,7 +259,7 @@ static void probe(const builder *c, const probe_set *w, int threads, const int32
         else ccn__level_points(&w->prep[l], w->pos[l + 1]);
     }
     if (c->has_sub) ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
-    limit_job j = {c, w->pos[c->L], w->posS, start, ccol, c->outs, cw, b};
+    limit_job j = {c, w->pos[c->L], w->posS, cd, c->outs, cw, b};
     ccn__parallel_for(threads, c->nouts, limit_range, &j);
 }
 
@@ -303,7 +306,7 @@ static int probe_set_copy(const builder *c, probe_set *w) {
 
 typedef struct {
     const builder *c; const probe_set *sets; int32_t nsets, npass;
-    const int32_t *col, *start, *ccol; double *cw;
+    const int32_t *col; const ccn__fvar_cands *cd; double *cw;
 } pool_job;
 
 /* Worker t (one task each) runs passes t + 1, t + 1 + nsets, ... on its own set. */
@@ -311,7 +314,7 @@ static void pool_range(void *ctx, int32_t b, int32_t end) {
     const pool_job *j = ctx;
     for (int32_t t = b; t < end; t++)
         for (int32_t pass = 1 + t; pass < j->npass; pass += j->nsets)
-            probe(j->c, &j->sets[t], 1, j->col, pass, j->start, j->ccol, j->cw);
+            probe(j->c, &j->sets[t], 1, j->col, pass, j->cd, j->cw);
 }
 
 /* Every pass: the first on the builder's own set (threaded inside; it makes the levels'
@@ -319,7 +322,7 @@ static void pool_range(void *ctx, int32_t b, int32_t end) {
  * weights and compute the same numbers wherever they run. Without memory for the copies they
  * run one after the other on the builder's set. */
 int ccn__fvar_probe_all(const ccn_plan *p, builder *c, int32_t npass, const int32_t *col,
-                     const int32_t *start, const int32_t *ccol, double *cw) {
+                     const ccn__fvar_cands *cd, double *cw) {
     if (npass <= 0) return 0;
     double **ownpos = malloc(sizeof(double *) * ((size_t)c->L + 1));
     if (!ownpos) return -1;
@@ -327,19 +330,19 @@ int ccn__fvar_probe_all(const ccn_plan *p, builder *c, int32_t npass, const int3
     probe_set own = {ownpos, c->posS, c->prep, &c->sub, NULL, {0}};
     int32_t nsets = p->threads - 1 < npass - 1 ? p->threads - 1 : npass - 1, made = 0;
     probe_set *sets = nsets > 0 ? calloc((size_t)nsets + 1, sizeof *sets) : NULL;
-    probe(c, &own, p->threads, col, 0, start, ccol, cw);
+    probe(c, &own, p->threads, col, 0, cd, cw);
     if (sets) { /* the builder's set is worker 0's too */
         sets[0] = own;
         for (made = 1; made <= nsets && !probe_set_copy(c, &sets[made]); made++) {}
         if (made <= nsets) probe_set_free(&sets[made], c->L);
     }
     if (made >= 2) {
-        pool_job j = {c, sets, made, npass, col, start, ccol, cw};
+        pool_job j = {c, sets, made, npass, col, cd, cw};
         for (int32_t l = 0; l < c->L; l++) c->prep[l].threads = 1; /* one thread per worker */
         ccn__parallel_tasks(made, made, pool_range, &j);
         for (int32_t l = 0; l < c->L; l++) c->prep[l].threads = p->threads;
     } else
-        for (int32_t pass = 1; pass < npass; pass++) probe(c, &own, p->threads, col, pass, start, ccol, cw);
+        for (int32_t pass = 1; pass < npass; pass++) probe(c, &own, p->threads, col, pass, cd, cw);
     for (int32_t t = 1; t < made; t++) probe_set_free(&sets[t], c->L);
     free(sets);
     free(ownpos);
