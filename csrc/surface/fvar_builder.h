@@ -31,6 +31,15 @@ typedef struct {
     int numbered_only;
     int32_t nvL, nsharpL;     /* level L's value vertices, those kept sharp */
     int32_t *hvL, *firstL;    /* level L: value vertex per corner; each one's first fan corner */
+    /* Level-1 blocks (surface/fvar_direct.c on level 1): a probed output in a level-1 face whose
+     * 4 x 4 block is regular there has the bicubic patch of those level-1 points as its limit,
+     * so the probes read it off level 1 (no limit stencil, nothing finer computed for it). */
+    ccn__fvar_direct dir1;
+    int32_t *d1;              /* level-L value vertex: its level-1 table, -1 none */
+    int32_t *d1ab;            /* its grid point in that level-1 face, a + (b << 16) */
+    int32_t nd1, side1, *d1verts; /* tables: 16 level-1 value vertices each (P_ij at i + 4 j) */
+    double *d1N;              /* tables: 8 * side1 basis values each (fvar_direct_table) */
+    uint8_t *skip;            /* level-L value vertex: no limit stencil (direct, or d1 >= 0) */
 } ccn__fvar_builder;
 
 #endif

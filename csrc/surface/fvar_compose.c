@@ -45,6 +45,8 @@ static void builder_free(builder *c) {
     free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
     free(c->posS); free(c->value_of); free(c->fo); free(c->ab); free(c->direct); free(c->outs);
     free(c->hvL); free(c->firstL);
+    ccn__fvar_direct_free(&c->dir1);
+    free(c->d1); free(c->d1ab); free(c->d1verts); free(c->d1N); free(c->skip);
     ccn__fvar_direct_free(&c->dir);
     for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
     free(c->pl);
@@ -145,9 +147,8 @@ static void irr_range(void *ctx, int32_t b, int32_t end) {
     const fast_job *j = ctx;
     const ccn_mesh *m = j->fl->m;
     float dep;
-    for (int32_t v = b; v < end; v++) /* a written-down output lies inside a regular block */
-        j->irr[v] = !j->skip[v] && (ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR ||
-                                    partner_semisharp(j->fl, v, j->method, &dep));
+    for (int32_t v = b; v < end; v++) /* written-down outputs too: their neighbours' stencils */
+        j->irr[v] = ccn__limit_kind(m, v, 0) != CCN_LIMIT_REGULAR || partner_semisharp(j->fl, v, j->method, &dep);
 }
 
 static void fast_range(void *ctx, int32_t b, int32_t end) {
@@ -191,7 +192,7 @@ static ccn_status limit_stencils(const ccn_plan *p, builder *c, ccn_error *err) 
     ccn__ring_limit *ring = malloc(sizeof *ring);
     ccn__ring_work *work = ccn__ring_work_create();
     wbuf b = {0, 0, NULL, NULL};
-    fast_job fj = {fl, p->opts.crease_method, c->direct, malloc(nv), malloc(sizeof(int32_t) * nv),
+    fast_job fj = {fl, p->opts.crease_method, c->skip ? c->skip : c->direct, malloc(nv), malloc(sizeof(int32_t) * nv),
                    malloc(sizeof(int32_t) * FAST_MAX * nv), malloc(sizeof(double) * FAST_MAX * nv)};
     int32_t *sstart = malloc(sizeof(int32_t) * nv); /* a serial stencil's start in b */
     c->st_start = malloc(sizeof(int32_t) * ((size_t)m->nv + 1));
@@ -269,12 +270,12 @@ done:
  * the child quad (V_j, E(h_j), F, E(h_j-1)) at corner j of its parent (refine/level.c), a
  * quarter of the parent's square. Integers: (x, y) in level-L face sizes within a face of side
  * z, so the parent's is (2 z c_0 + x (c_1 - c_0) + y (c_-1 - c_0)) with side 2 z. */
-static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) {
+static int32_t origin_at(const ccn_plan *p, int32_t h, int32_t stop, int32_t *ab) {
     static const int32_t C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     const ccn_mesh *mL = p->lev[p->L]; /* the value mesh's faces and corners are the vertices' */
     int32_t g = mL->hface[h], j = h - mL->fstart[g];
     int32_t x = C[j & 3][0], y = C[j & 3][1], z = 1;
-    for (int32_t l = p->L; l > 0; l--) {
+    for (int32_t l = p->L; l > stop; l--) {
         const ccn_mesh *m = p->lev[l - 1];
         int32_t f = m->hface[g], k = g - m->fstart[f];
         if (ccn__fsize(m, f) == 4) {
@@ -285,12 +286,65 @@ static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) {
         }
         g = f;
     }
-    int32_t sc = (1 << p->L) / z;
+    int32_t sc = (1 << (p->L - stop)) / z;
     *ab = x * sc + ((y * sc) << 16);
     return g;
 }
 
+static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) { return origin_at(p, h, 0, ab); }
+
 typedef struct { const ccn_plan *p; builder *c; } origin_job;
+
+static void origin1_range(void *ctx, int32_t b, int32_t end) {
+    const origin_job *j = ctx;
+    builder *c = j->c;
+    const ccn_mesh *mL = c->lev[c->L].m;
+    for (int32_t o = b; o < end; o++)
+        c->d1[o] = c->direct[o] ? -1 : origin_at(j->p, mL->vfan[mL->vfan_start[o]], 1, &c->d1ab[o]);
+}
+
+/* The probed outputs that lie in a level-1 face whose block is regular at level 1 (the level-L
+ * faces below a level-1 face are its quarters, as below level 0): their tables and grid points
+ * (ccn__fvar_builder.d1). */
+static ccn_status level1_blocks(const ccn_plan *p, builder *c, ccn_error *err) {
+    const ccn_mesh *mL = c->lev[c->L].m, *m1 = c->lev[1].m;
+    int32_t *tab = malloc(sizeof(int32_t) * (size_t)(m1->nf ? m1->nf : 1));
+    c->d1 = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    c->d1ab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
+    c->skip = malloc((size_t)(mL->nv ? mL->nv : 1));
+    if (!tab || !c->d1 || !c->d1ab || !c->skip || ccn__fvar_direct_build(&c->lev[1], p->threads, &c->dir1)) {
+        free(tab);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    }
+    for (int32_t g = 0; g < m1->nf; g++) tab[g] = -1;
+    origin_job oj = {p, c};
+    ccn__parallel_for(p->threads, mL->nv, origin1_range, &oj); /* d1: the level-1 face */
+    c->nd1 = 0;
+    for (int32_t o = 0; o < mL->nv; o++) {
+        int32_t g = c->d1[o];
+        if (g >= 0 && c->dir1.slot[g] >= 0) {
+            if (tab[g] < 0) tab[g] = c->nd1++;
+            c->d1[o] = tab[g];
+        } else
+            c->d1[o] = -1;
+        c->skip[o] = (uint8_t)(c->direct[o] || c->d1[o] >= 0);
+    }
+    c->side1 = (1 << (c->L - 1)) + 1;
+    c->d1verts = malloc(sizeof(int32_t) * 16 * (size_t)(c->nd1 ? c->nd1 : 1));
+    c->d1N = malloc(sizeof(double) * 8 * (size_t)c->side1 * (size_t)(c->nd1 ? c->nd1 : 1));
+    if (!c->d1verts || !c->d1N) {
+        free(tab);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    }
+    for (int32_t g = 0; g < m1->nf; g++) {
+        int32_t t = tab[g];
+        if (t < 0) continue;
+        memcpy(c->d1verts + 16 * (size_t)t, c->dir1.verts + 16 * (size_t)c->dir1.slot[g], sizeof(int32_t) * 16);
+        ccn__fvar_direct_table(&c->dir1, c->dir1.slot[g], c->side1, c->d1N + 8 * (size_t)c->side1 * t);
+    }
+    free(tab);
+    return CCN_OK;
+}
 
 static void origin_range(void *ctx, int32_t b, int32_t end) {
     const origin_job *j = ctx;
@@ -415,6 +469,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     c->nouts = 0;
     for (int32_t o = 0; o < mL->nv; o++)
         if (!c->direct[o]) c->outs[c->nouts++] = o;
+    if (!c->bilinear && c->L >= 1 && (st = level1_blocks(p, c, err))) return st;
     if (!c->bilinear && (st = limit_stencils(p, c, err))) return st;
     if (c->nnear) {
         if ((st = ccn__fvar_prepare(&c->sub, &c->lev[c->L], p->opts.scheme, p->opts.crease_method,

@@ -14,7 +14,7 @@ typedef ccn__fvar_probe_list probe_list;
  * values (3 components: colours 3b .. 3b+2 set to 1) is the weight of each of o's candidates
  * (row start[o] .. start[o+1]) with one of those colours. */
 typedef struct {
-    const builder *c; const double *PL, *PS; const ccn__fvar_cands *cd; const int32_t *outs; double *cw; int32_t b;
+    const builder *c; const double *PL, *PS, *P1; const ccn__fvar_cands *cd; const int32_t *outs; double *cw; int32_t b;
 } limit_job;
 
 static void limit_range(void *ctx, int32_t b, int32_t end) {
@@ -28,7 +28,22 @@ static void limit_range(void *ctx, int32_t b, int32_t end) {
         int32_t o = j->outs ? j->outs[i] : i;
         double x[3];
         if (c->bilinear) memcpy(x, PL + 3 * (size_t)o, sizeof x);
-        else {
+        else if (c->d1 && c->d1[o] >= 0) { /* the level-1 block's patch (ccn__fvar_builder.d1) */
+            int32_t t = c->d1[o], a1 = c->d1ab[o] & 0xffff, b1 = c->d1ab[o] >> 16;
+            const double *Nu = c->d1N + 8 * (size_t)c->side1 * t + 4 * (size_t)a1;
+            const double *Nv = c->d1N + 8 * (size_t)c->side1 * t + 4 * ((size_t)c->side1 + b1);
+            const int32_t *P = c->d1verts + 16 * (size_t)t;
+            double x0 = 0, x1 = 0, x2 = 0;
+            for (int jj = 0; jj < 4; jj++) {
+                double r0 = 0, r1 = 0, r2 = 0;
+                for (int ii = 0; ii < 4; ii++) {
+                    const double *q = j->P1 + 3 * (size_t)P[ii + 4 * jj];
+                    r0 += Nu[ii] * q[0]; r1 += Nu[ii] * q[1]; r2 += Nu[ii] * q[2];
+                }
+                x0 += Nv[jj] * r0; x1 += Nv[jj] * r1; x2 += Nv[jj] * r2;
+            }
+            x[0] = x0; x[1] = x1; x[2] = x2;
+        } else {
             double x0 = 0, x1 = 0, x2 = 0;
             for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
                 int32_t i = c->st_v[k];
@@ -151,6 +166,14 @@ static void mark_faces_around(const ccn_mesh *m, int32_t v, uint8_t *need) {
     need[v] = 1;
 }
 
+/* The level-1 block points of the outputs read off level 1 (ccn__fvar_builder.d1). */
+static void mark_level1_blocks(const builder *c, uint8_t *need1) {
+    for (int32_t i = 0; c->d1 && i < c->nouts; i++) {
+        int32_t t = c->d1[c->outs[i]];
+        for (int k = 0; t >= 0 && k < 16; k++) need1[c->d1verts[16 * (size_t)t + k]] = 1;
+    }
+}
+
 static int list_of(const uint8_t *mark, int32_t n, int32_t **out, int32_t *count) {
     int32_t k = 0;
     for (int32_t i = 0; i < n; i++) k += mark[i] != 0;
@@ -190,9 +213,11 @@ int ccn__fvar_probe_lists(builder *c) {
         }
         free(isev);
     }
+    if (L == 1) mark_level1_blocks(c, need);
     int ok = 1;
     for (int32_t l = L - 1; ok && l >= 0; l--) {
         const ccn_mesh *m = c->lev[l].m;
+        if (l == 0 && L > 1) mark_level1_blocks(c, need); /* need: level 1's points here */
         const ccn__level *pr = &c->prep[l];
         probe_list *q = &c->pl[l];
         uint8_t *fm = calloc((size_t)m->nf + 1, 1), *em = calloc((size_t)m->ne + 1, 1);
@@ -259,7 +284,7 @@ static void probe(const builder *c, const probe_set *w, int threads, const int32
         else ccn__level_points(&w->prep[l], w->pos[l + 1]);
     }
     if (c->has_sub) ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
-    limit_job j = {c, w->pos[c->L], w->posS, cd, c->outs, cw, b};
+    limit_job j = {c, w->pos[c->L], w->posS, c->L >= 1 ? w->pos[1] : NULL, cd, c->outs, cw, b};
     ccn__parallel_for(threads, c->nouts, limit_range, &j);
 }
 
