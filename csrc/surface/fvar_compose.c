@@ -484,7 +484,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
 
 typedef struct {
     const builder *c;
-    const ccn__fvar_csr *K; const int32_t *fo, *col, *start, *compact;
+    const ccn__fvar_csr *K; const int32_t *fo, *start, *compact;
     int32_t *idx;
     ccn__fvar_stencils *s;
 } cand_job;
@@ -619,7 +619,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
     int32_t *compact = NULL;
     if (c->dir.count > 0 && (st = direct_tables(p, c, s, &compact, err))) { free(compact); goto done; }
-    cand_job cj = {c, &K, fo, col, s->start, compact, s->idx, s};
+    cand_job cj = {c, &K, fo, s->start, compact, s->idx, s};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);
     if (c->dir.count > 0 && c->nouts) { /* probes of the other outputs: their points only, the rest zero */
