@@ -144,7 +144,7 @@ def _remove_unused():
         if p.library is None and p not in named:
             modifier.remove_proxy(p)
             removed += 1
-    for name in (proxies.EMPTY_NAME, ".ccnurbs_scratch"):
+    for name in (".ccnurbs_scratch",):
         me = bpy.data.meshes.get(name)
         if me is not None and me.users == 0 and me.library is None:
             bpy.data.meshes.remove(me)
