@@ -43,21 +43,28 @@ class Cage:
         used_e[self.loop_edges] = True
         return int((~used_v).sum()), int((~used_e).sum())
 
-    def topology_key(self, *settings, creases=False, knots=True):
-        """Hash of everything a plan depends on except positions: polygons, edges, intervals,
-        material indices, settings and (with Use Creases) creases. With knots=False, the key of
-        the proxy's topology: intervals change the plan but not the limit mesh's faces."""
-        h = hashlib.blake2b(digest_size=16)
+    def topology_keys(self, *settings, creases=False):
+        """(plan key, faces key): hashes of everything a plan depends on except positions
+        (polygons, edges, intervals, material indices, settings and, with Use Creases,
+        creases), and the same without the intervals: the key of the proxy's topology
+        (intervals change the plan but not the limit mesh's faces). One pass over the arrays."""
+        base = hashlib.blake2b(digest_size=16)
         for a in (self.face_sizes, self.face_verts, self.edge_verts, self.material_index):
-            h.update(np.ascontiguousarray(a).tobytes())
-            h.update(b"|")
-        if knots:
-            h.update(b"K" + (self.knots.tobytes() if self.knots is not None else b"-"))
+            base.update(np.ascontiguousarray(a).tobytes())
+            base.update(b"|")
+        tail = b""
         if creases:
             for a in (self.edge_creases, self.vertex_creases):
-                h.update(b"C" + (a.tobytes() if a is not None else b"-"))
-        h.update(repr((len(self.positions),) + settings).encode())
-        return h.hexdigest()
+                tail += b"C" + (a.tobytes() if a is not None else b"-")
+        tail += repr((len(self.positions),) + settings).encode()
+        keys = []
+        for knots in (True, False):
+            h = base.copy()
+            if knots:
+                h.update(b"K" + (self.knots.tobytes() if self.knots is not None else b"-"))
+            h.update(tail)
+            keys.append(h.hexdigest())
+        return tuple(keys)
 
     def position_key(self):
         return hashlib.blake2b(self.positions.tobytes(), digest_size=16).hexdigest()

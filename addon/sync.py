@@ -130,9 +130,8 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
-        topo = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases) + uv_topo
-        faces = cage.topology_key(levels, *s.option_tuple(), creases=s.use_creases,
-                                  knots=False) + uv_topo
+        topo, faces = (k + uv_topo for k in
+                       cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases))
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
         key = topo + ":" + cage.position_key() + ":" + ekey
         proxies.sync_materials(obj.data, p)
