@@ -319,7 +319,10 @@ class TestSaveCost(AddonTestCase):
                  times["CCNURBS"][1], ratio_next, times["SUBSURF"][2], times["CCNURBS"][2],
                  times["CCNURBS"][2] / times["SUBSURF"][2], sizes["SUBSURF"], sizes["CCNURBS"]))
         self.assertLessEqual(sizes["CCNURBS"], 1.2 * sizes["SUBSURF"], "the file holds more")
-        # the write itself, generous margin against millisecond noise (target 1.2x); the
-        # evaluation after it is printed
+        # the write itself, generous margin against millisecond noise (target 1.2x)
         self.assertLessEqual(times["CCNURBS"][0], 3.0 * times["SUBSURF"][0] + 0.05,
                              "saving is far slower than with Subsurf (target 1.2x)")
+        # and what the save leaves for the next redraw: nothing to evaluate (the proxies are
+        # swapped in place; through the API this was 0.5 s on 3.4)
+        self.assertLessEqual(times["CCNURBS"][2], 3.0 * times["SUBSURF"][2] + 0.05,
+                             "the save leaves an evaluation behind (target 1.2x)")
