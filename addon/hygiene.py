@@ -144,10 +144,10 @@ def _remove_unused():
         if p.library is None and p not in named:
             modifier.remove_proxy(p)
             removed += 1
-    for name in (".ccnurbs_scratch",):
-        me = bpy.data.meshes.get(name)
-        if me is not None and me.users == 0 and me.library is None:
-            bpy.data.meshes.remove(me)
+    # the add-on's two session meshes have no user and are never saved: the edit-mode scratch
+    # (cage.py) and the empty mesh of saves (proxies.py). They stay: removing one re-creates it
+    # at the next edit or save, and each removal or creation rebuilds the depsgraph relations
+    # (in Edit Mode that was every update)
     return removed
 
 

@@ -177,6 +177,35 @@ class TestModifier(AddonTestCase):
         R, _ = reference(ob)
         np.testing.assert_allclose(P2, R, atol=POS_TOL)
 
+    def test_edit_mode_moves_run_no_hygiene(self):
+        """A move in Edit Mode changes no data-block count: no hygiene pass, no mesh created
+        or removed (each would rebuild the depsgraph relations on every update). 4.x reads the
+        edit mesh through the scratch mesh (3.4 does not need it)."""
+        ob = add_modifier(grid(4, "EditCost"))
+        bpy.ops.object.mode_set(mode='EDIT')
+        bm = bmesh.from_edit_mesh(ob.data)
+        bm.verts.ensure_lookup_table()
+        hyg = ccn.handlers.hygiene
+        real, calls = hyg.collect, []
+
+        def counting():
+            calls.append(1)
+            return real()
+        try:
+            for r in range(4):
+                if r == 1:
+                    hyg.collect = counting  # after the first edit-mode update
+                    meshes = len(bpy.data.meshes)
+                bm.verts[12].co.z = 0.25 * (r + 1)
+                bmesh.update_edit_mesh(ob.data)
+                P = evaluated_positions(ob)
+                self.assertGreater(P[:, 2].max(), 0.05 * (r + 1))
+        finally:
+            hyg.collect = real
+            bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertEqual(calls, [], "edit-mode moves ran the hygiene pass")
+        self.assertEqual(len(bpy.data.meshes), meshes)
+
     def test_render_uses_render_levels(self):
         ob = add_modifier(load_cage("Fan5", os.path.join(DATA, "fan5.obj")), levels=1,
                           render_levels=3)
