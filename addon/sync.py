@@ -40,7 +40,7 @@ pending_normals = set()  # names of cages whose viewport proxy waits for its exa
 
 class Status:
     __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
-                 "showing", "loose", "element")
+                 "showing", "loose", "element", "faces_key")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
@@ -50,6 +50,7 @@ class Status:
         self.showing = "limit"   # limit | last valid limit | cage
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
         self.element = None      # (ccn_element_kind, index) an error names (errors.py)
+        self.faces_key = None    # the cage topology `loose` was counted on
 
 
 def status(obj, kind='VIEW'):
@@ -125,17 +126,19 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     t0 = time.perf_counter()
     p = None
     try:
-        st.loose = cage.loose_counts()
-        p = modifier.proxy(obj, kind)
-        if p is None:
-            raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
         topo, faces = (k + uv_topo for k in
                        cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases))
+        old = _status.get(key_name)
+        st.faces_key = faces  # loose counts depend on it only: a position update reuses them
+        st.loose = old.loose if old is not None and old.faces_key == faces else \
+            cage.loose_counts()
+        p = modifier.proxy(obj, kind)
+        if p is None:
+            raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
         key = topo + ":" + cage.position_key() + ":" + ekey
         proxies.sync_materials(obj.data, p)
-        old = _status.get(key_name)
         me = p.data
         stored = me.get(proxies.KEY_PROP)
         if stored == key + PENDING and defer_normals:
@@ -145,7 +148,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             if old is None or old.error:  # unknown (file just loaded) or fixed by undo
                 old = Status(kind, levels)
                 old.num_verts, old.num_faces = len(me.vertices), len(me.polygons)
-                old.loose = st.loose
+                old.loose, old.faces_key = st.loose, faces
                 _status[key_name] = old
             return old
         stats["syncs"] += 1
