@@ -10,15 +10,16 @@ fields directly changes what the file writer sees and nothing the depsgraph watc
 Safety: nothing is assumed about Blender's struct layout. The offsets are found once per session
 on throw-away data and accepted only when a field follows every change made through the API
 (`ID.users` under fake-user toggles and a new user; `Object.data` under two assignments) at
-exactly one offset; otherwise `layout()` is None and callers use the API. Reads stay inside
-structs larger than the scanned range (ID, Mesh, Object are all larger than SCAN bytes).
+exactly one offset; otherwise `layout()` is None and callers use the API. Only the probe
+reads a range (640 bytes of a Mesh, 768 of an Object, both inside those structs); the edits
+write one field each, at the verified offsets.
 """
 import ctypes
 
 import bpy
 
-SCAN_ID = 640    # bytes of an ID-headed struct searched for `us` (ID is < 450 bytes in 3.4..5.x)
-SCAN_OBJECT = 1024  # bytes of an Object searched for `data` (Object is > 1.5 kB in 3.4..5.x)
+SCAN_ID = 640       # bytes of a Mesh searched for ID.us (after the name: 112 in 3.4, 304 in 5.0)
+SCAN_OBJECT = 768   # bytes of an Object searched for `data` (at 376 in 3.4, 392 in 4.5, 560 in 5.0)
 _TMP = ".ccnurbs idmem probe"
 
 _layout = []  # [None] or [(us offset, data offset)] once probed

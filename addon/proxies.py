@@ -4,8 +4,9 @@ All bulk data goes through foreach_set. A proxy's mesh is its own (never the sha
 used while saving). Saving: a viewport proxy shows what the add-on computes again on load, so
 it points at one empty mesh during the write (`save_pre` / `save_post`: O(1) per cage, the mesh
 itself is untouched; done in place by idmem, so the save tags nothing and the next redraw
-evaluates nothing; the empty mesh stays in the session with no user, never saved); a render proxy is empty outside renders unless the cage's
-*Store Render Mesh in File* is on, and is then written as it is (never rebuilt by saving).
+evaluates nothing; the empty mesh stays in the session with no user, never saved); a render
+proxy is empty outside renders unless the cage's *Store Render Mesh in File* is on, and is then
+written as it is (never rebuilt by saving).
 """
 import bpy
 import numpy as np
