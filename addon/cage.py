@@ -43,11 +43,25 @@ class Cage:
         used_e[self.loop_edges] = True
         return int((~used_v).sum()), int((~used_e).sum())
 
-    def topology_keys(self, *settings, creases=False):
+    def topology_keys(self, *settings, creases=False, memo=None):
         """(plan key, faces key): hashes of everything a plan depends on except positions
         (polygons, edges, intervals, material indices, settings and, with Use Creases,
         creases), and the same without the intervals: the key of the proxy's topology
-        (intervals change the plan but not the limit mesh's faces). One pass over the arrays."""
+        (intervals change the plan but not the limit mesh's faces). One pass over the arrays.
+        memo (a dict kept by the caller per cage): when every hashed input equals the last
+        call's, its keys are returned without hashing (a position update)."""
+        inputs = (self.face_sizes, self.face_verts, self.edge_verts, self.material_index,
+                  self.knots) + ((self.edge_creases, self.vertex_creases) if creases else ())
+        sig = (len(self.positions), settings, creases)
+        if memo is not None and memo.get("sig") == sig and _same(memo["inputs"], inputs):
+            return memo["keys"]
+        keys = self._hash_topology(settings, creases)
+        if memo is not None:
+            memo.update(sig=sig, keys=keys,
+                        inputs=tuple(None if a is None else np.array(a) for a in inputs))
+        return keys
+
+    def _hash_topology(self, settings, creases):
         base = hashlib.blake2b(digest_size=16)
         for a in (self.face_sizes, self.face_verts, self.edge_verts, self.material_index):
             base.update(np.ascontiguousarray(a).tobytes())
@@ -68,6 +82,21 @@ class Cage:
 
     def position_key(self):
         return hashlib.blake2b(self.positions.tobytes(), digest_size=16).hexdigest()
+
+
+def _same(old, new):
+    """Equal arrays (or both None), input by input."""
+    if len(old) != len(new):
+        return False
+    for a, b in zip(old, new):
+        if a is None or b is None:
+            if a is not b:
+                return False
+            continue
+        b = np.asarray(b)
+        if a.shape != b.shape or a.dtype != b.dtype or not np.array_equal(a, b):
+            return False
+    return True
 
 
 def sharpness(creases):

@@ -30,6 +30,7 @@ stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "
          "internal_errors": 0, "render_frames": 0}
 _plans = {}      # (object name, kind) -> (topology key, native.Plan)
 _status = {}     # (object name, kind) -> Status
+_key_memo = {}   # (object name, kind) -> the last topology keys and their inputs (cage.py)
 # Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
 # evaluation of the cage afterwards cost 5x the rest of an update, issue 15): with
 # defer_normals the proxy gets Blender's own normals and this key suffix, and its cage is listed
@@ -60,7 +61,7 @@ def status(obj, kind='VIEW'):
 def rename(old, new):
     """A cage was renamed: its plans and status follow it."""
     for kind in ('VIEW', 'RENDER'):
-        for table in (_plans, _status):
+        for table in (_plans, _status, _key_memo):
             if (old, kind) in table:
                 table[(new, kind)] = table.pop((old, kind))
 
@@ -72,6 +73,7 @@ def forget(name, kinds=('VIEW', 'RENDER')):
         if entry is not None:
             entry[1].close()
         _status.pop((name, kind), None)
+        _key_memo.pop((name, kind), None)
 
 
 def forget_all():
@@ -79,6 +81,7 @@ def forget_all():
         plan.close()
     _plans.clear()
     _status.clear()
+    _key_memo.clear()
     pending_normals.clear()
 
 
@@ -128,7 +131,8 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     try:
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
         topo, faces = (k + uv_topo for k in
-                       cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases))
+                       cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases,
+                                          memo=_key_memo.setdefault(key_name, {})))
         old = _status.get(key_name)
         st.faces_key = faces  # loose counts depend on it only: a position update reuses them
         st.loose = old.loose if old is not None and old.faces_key == faces else \

@@ -177,6 +177,35 @@ class TestModifier(AddonTestCase):
         R, _ = reference(ob)
         np.testing.assert_allclose(P2, R, atol=POS_TOL)
 
+    def test_topology_key_memo_never_stale(self):
+        """The memo returns the last keys only when every hashed input is equal: each change
+        (an interval, a crease, a face, a material, a vertex count, a setting) gives the keys
+        a fresh hash gives."""
+        ob = grid(3, "Memo")
+        cage = ccn.cage.read_mesh(ob.data)
+        memo = {}
+        first = cage.topology_keys(2, "x", creases=True, memo=memo)
+        self.assertEqual(first, cage.topology_keys(2, "x", creases=True))
+        again = ccn.cage.read_mesh(ob.data)  # new arrays, same values: the memo answers
+        self.assertEqual(again.topology_keys(2, "x", creases=True, memo=memo), first)
+        changes = {
+            "knots": lambda c: setattr(c, "knots", np.full(c.num_edges, 2.0)),
+            "creases": lambda c: setattr(c, "edge_creases", np.full(c.num_edges, 0.5)),
+            "faces": lambda c: setattr(c, "face_verts", np.roll(c.face_verts, 1)),
+            "materials": lambda c: setattr(c, "material_index", c.material_index + 1),
+            "vertices": lambda c: setattr(c, "positions", np.zeros((c.num_verts + 1, 3))),
+        }
+        for what, change in changes.items():
+            with self.subTest(change=what):
+                c = ccn.cage.read_mesh(ob.data)
+                change(c)
+                m = dict(memo)
+                got = c.topology_keys(2, "x", creases=True, memo=m)
+                self.assertEqual(got, c.topology_keys(2, "x", creases=True))
+                self.assertNotEqual(got, first)
+        m = dict(memo)
+        self.assertNotEqual(cage.topology_keys(3, "x", creases=True, memo=m), first)
+
     def test_edit_mode_moves_run_no_hygiene(self):
         """A move in Edit Mode changes no data-block count: no hygiene pass, no mesh created
         or removed (each would rebuild the depsgraph relations on every update). 4.x reads the
