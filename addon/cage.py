@@ -49,7 +49,8 @@ class Cage:
         creases), and the same without the intervals: the key of the proxy's topology
         (intervals change the plan but not the limit mesh's faces). One pass over the arrays.
         memo (a dict kept by the caller per cage): when every hashed input equals the last
-        call's, its keys are returned without hashing (a position update)."""
+        call's, its keys are returned without hashing (a position update); otherwise it starts
+        afresh, so what the caller keeps in it belongs to this topology."""
         inputs = (self.face_sizes, self.face_verts, self.edge_verts, self.material_index,
                   self.knots) + ((self.edge_creases, self.vertex_creases) if creases else ())
         sig = (len(self.positions), settings, creases)
@@ -57,6 +58,7 @@ class Cage:
             return memo["keys"]
         keys = self._hash_topology(settings, creases)
         if memo is not None:
+            memo.clear()
             memo.update(sig=sig, keys=keys,
                         inputs=tuple(None if a is None else np.array(a) for a in inputs))
         return keys

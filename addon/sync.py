@@ -30,7 +30,8 @@ stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "
          "internal_errors": 0, "render_frames": 0}
 _plans = {}      # (object name, kind) -> (topology key, native.Plan)
 _status = {}     # (object name, kind) -> Status
-_key_memo = {}   # (object name, kind) -> the last topology keys and their inputs (cage.py)
+_key_memo = {}   # (object name, kind) -> the last topology keys, their inputs (cage.py), and
+#                  "loose": the loose counts of that topology
 # Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
 # evaluation of the cage afterwards cost 5x the rest of an update, issue 15): with
 # defer_normals the proxy gets Blender's own normals and this key suffix, and its cage is listed
@@ -41,7 +42,7 @@ pending_normals = set()  # names of cages whose viewport proxy waits for its exa
 
 class Status:
     __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
-                 "showing", "loose", "element", "faces_key")
+                 "showing", "loose", "element")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
@@ -51,7 +52,6 @@ class Status:
         self.showing = "limit"   # limit | last valid limit | cage
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
         self.element = None      # (ccn_element_kind, index) an error names (errors.py)
-        self.faces_key = None    # the cage topology `loose` was counted on
 
 
 def status(obj, kind='VIEW'):
@@ -130,13 +130,14 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     p = None
     try:
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
+        memo = _key_memo.setdefault(key_name, {})
         topo, faces = (k + uv_topo for k in
                        cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases,
-                                          memo=_key_memo.setdefault(key_name, {})))
+                                          memo=memo))
+        if "loose" not in memo:  # a new topology (the memo starts afresh): count once
+            memo["loose"] = cage.loose_counts()
+        st.loose = memo["loose"]
         old = _status.get(key_name)
-        st.faces_key = faces  # loose counts depend on it only: a position update reuses them
-        st.loose = old.loose if old is not None and old.faces_key == faces else \
-            cage.loose_counts()
         p = modifier.proxy(obj, kind)
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
@@ -152,7 +153,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             if old is None or old.error:  # unknown (file just loaded) or fixed by undo
                 old = Status(kind, levels)
                 old.num_verts, old.num_faces = len(me.vertices), len(me.polygons)
-                old.loose, old.faces_key = st.loose, faces
+                old.loose = st.loose
                 _status[key_name] = old
             return old
         stats["syncs"] += 1
