@@ -312,13 +312,29 @@ static ccn_status level1_blocks(const ccn_plan *p, builder *c, ccn_error *err) {
     c->d1 = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     c->d1ab = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
     c->skip = malloc((size_t)(mL->nv ? mL->nv : 1));
-    if (!tab || !c->d1 || !c->d1ab || !c->skip || ccn__fvar_direct_build(&c->lev[1], p->threads, &c->dir1)) {
+    if (!tab || !c->d1 || !c->d1ab || !c->skip) {
         free(tab);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     }
     for (int32_t g = 0; g < m1->nf; g++) tab[g] = -1;
     origin_job oj = {p, c};
     ccn__parallel_for(p->threads, mL->nv, origin1_range, &oj); /* d1: the level-1 face */
+    int32_t nlist = 0; /* only the level-1 faces of probed outputs are classified (tab: a list) */
+    for (int32_t o = 0; o < mL->nv; o++) {
+        int32_t g = c->d1[o];
+        if (g >= 0 && tab[g] < 0) { tab[g] = 0; nlist++; }
+    }
+    int32_t *list = malloc(sizeof(int32_t) * (size_t)(nlist + 1));
+    if (list) {
+        nlist = 0;
+        for (int32_t g = 0; g < m1->nf; g++)
+            if (!tab[g]) { list[nlist++] = g; tab[g] = -1; }
+    }
+    if (!list || ccn__fvar_direct_build(&c->lev[1], p->threads, list, nlist, &c->dir1)) {
+        free(tab); free(list);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+    }
+    free(list);
     c->nd1 = 0;
     for (int32_t o = 0; o < mL->nv; o++) {
         int32_t g = c->d1[o];
@@ -439,7 +455,7 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     ccn_status st = ccn__fvar_build(p->lev[0], ch->indices, ch->linear, pinned, &c->lev[0], &c->value_of, err);
     if (st) return st;
-    if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], p->threads, &c->dir))
+    if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], p->threads, NULL, 0, &c->dir))
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     if (!c->bilinear && c->dir.count == c->lev[0].m->nf) { /* nothing to probe */
         c->numbered_only = 1;

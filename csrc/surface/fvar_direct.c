@@ -213,21 +213,59 @@ static int block(const ccn__fvar_level *fl, const uint8_t *kind, int32_t f, int3
     return 0;
 }
 
-typedef struct { const ccn__fvar_level *f0; uint8_t *kind; ccn__fvar_direct *d; } direct_job;
+typedef struct {
+    const ccn__fvar_level *f0; uint8_t *kind; ccn__fvar_direct *d; const int32_t *list;
+} direct_job;
 
 static void kind_range(void *ctx, int32_t b, int32_t e) {
     const direct_job *j = ctx;
-    for (int32_t v = b; v < e; v++) j->kind[v] = (uint8_t)value_kind(j->f0, v);
+    for (int32_t i = b; i < e; i++) {
+        int32_t v = j->list ? j->list[i] : i;
+        j->kind[v] = (uint8_t)value_kind(j->f0, v);
+    }
 }
 
 static void block_range(void *ctx, int32_t b, int32_t e) {
     const direct_job *j = ctx;
     ccn__fvar_direct *d = j->d;
-    for (int32_t f = b; f < e; f++)
+    for (int32_t i = b; i < e; i++) {
+        int32_t f = j->list ? j->list[i] : i;
         d->slot[f] = block(j->f0, j->kind, f, d->verts + 16 * (size_t)f, d->knots + 12 * (size_t)f, d->fold + f) ? -1 : f;
+    }
 }
 
-int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, ccn__fvar_direct *d) {
+/* The value vertices a listed face's block can reach: the corners of the faces around its
+ * corners (block() reads no other kind). Returns their list (malloc'd), NULL out of memory. */
+static int32_t *block_vertices(const ccn_mesh *m, const int32_t *faces, int32_t nfaces, int32_t *count) {
+    uint8_t *mark = calloc((size_t)m->nv + 1, 1);
+    int32_t n = 0, *list = NULL;
+    if (!mark) return NULL;
+    for (int32_t i = 0; i < nfaces; i++) {
+        int32_t f = faces[i];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) {
+            int32_t c = m->hvert[h];
+            for (int32_t q = m->vfan_start[c]; q < m->vfan_start[c + 1]; q++) {
+                int32_t g = m->hface[m->vfan[q]];
+                for (int32_t k = m->fstart[g]; k < m->fstart[g + 1]; k++) {
+                    int32_t w = m->hvert[k];
+                    n += !mark[w];
+                    mark[w] = 1;
+                }
+            }
+        }
+    }
+    if ((list = malloc(sizeof(int32_t) * (size_t)(n + 1)))) {
+        n = 0;
+        for (int32_t v = 0; v < m->nv; v++)
+            if (mark[v]) list[n++] = v;
+        *count = n;
+    }
+    free(mark);
+    return list;
+}
+
+int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, const int32_t *faces, int32_t nfaces,
+                           ccn__fvar_direct *d) {
     const ccn_mesh *m = f0->m;
     memset(d, 0, sizeof *d);
     uint8_t *kind = malloc((size_t)(m->nv ? m->nv : 1));
@@ -235,12 +273,19 @@ int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, ccn__fvar_dir
     d->verts = malloc(sizeof(int32_t) * 16 * (size_t)(m->nf ? m->nf : 1)); /* slot = face */
     d->knots = malloc(sizeof(double) * 12 * (size_t)(m->nf ? m->nf : 1));
     d->fold = malloc((size_t)(m->nf ? m->nf : 1));
-    if (!kind || !d->slot || !d->verts || !d->knots || !d->fold) { free(kind); ccn__fvar_direct_free(d); return -1; }
-    direct_job j = {f0, kind, d};
-    ccn__parallel_for(threads, m->nv, kind_range, &j);
-    ccn__parallel_for(threads, m->nf, block_range, &j);
+    int32_t nverts = m->nv, *verts = faces ? block_vertices(m, faces, nfaces, &nverts) : NULL;
+    if (!kind || !d->slot || !d->verts || !d->knots || !d->fold || (faces && !verts)) {
+        free(kind); free(verts); ccn__fvar_direct_free(d);
+        return -1;
+    }
+    direct_job j = {f0, kind, d, verts};
+    ccn__parallel_for(threads, nverts, kind_range, &j);
+    if (faces)
+        for (int32_t f = 0; f < m->nf; f++) d->slot[f] = -1;
+    j.list = faces;
+    ccn__parallel_for(threads, faces ? nfaces : m->nf, block_range, &j);
     for (int32_t f = 0; f < m->nf; f++) d->count += d->slot[f] >= 0;
-    free(kind);
+    free(kind); free(verts);
     return 0;
 }
 

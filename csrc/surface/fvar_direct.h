@@ -15,9 +15,11 @@ typedef struct {
     int32_t count;
 } ccn__fvar_direct;
 
-/* Classifies the faces of level 0 (see surface/fvar_direct.c) on up to `threads`. Returns 0,
- * or -1 out of memory. */
-int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, ccn__fvar_direct *d);
+/* Classifies the faces of a level (see surface/fvar_direct.c) on up to `threads`: every face,
+ * or only the nfaces listed (distinct; the others get slot -1). Returns 0, or -1 out of
+ * memory. */
+int ccn__fvar_direct_build(const ccn__fvar_level *f0, int threads, const int32_t *faces, int32_t nfaces,
+                           ccn__fvar_direct *d);
 void ccn__fvar_direct_free(ccn__fvar_direct *d);
 
 /* The basis functions of slot s's face at the grid points a / (side - 1), a = 0 .. side - 1, of
