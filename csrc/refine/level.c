@@ -177,58 +177,59 @@ static void one_vertex_point(const ccn__level *c, int32_t v, const double *fp, d
 
 /* ---- the rules' weights, tabulated (ccn__level.tf ...) ------------------------------- */
 
-/* Over all elements (list NULL) or the listed ones; each tabulated once (tmask). */
+/* One element's weights, each tabulated once (tmask). */
+static void tab_face(ccn__level *c, int32_t f) {
+    if (c->tmask[f]) return;
+    c->tmask[f] = 1;
+    if (ccn__fsize(c->m, f) == 4) ccn__quad_face_weights(c->m, f, c->pinned, c->tf + 2 * (size_t)f);
+}
+
+static void tab_edge(ccn__level *c, int32_t e) {
+    const ccn_mesh *m = c->m;
+    uint8_t *mask = c->tmask + m->nf;
+    if (mask[e]) return;
+    mask[e] = 1;
+    int32_t h = c->erep[e], t = m->htwin[h];
+    double *o = c->te + 3 * (size_t)e;
+    o[0] = ccn__curve_edge_weight(m, h, c->pinned);
+    o[1] = t < 0 ? 0.0 : ccn__transverse(m, h);
+    o[2] = t < 0 ? 0.0 : ccn__transverse(m, t);
+}
+
+static void tab_vertex(ccn__level *c, int32_t v, float ps[CREASE_STACK]) {
+    const ccn_mesh *m = c->m;
+    uint8_t *mask = c->tmask + m->nf + m->ne;
+    if (mask[v]) return;
+    mask[v] = 1;
+    if (m->vfan_start[v + 1] == m->vfan_start[v] || m->vboundary[v]) return;
+    if (c->tvs) { /* creased mesh: where creased_vertex_point takes the smooth rule */
+        int32_t n = ccn__valence(m, v);
+        if ((c->partner && c->partner[v] >= 0) || n > CREASE_STACK) return;
+        ccn__fan_sharpness(m, v, ps);
+        int rule = ccn__sharp_rule(ccn__vertex_sharpness(m, v, c->pinned), n, ps);
+        if (rule != CCN_RULE_SMOOTH && rule != CCN_RULE_DART) return;
+        c->tvs[v] = 1;
+    }
+    ccn__nurss_vertex_weights(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v);
+}
+
+/* Over all elements (list NULL) or the listed ones. */
 typedef struct { ccn__level *c; const int32_t *list; } tab_job;
 
 static void tab_face_range(void *ctx, int32_t b, int32_t e) {
     const tab_job *j = ctx;
-    ccn__level *c = j->c;
-    for (int32_t i = b; i < e; i++) {
-        int32_t f = j->list ? j->list[i] : i;
-        if (c->tmask[f]) continue;
-        c->tmask[f] = 1;
-        if (ccn__fsize(c->m, f) == 4) ccn__quad_face_weights(c->m, f, c->pinned, c->tf + 2 * (size_t)f);
-    }
+    for (int32_t i = b; i < e; i++) tab_face(j->c, j->list ? j->list[i] : i);
 }
 
 static void tab_edge_range(void *ctx, int32_t b, int32_t end) {
     const tab_job *j = ctx;
-    ccn__level *c = j->c;
-    const ccn_mesh *m = c->m;
-    uint8_t *mask = c->tmask + m->nf;
-    for (int32_t i = b; i < end; i++) {
-        int32_t e = j->list ? j->list[i] : i;
-        if (mask[e]) continue;
-        mask[e] = 1;
-        int32_t h = c->erep[e], t = m->htwin[h];
-        double *o = c->te + 3 * (size_t)e;
-        o[0] = ccn__curve_edge_weight(m, h, c->pinned);
-        o[1] = t < 0 ? 0.0 : ccn__transverse(m, h);
-        o[2] = t < 0 ? 0.0 : ccn__transverse(m, t);
-    }
+    for (int32_t i = b; i < end; i++) tab_edge(j->c, j->list ? j->list[i] : i);
 }
 
 static void tab_vertex_range(void *ctx, int32_t b, int32_t e) {
     const tab_job *j = ctx;
-    ccn__level *c = j->c;
-    const ccn_mesh *m = c->m;
-    uint8_t *mask = c->tmask + m->nf + m->ne;
     float ps[CREASE_STACK];
-    for (int32_t i = b; i < e; i++) {
-        int32_t v = j->list ? j->list[i] : i;
-        if (mask[v]) continue;
-        mask[v] = 1;
-        if (m->vfan_start[v + 1] == m->vfan_start[v] || m->vboundary[v]) continue;
-        if (c->tvs) { /* creased mesh: where creased_vertex_point takes the smooth rule */
-            int32_t n = ccn__valence(m, v);
-            if ((c->partner && c->partner[v] >= 0) || n > CREASE_STACK) continue;
-            ccn__fan_sharpness(m, v, ps);
-            int rule = ccn__sharp_rule(ccn__vertex_sharpness(m, v, c->pinned), n, ps);
-            if (rule != CCN_RULE_SMOOTH && rule != CCN_RULE_DART) continue;
-            c->tvs[v] = 1;
-        }
-        ccn__nurss_vertex_weights(m, v, c->th + 2 * (size_t)m->vfan_start[v], c->tv + 2 * (size_t)v);
-    }
+    for (int32_t i = b; i < e; i++) tab_vertex(j->c, j->list ? j->list[i] : i, ps);
 }
 
 /* The tables, allocated once per level (0: out of memory, no tables: the rules run). The face
@@ -277,6 +278,21 @@ static void tabulate_lists(ccn__level *c, const int32_t *faces, int32_t nfaces, 
     ccn__parallel_for(c->threads, nedges, tab_edge_range, &j);
     j.list = verts;
     ccn__parallel_for(c->threads, nverts, tab_vertex_range, &j);
+}
+
+/* The weights of the points ccn__level_points_subset computes around the listed vertices,
+ * once (the same list every call). */
+void ccn__level_tabulate_subset(ccn__level *c, const int32_t *verts, int32_t nverts) {
+    const ccn_mesh *m = c->m;
+    if (c->tab_sub || !tab_alloc(c)) return;
+    float ps[CREASE_STACK];
+    for (int32_t i = 0; i < nverts; i++) {
+        int32_t v = verts[i], n = ccn__valence(m, v);
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) tab_face(c, m->hface[m->vfan[k]]);
+        for (int32_t k = 0; k < n; k++) tab_edge(c, ccn__fan_edge(m, v, k));
+        tab_vertex(c, v, ps);
+    }
+    c->tab_sub = 1;
 }
 
 static void vertex_range(void *ctx, int32_t b, int32_t e) {

@@ -32,8 +32,9 @@ typedef struct {
      * by ccn__level_points_lists (they depend on topology and intervals only): quad face (s, t), edge (curve weight and
      * the two transverse intervals), interior vertex ((n-3)/n, 3/(n sum)) and its fan's
      * (m_i, f_i) at the fan's half-edge positions; on a creased mesh tvs[v] says which
-     * vertices' (smooth) rule is in tv / th. NULL: computed per call. */
-    int tab_tried, tab_full;
+     * vertices' (smooth) rule is in tv / th. NULL: computed per call. tab_sub: the elements
+     * of ccn__level_points_subset's list, by ccn__level_tabulate_subset. */
+    int tab_tried, tab_full, tab_sub;
     double *tf, *te, *tv, *th;
     uint8_t *tvs, *tmask; /* tmask: faces, edges, vertices tabulated (lists: a part) */
 } ccn__level;
@@ -45,9 +46,11 @@ ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, i
                                  ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
 void ccn__level_points(ccn__level *c, double *out);
-/* Next-level points around the listed vertices only (see refine/level.c). */
+/* Next-level points around the listed vertices only (see refine/level.c); with the tables of
+ * ccn__level_tabulate_subset (made once, for the same list) where it ran. */
 void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
                               double *out);
+void ccn__level_tabulate_subset(ccn__level *c, const int32_t *verts, int32_t nverts);
 /* The next-level points of the listed faces, edges and vertices only (each once; every EV's
  * red points too). A point is right when the old points its rule reads are. */
 void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces,

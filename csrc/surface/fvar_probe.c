@@ -283,7 +283,10 @@ static void probe(const builder *c, const probe_set *w, int threads, const int32
         if (q) ccn__level_points_lists(&w->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, w->pos[l + 1]);
         else ccn__level_points(&w->prep[l], w->pos[l + 1]);
     }
-    if (c->has_sub) ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
+    if (c->has_sub) {
+        ccn__level_tabulate_subset(w->sub, c->near, c->nnear); /* the first pass, before the copies */
+        ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
+    }
     limit_job j = {c, w->pos[c->L], w->posS, c->L >= 1 ? w->pos[1] : NULL, cd, c->outs, cw, b};
     ccn__parallel_for(threads, c->nouts, limit_range, &j);
 }

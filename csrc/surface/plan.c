@@ -296,7 +296,10 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     ccn__normalize(p->lev[0], centre, &scale);
     p->scale = scale;
     for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
-    if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
+    if (p->has_sub) {
+        ccn__level_tabulate_subset(&p->sub, p->near, p->nnear);
+        ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
+    }
     eval_stencils(p, out);
     if (out->normals && p->nsec) eval_sectors(p, out);
     ccn_status st = ccn__caps_evaluate(p, out, err);

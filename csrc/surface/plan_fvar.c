@@ -269,7 +269,10 @@ ccn_status ccn_plan_evaluate_vertex_data(ccn_plan *p, int32_t width, const doubl
             for (int k = 0; k < 3; k++)
                 m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * data[(size_t)width * v + c0 + k] : 0.0;
         for (int32_t l = 0; l < top; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
-        if (p->has_sub) ccn__level_points_subset(&p->sub, p->near, p->nnear, PS);
+        if (p->has_sub) {
+            ccn__level_tabulate_subset(&p->sub, p->near, p->nnear);
+            ccn__level_points_subset(&p->sub, p->near, p->nnear, PS);
+        }
         apply_job j = {p, mL->pos, PS, mL->nv, out, width, c0, up};
         ccn__parallel_for(p->threads, p->nout_v, apply_range, &j);
     }
