@@ -314,20 +314,3 @@ def has_evaluated_geometry():
     references, read per object instead of walking `depsgraph.object_instances`."""
     return hasattr(bpy.types.Object, "evaluated_geometry")
 
-
-def temp_override(context, **kw):
-    """Context override: `context.temp_override` (3.2+ and 4.x)."""
-    return context.temp_override(**kw)
-
-
-def move_modifier_first(obj, mod, context=None):
-    """`ObjectModifiers.move` (3.5+/4.x) vs the operator with a context override (3.4)."""
-    idx = list(obj.modifiers).index(mod)
-    if idx == 0:
-        return
-    if hasattr(obj.modifiers, "move"):
-        obj.modifiers.move(idx, 0)
-        return
-    ctx = context or bpy.context
-    with ctx.temp_override(object=obj, active_object=obj):
-        bpy.ops.object.modifier_move_to_index(modifier=mod.name, index=0)

@@ -250,7 +250,7 @@ def new_group_and_proxies(obj):
     return build_group(obj.name_full, view, render)
 
 
-def ensure(obj, context=None, fresh=False):
+def ensure(obj, fresh=False):
     """Creates or repairs the modifier, its node group and the two proxies of a cage. fresh=True
     replaces a group that another object owns (a duplicate or a copied modifier)."""
     s = obj.ccnurbs
@@ -268,11 +268,9 @@ def ensure(obj, context=None, fresh=False):
         mod.show_in_editmode = True
     if mod.node_group != group:
         mod.node_group = group  # before anything that may run the handlers (and hygiene)
-    if created:
-        try:
-            compat.move_modifier_first(obj, mod, context)
-        except (RuntimeError, TypeError):
-            pass  # stays last: still correct when no modifier before it changes geometry
+    # a new CCNURBS goes where Blender puts any new modifier, last (before a modifier pinned
+    # last, 4.2+), so that Mirror, Armature, shape keys... already on the object are above it
+    # and count, as with Subdivision Surface
     return mod
 
 

@@ -23,7 +23,7 @@ class OBJECT_OT_ccnurbs_add(bpy.types.Operator):
         msgs, level = [], 'INFO'
         existed = {o.name_full: modifier.is_cage(o) for o in objs}
         for obj in objs:
-            modifier.ensure(obj, context)
+            modifier.ensure(obj)
         handlers.sync_cages(context.evaluated_depsgraph_get(), objs, 'VIEW')  # no-op if done
         for obj in objs:
             st = sync.status(obj, 'VIEW') or sync.Status('VIEW', error="no input evaluated")

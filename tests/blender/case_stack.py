@@ -105,6 +105,32 @@ class TestStackAbove(AddonTestCase):
         self.assertGreater(np.abs(evaluated_positions(uniform) - P).max(), 1e-3,
                            "intervals had no effect: the test would not see them lost")
 
+    def test_add_goes_below_the_existing_stack(self):
+        """Add CCNURBS on an object that already has Mirror (the half-modelling set-up) puts it
+        last, as Blender puts any new modifier (Subsurf too): the existing Mirror is above it,
+        counts, and the limit is the smooth surface across the seam, not a mirrored limit. On
+        4.2+ a modifier pinned last stays last."""
+        ob = half_grid("AddBelow")
+        mirror = ob.modifiers.new("Mirror", 'MIRROR')
+        mirror.use_clip = mirror.use_mirror_merge = True
+        pinned = None
+        if hasattr(mirror, "use_pin_to_last"):
+            pinned = ob.modifiers.new("WeightedNormal", 'WEIGHTED_NORMAL')
+            pinned.use_pin_to_last = True
+        add_modifier(ob, levels=2)
+        names = [m.name for m in ob.modifiers]
+        ccn_name = ccn.modifier.get_modifier(ob).name
+        self.assertEqual(names.index("Mirror"), 0, names)
+        self.assertEqual(names.index(ccn_name), 1, names)
+        if pinned is not None:
+            self.assertEqual(names[-1], "WeightedNormal", names)
+            pinned.show_viewport = False  # the comparison below is of the limit itself
+        P = evaluated_positions(ob)
+        self.assertLess(P[:, 0].min(), -2.5, "the mirrored half is missing")
+        R = cli_of_stack(ob)
+        self.assertEqual(P.shape, R.shape, "not the limit of the mirrored cage")
+        self.assertLessEqual(np.abs(P - R).max(), POS_TOL, "differs from `ccnurbs limit` of the stack")
+
     def test_other_modifiers_above(self):
         ob = add_modifier(half_grid("Stack"), levels=1)
         lat = bpy.data.objects.new("Lattice", bpy.data.lattices.new("Lattice"))
