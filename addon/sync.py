@@ -20,7 +20,7 @@ evaluation (measured in README "Design notes").
 import time
 import traceback
 
-from . import attrs, modifier, native, proxies
+from . import attrs, memory, modifier, native, proxies
 from . import cage as cagemod
 
 # Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
@@ -97,6 +97,10 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
     if cached is not None:
         cached[1].close()
         del _plans[key_name]
+    why = memory.refusal(cage.face_sizes, levels,
+                         "Levels Viewport" if key_name[1] == 'VIEW' else "Render levels")
+    if why:  # before anything is allocated (memory.py)
+        raise native.CCNError("CCN_ERR_MEMORY", why)
     sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
     vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
     plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,

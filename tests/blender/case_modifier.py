@@ -380,6 +380,41 @@ class TestModifier(AddonTestCase):
         np.testing.assert_array_equal(evaluated_positions(ob2),
                                       cagelib.mesh_positions(ob2.data))
 
+    def test_levels_that_do_not_fit_are_refused(self):
+        """A Levels value whose limit mesh would not fit in the free memory is refused before
+        anything is allocated (addon/memory.py), the last limit stays, nothing crashes."""
+        bpy.ops.mesh.primitive_monkey_add()
+        ob = add_modifier(bpy.context.object, levels=1)
+        sizes = np.array([p.loop_total for p in ob.data.polygons])
+        for L in (1, 2):  # the estimate counts the faces the plan makes
+            ob.ccnurbs.levels = L
+            update()
+            self.assertEqual(ccn.memory.limit_faces(sizes, L), ccn.sync.status(ob).num_faces)
+        good = evaluated_positions(ob)
+        ob.ccnurbs.levels = 10  # 500 million faces, ~800 GB: refused on any machine
+        P = evaluated_positions(ob)
+        st = ccn.sync.status(ob)
+        self.assertIn("levels 10 would make 515.9 million faces, about 768.8 GB, but ", st.error or "")
+        self.assertIn("of memory is free: lower Levels Viewport", st.error)
+        self.assertEqual(st.showing, "last valid limit")
+        np.testing.assert_array_equal(P, good)  # the last limit stays
+        self.assertIn("lower the levels", ccn.errors.advice(st.error))
+        # with 50 MB free, levels 3 (32k faces, ~51 MB) is refused, and built once it fits
+        free = ccn.memory.free_bytes
+        try:
+            ccn.memory.free_bytes = lambda: 50 * 2 ** 20
+            ob.ccnurbs.levels = 3
+            update()
+            self.assertIn("of memory is free", ccn.sync.status(ob).error or "")
+            ccn.memory.free_bytes = lambda: 100 * 2 ** 20
+            ob.ccnurbs.levels = 2
+            ob.ccnurbs.levels = 3
+            update()
+            self.assertIsNone(ccn.sync.status(ob).error)
+        finally:
+            ccn.memory.free_bytes = free
+        self.assertGreater(len(evaluated_positions(ob)), len(good))
+
     def test_duplicate_gets_own_proxies(self):
         ob = add_modifier(grid(2, "Orig"))
         before = evaluated_positions(ob)
