@@ -6,7 +6,9 @@
  * creasemethod, facevaryinginterpolateboundary; other tags are skipped with a warning).
  * A `# crease`/`# corner` comment whose next word is not an integer is prose (OpenSubdiv's
  * shapes say "#  crease tags for perimeter:") and is skipped. Other statements are skipped.
- * Never reads past `len`; any malformed number is a CCN_ERR_IO naming the line. */
+ * A backslash at the end of a line continues the statement on the next (errors name the
+ * statement's first line). Never reads past `len`; any malformed number is a CCN_ERR_IO naming
+ * the line. */
 #include "ccnurbs.h"
 
 #include "base/error.h"
@@ -55,15 +57,31 @@ static int grow(void **p, int32_t *cap, int32_t need, size_t elem) {
 
 typedef struct { const char *s, *end; } cursor;
 
+/* A backslash ending a physical line continues the statement on the next one (the OBJ
+ * format's line continuation): the backslash, its '\r' and '\n' count as white space. */
+static int continuation(const cursor *c) {
+    const char *p = c->s;
+    if (p >= c->end || *p != '\\') return 0;
+    p++;
+    if (p < c->end && *p == '\r') p++;
+    return p < c->end && *p == '\n' ? (int)(p + 1 - c->s) : 0;
+}
+
 static void skip_ws(cursor *c) {
-    while (c->s < c->end && (*c->s == ' ' || *c->s == '\t' || *c->s == '\r')) c->s++;
+    for (;;) {
+        int k;
+        if (c->s < c->end && (*c->s == ' ' || *c->s == '\t' || *c->s == '\r')) c->s++;
+        else if ((k = continuation(c)) > 0) c->s += k;
+        else return;
+    }
 }
 
 /* Copies the next token (up to 63 chars) into buf; returns its length (0 at end of line). */
 static int token(cursor *c, char *buf) {
     skip_ws(c);
     int n = 0;
-    while (c->s < c->end && *c->s != ' ' && *c->s != '\t' && *c->s != '\r' && *c->s != '\n') {
+    while (c->s < c->end && *c->s != ' ' && *c->s != '\t' && *c->s != '\r' && *c->s != '\n' &&
+           !continuation(c)) {
         if (n < 63) buf[n] = *c->s;
         n++;
         c->s++;
@@ -357,11 +375,20 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
     long line = 0;
     while (s < end) {
         const char *nl = memchr(s, '\n', (size_t)(end - s));
+        long more = 0; /* physical lines joined by continuations */
+        for (;;) {
+            const char *b = nl;
+            if (b && b > s && b[-1] == '\r') b--;
+            if (!b || b == s || b[-1] != '\\') break;
+            more++;
+            nl = memchr(nl + 1, '\n', (size_t)(end - nl - 1));
+        }
         const char *le = nl ? nl : end;
         cursor c = {s, le};
         line++;
         ccn_status st = parse_line(o, &c, line, err);
         if (st) { ccn_obj_destroy(o); return st; }
+        line += more;
         s = nl ? nl + 1 : end;
     }
     if (o->nvc > 0) { /* vertex sharpness for every vertex (0 where no corner was given) */

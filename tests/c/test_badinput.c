@@ -548,6 +548,26 @@ static void row_garbage_obj(void) {
     ccn_obj_destroy(o);
 }
 
+/* The OBJ format's line continuation: a backslash ending a line (LF or CRLF) joins the next,
+ * also between a number and the backslash; errors after it count the physical lines. */
+static void row_obj_continuation(void) {
+    const char *t = "v 0 0 0\nv 1 0 \\\n0\nv 1 1 0\r\nv 0 1 0\nf 1 2\\\r\n 3 \\\n4\n";
+    ccn_obj *o = NULL;
+    ccn_error err;
+    CHECK(ccn_obj_parse(t, strlen(t), &o, &err) == CCN_OK, "%s", err.message);
+    if (o) {
+        ccn_cage c;
+        ccn_obj_cage(o, &c);
+        CHECK(c.num_verts == 4 && c.num_faces == 1 && c.face_sizes[0] == 4,
+              "continued lines: %d verts, %d faces", (int)c.num_verts, (int)c.num_faces);
+        CHECK(c.num_faces == 1 && c.face_verts[3] == 3 && c.positions[3] == 1.0 && c.positions[5] == 0.0,
+              "continued values misread");
+        ccn_obj_destroy(o);
+    }
+    expect_obj_err("v 0 0 \\\n0\n\nv 1 x 0\n", CCN_ERR_IO, 4, "OBJ line 4: vertex needs three numbers");
+    expect_obj_err("v 0 0 0\nf 1 \\\n x\n", CCN_ERR_IO, 2, "OBJ line 2: bad face index");
+}
+
 /* Out-of-range indices and inconsistent orientation, for completeness of the table. */
 static void row_index_out_of_range(void) {
     int32_t fv[4] = {0, 1, 2, 9};
@@ -558,6 +578,7 @@ static void row_index_out_of_range(void) {
 
 int main(void) {
     RUN(row_nan_coordinate);
+    RUN(row_obj_continuation);
     RUN(row_inf_coordinate);
     RUN(row_interval_negative);
     RUN(row_interval_zero);
