@@ -508,22 +508,25 @@ static void row_two_million_faces(void) {
     soup_free(&s);
 }
 
+/* The parsed text (which must parse) and its cage view; NULL if it did not parse. */
+static ccn_obj *parsed_cage(const char *text, ccn_cage *c) {
+    ccn_obj *o = NULL;
+    ccn_error err;
+    CHECK(ccn_obj_parse(text, strlen(text), &o, &err) == CCN_OK, "%s", err.message);
+    if (o) ccn_obj_cage(o, c);
+    return o;
+}
+
 static void row_truncated_obj(void) {
     expect_obj_err("v 0 0 0\nv 1 0", CCN_ERR_IO, 2, "OBJ line 2: vertex needs three numbers");
     expect_obj_err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 /", CCN_ERR_IO, 5,
                    "OBJ line 5: bad face index");
     expect_obj_err("v 0 0 0\n# knot 1 2", CCN_ERR_IO, 2, "expected '# knot i j d'");
     /* a file cut after a complete line parses; then the cage is judged (a 2-gon here) */
-    const char *t = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2";
-    ccn_obj *o = NULL;
-    ccn_error err;
-    CHECK(ccn_obj_parse(t, strlen(t), &o, &err) == CCN_OK, "%s", err.message);
-    if (o) {
-        ccn_cage c;
-        ccn_obj_cage(o, &c);
-        expect_err(&c, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, 0, "face 0 has 2 vertices");
-        ccn_obj_destroy(o);
-    }
+    ccn_cage c;
+    ccn_obj *o = parsed_cage("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2", &c);
+    if (o) expect_err(&c, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, 0, "face 0 has 2 vertices");
+    ccn_obj_destroy(o);
 }
 
 static void row_garbage_obj(void) {
@@ -551,19 +554,15 @@ static void row_garbage_obj(void) {
 /* The OBJ format's line continuation: a backslash ending a line (LF or CRLF) joins the next,
  * also between a number and the backslash; errors after it count the physical lines. */
 static void row_obj_continuation(void) {
-    const char *t = "v 0 0 0\nv 1 0 \\\n0\nv 1 1 0\r\nv 0 1 0\nf 1 2\\\r\n 3 \\\n4\n";
-    ccn_obj *o = NULL;
-    ccn_error err;
-    CHECK(ccn_obj_parse(t, strlen(t), &o, &err) == CCN_OK, "%s", err.message);
+    ccn_cage c;
+    ccn_obj *o = parsed_cage("v 0 0 0\nv 1 0 \\\n0\nv 1 1 0\r\nv 0 1 0\nf 1 2\\\r\n 3 \\\n4\n", &c);
     if (o) {
-        ccn_cage c;
-        ccn_obj_cage(o, &c);
         CHECK(c.num_verts == 4 && c.num_faces == 1 && c.face_sizes[0] == 4,
               "continued lines: %d verts, %d faces", (int)c.num_verts, (int)c.num_faces);
         CHECK(c.num_faces == 1 && c.face_verts[3] == 3 && c.positions[3] == 1.0 && c.positions[5] == 0.0,
               "continued values misread");
-        ccn_obj_destroy(o);
     }
+    ccn_obj_destroy(o);
     expect_obj_err("v 0 0 \\\n0\n\nv 1 x 0\n", CCN_ERR_IO, 4, "OBJ line 4: vertex needs three numbers");
     expect_obj_err("v 0 0 0\nf 1 \\\n x\n", CCN_ERR_IO, 2, "OBJ line 2: bad face index");
 }
