@@ -81,6 +81,23 @@ def stack_keeps_topology(obj):
     return True
 
 
+SUBDIVIDED_NOTE = ("\"%s\" above CCNURBS subdivides the cage first: this is the limit of the "
+                   "subdivided cage (remove or disable it for the cage's own limit)")
+
+
+def subdivisions_above(obj):
+    """Names of the enabled Subdivision Surface / Multiresolution modifiers above CCNURBS: they
+    subdivide the cage before CCNURBS sees it (an object that had Subsurf when CCNURBS was
+    added), which the panel and the Add operator point out."""
+    ours, names = get_modifier(obj), []
+    for m in obj.modifiers:
+        if m == ours:
+            break
+        if m.show_viewport and m.type in ('SUBSURF', 'MULTIRES'):
+            names.append(m.name)
+    return names
+
+
 def is_cage(obj):
     return (obj is not None and obj.type == 'MESH' and obj.ccnurbs.role == 'CAGE'
             and get_modifier(obj) is not None)

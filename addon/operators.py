@@ -35,6 +35,9 @@ class OBJECT_OT_ccnurbs_add(bpy.types.Operator):
                             % (obj.name, "updated" if existed[obj.name_full] else "added",
                                st.num_verts,
                                st.num_faces, obj.ccnurbs.levels))
+            for name in modifier.subdivisions_above(obj):
+                level = 'WARNING'
+                msgs.append("%s: %s" % (obj.name, modifier.SUBDIVIDED_NOTE % name))
         self.report({level}, "CCNURBS " + "; ".join(msgs))
         return {'FINISHED'}
 

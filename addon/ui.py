@@ -89,6 +89,8 @@ def _draw_status(layout, obj):
             notes.append("%d cap fallbacks (exact limit there: too close to another"
                          " extraordinary point or a boundary, valence > 32, or spoke"
                          " interval ratios beyond about 1:5)" % z["num_cap_fallbacks"])
+        for name in modifier.subdivisions_above(obj):
+            notes.append(modifier.SUBDIVIDED_NOTE % name)
         if z.get("num_ignored_verts") or z.get("num_ignored_edges"):
             notes.append("ignored: %d loose verts, %d loose edges"
                          % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))

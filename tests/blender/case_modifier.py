@@ -415,6 +415,25 @@ class TestModifier(AddonTestCase):
             ccn.memory.free_bytes = free
         self.assertGreater(len(evaluated_positions(ob)), len(good))
 
+    def test_subsurf_above_is_pointed_out(self):
+        """CCNURBS added to an object that has Subdivision Surface goes after it (as any new
+        modifier), so it takes the subdivided cage: the panel says so, and stops saying it
+        once Subsurf is disabled."""
+        ob = grid(2, "HadSubsurf")
+        sub = ob.modifiers.new("My Subsurf", 'SUBSURF')
+        sub.levels = 1
+        add_modifier(ob, levels=1)
+        self.assertEqual(ccn.modifier.subdivisions_above(ob), ["My Subsurf"])
+        bpy.context.view_layer.objects.active = ob
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertIn('"My Subsurf" above CCNURBS subdivides the cage first', shown)
+        self.assertEqual(ccn.sync.status(ob).sizes["num_cage_verts"], 25, "not the subdivided cage")
+        sub.show_viewport = False
+        update()
+        self.assertEqual(ccn.modifier.subdivisions_above(ob), [])
+        self.assertNotIn("subdivides the cage first", labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)))
+        self.assertMatchesCLI(ob)
+
     def test_duplicate_gets_own_proxies(self):
         ob = add_modifier(grid(2, "Orig"))
         before = evaluated_positions(ob)
