@@ -31,6 +31,9 @@ _ADVICE = (
                 "can meet at a vertex."),
     ("sides; the limit surface", "Split this face (Knife, or Poke Faces)."),
     ("cage has no faces", "Add faces: only faces are subdivided."),
+    ("the add-on cannot write the limit surface into linked data",
+     "Append the object instead of linking it (File > Append), or make it local (Object > "
+     "Relations > Make Local)."),
     ("of memory is free", "Each level needs four times the memory of the one below: lower the "
                           "levels, or close programs that hold memory."),
     ("out of memory", "Lower the levels: the limit mesh did not fit in memory."),

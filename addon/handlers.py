@@ -78,6 +78,9 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
     proxies with deferred exact normals where defer_normals(), unless defer=False). Returns the
     number of proxies written."""
     defer = kind == 'VIEW' and (defer_normals() if defer is None else defer)
+    for o in objs:
+        if o.library is not None and modifier.is_cage(o) and sync.status(o, kind) is None:
+            sync.linked_cage(o, kind)
     objs = [o for o in objs if modifier.is_cage(o) and o.library is None and _shown(o, depsgraph)]
     taps = tap.read(depsgraph, objs)
     written = 0

@@ -20,6 +20,8 @@ evaluation (measured in README "Design notes").
 import time
 import traceback
 
+import bpy
+
 from . import attrs, memory, modifier, native, proxies
 from . import cage as cagemod
 
@@ -222,6 +224,18 @@ def missing_tap(obj, kind):
     p = modifier.proxy(obj, kind)
     st.showing = "last valid limit" if p is not None and p.data and len(p.data.vertices) \
         else "cage"
+    _status[(obj.name_full, kind)] = st
+    return st
+
+
+def linked_cage(obj, kind):
+    """A cage linked from a library file: its proxies are that file's, read-only here, so the
+    add-on cannot write its limit and the object shows its cage (or, in renders, the render
+    mesh the library stored). Said in the panel instead of silently."""
+    lib = obj.library.filepath if obj.library is not None else ""
+    st = Status(kind, error="linked from %s: the add-on cannot write the limit surface into "
+                "linked data, so the cage is shown" % (bpy.path.basename(lib) or "a library"))
+    st.showing = "cage"
     _status[(obj.name_full, kind)] = st
     return st
 

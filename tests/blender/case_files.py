@@ -192,6 +192,37 @@ class TestFileHygiene(AddonTestCase):
         self.assertOwnSurface(ob)
         self.assertClean(save("hyg_append_dst"), "append")
 
+    def test_linked_cage_says_it_shows_the_cage(self):
+        """A cage linked (not appended) from a library file cannot get its limit written (its
+        proxies are the library's, read-only): it shows its cage and the panel says so, with
+        what to do, instead of nothing."""
+        ob = add_modifier(grid(3, "Linked"))
+        self.assertGreater(len(evaluated_positions(ob)), len(ob.data.vertices))
+        save("hyg_link_src")
+        src = os.path.join(TMP, "hyg_link_lib.blend")
+        shutil.copyfile(os.path.join(TMP, "hyg_link_src.blend"), src)
+        reset_scene()
+        with bpy.data.libraries.load(src, link=True) as (data_from, data_to):
+            data_to.objects = ["Linked"]
+        lo = data_to.objects[0]
+        bpy.context.scene.collection.objects.link(lo)
+        update()
+        self.assertIsNotNone(lo.library)
+        st = ccn.sync.status(lo)
+        self.assertIsNotNone(st, "a linked cage gets no status")
+        self.assertIn("linked from hyg_link_lib.blend: the add-on cannot write", st.error or "")
+        self.assertEqual(st.showing, "cage")
+        self.assertEqual(len(evaluated_positions(lo)), len(lo.data.vertices))
+        self.assertIn("Append the object", ccn.errors.advice(st.error))
+        bpy.context.view_layer.objects.active = lo
+        self.assertIn("the add-on cannot write the limit surface",
+                      labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)))
+        local = lo.make_local()  # what the advice says: the surface appears
+        update()
+        self.assertIsNone(local.library)
+        self.assertIsNone(ccn.sync.status(local).error)
+        self.assertOwnSurface(local)
+
     def test_undo_leaves_nothing_stale(self):
         ob = grid(3, "Undo")
         bpy.ops.ed.undo_push(message="start")
