@@ -51,6 +51,21 @@ def select_only(*objs):
     bpy.context.view_layer.objects.active = objs[0]
 
 
+
+def from_library(stem, name, link):
+    """Saves the scene as library STEM_lib.blend, starts a new file and appends or links
+    object NAME from it into the scene; returns that object (evaluated once)."""
+    save(stem + "_src")
+    src = os.path.join(TMP, stem + "_lib.blend")
+    shutil.copyfile(os.path.join(TMP, stem + "_src.blend"), src)
+    reset_scene()
+    with bpy.data.libraries.load(src, link=link) as (data_from, data_to):
+        data_to.objects = [name]
+    ob = data_to.objects[0]
+    bpy.context.scene.collection.objects.link(ob)
+    update()
+    return ob
+
 class TestFileHygiene(AddonTestCase):
     def assertClean(self, path, msg=""):
         got, want = file_ids(path), expected_ids(bpy.context.scene)
@@ -178,16 +193,8 @@ class TestFileHygiene(AddonTestCase):
                 self.assertClean(save("hyg_" + how), how)
 
     def test_append_into_new_file(self):
-        ob = add_modifier(grid(3, "Appended"))
-        save("hyg_append_src")
-        src = os.path.join(TMP, "hyg_append_lib.blend")
-        shutil.copyfile(os.path.join(TMP, "hyg_append_src.blend"), src)
-        reset_scene()
-        with bpy.data.libraries.load(src, link=False) as (data_from, data_to):
-            data_to.objects = ["Appended"]
-        for o in data_to.objects:
-            bpy.context.scene.collection.objects.link(o)
-        update()
+        add_modifier(grid(3, "Appended"))
+        from_library("hyg_append", "Appended", link=False)
         ob = bpy.data.objects["Appended"]
         self.assertOwnSurface(ob)
         self.assertClean(save("hyg_append_dst"), "append")
@@ -198,15 +205,7 @@ class TestFileHygiene(AddonTestCase):
         what to do, instead of nothing."""
         ob = add_modifier(grid(3, "Linked"))
         self.assertGreater(len(evaluated_positions(ob)), len(ob.data.vertices))
-        save("hyg_link_src")
-        src = os.path.join(TMP, "hyg_link_lib.blend")
-        shutil.copyfile(os.path.join(TMP, "hyg_link_src.blend"), src)
-        reset_scene()
-        with bpy.data.libraries.load(src, link=True) as (data_from, data_to):
-            data_to.objects = ["Linked"]
-        lo = data_to.objects[0]
-        bpy.context.scene.collection.objects.link(lo)
-        update()
+        lo = from_library("hyg_link", "Linked", link=True)
         self.assertIsNotNone(lo.library)
         st = ccn.sync.status(lo)
         self.assertIsNotNone(st, "a linked cage gets no status")
