@@ -98,6 +98,35 @@ def subdivisions_above(obj):
     return names
 
 
+VGROUP_NOTE = ("\"%s\" below CCNURBS uses %s, but the limit mesh carries no vertex groups: "
+               "move it above CCNURBS")
+
+
+def vertex_groups_below(obj):
+    """(modifier name, what it uses) for the enabled modifiers below CCNURBS that need vertex
+    groups, which the limit mesh does not carry (README): a vertex-group property that names
+    one, an Armature deforming by groups, Cloth / Soft Body pinning."""
+    ours, found, below = get_modifier(obj), [], False
+    for m in obj.modifiers:
+        if m == ours:
+            below = True
+            continue
+        if not below or not m.show_viewport:
+            continue
+        names = [getattr(m, p.identifier) for p in m.bl_rna.properties
+                 if p.type == 'STRING' and "vertex_group" in p.identifier
+                 and getattr(m, p.identifier, "")]
+        settings = getattr(m, "settings", None)
+        for prop in ("vertex_group_mass", "vertex_group_goal"):
+            if settings is not None and getattr(settings, prop, ""):
+                names.append(getattr(settings, prop))
+        if names:
+            found.append((m.name, "vertex group " + ", ".join('"%s"' % n for n in names)))
+        elif m.type == 'ARMATURE' and m.use_vertex_groups:
+            found.append((m.name, "the vertex groups of its bones"))
+    return found
+
+
 def is_cage(obj):
     return (obj is not None and obj.type == 'MESH' and obj.ccnurbs.role == 'CAGE'
             and get_modifier(obj) is not None)

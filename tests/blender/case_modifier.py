@@ -434,6 +434,29 @@ class TestModifier(AddonTestCase):
         self.assertNotIn("subdivides the cage first", labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)))
         self.assertMatchesCLI(ob)
 
+    def test_vertex_groups_below_are_pointed_out(self):
+        """The limit mesh carries no vertex groups (README): a modifier below CCNURBS that
+        needs one is named in the panel, with what to do; above CCNURBS it is fine."""
+        ob = grid(2, "Groups")
+        ob.vertex_groups.new(name="pin").add([0, 1], 1.0, 'REPLACE')
+        add_modifier(ob, levels=1)
+        disp = ob.modifiers.new("Disp", 'DISPLACE')
+        update()
+        self.assertEqual(ccn.modifier.vertex_groups_below(ob), [])  # no group named
+        disp.vertex_group = "pin"
+        arm = ob.modifiers.new("Rig", 'ARMATURE')
+        update()
+        self.assertEqual(ccn.modifier.vertex_groups_below(ob),
+                         [("Disp", 'vertex group "pin"'), ("Rig", "the vertex groups of its bones")])
+        bpy.context.view_layer.objects.active = ob
+        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
+        self.assertIn('"Disp" below CCNURBS uses vertex group "pin", but the limit mesh carries no '
+                      'vertex groups: move it above CCNURBS', " ".join(shown.split()))
+        arm.show_viewport = False
+        with bpy.context.temp_override(object=ob, active_object=ob):
+            bpy.ops.object.modifier_move_to_index(modifier="Disp", index=0)
+        self.assertEqual(ccn.modifier.vertex_groups_below(ob), [])
+
     def test_duplicate_gets_own_proxies(self):
         ob = add_modifier(grid(2, "Orig"))
         before = evaluated_positions(ob)
