@@ -45,6 +45,8 @@ GROUP_TAG = "ccnurbs_group"
 OWNER_PROP = "ccnurbs_owner"
 TAP_ATTR = "ccn_co"
 VIEW_NODE, RENDER_NODE = "Viewport Proxy", "Render Proxy"
+FALLBACK_NODE, PROXY_SWITCH = "Limit or Cage", "Proxy"
+VG_NODE, VG_PREFIX, VG_PROP = "VG ", "ccn_vg_", "ccnurbs_vertex_groups"  # set_vertex_groups
 PROXY_PREFIX = {'VIEW_PROXY': ".CCNURBS view ", 'RENDER_PROXY': ".CCNURBS render "}
 
 
@@ -98,33 +100,44 @@ def subdivisions_above(obj):
     return names
 
 
-VGROUP_NOTE = ("\"%s\" below CCNURBS uses %s, but the limit mesh carries no vertex groups: "
-               "move it above CCNURBS")
+VGROUP_NOTE = ("\"%s\" below CCNURBS deforms by the vertex groups of its bones, which the limit "
+               "mesh does not carry: move it above CCNURBS")
 
 
-def vertex_groups_below(obj):
-    """(modifier name, what it uses) for the enabled modifiers below CCNURBS that need vertex
-    groups, which the limit mesh does not carry (README): a vertex-group property that names
-    one, an Armature deforming by groups, Cloth / Soft Body pinning."""
-    ours, found, below = get_modifier(obj), [], False
+def _vertex_group_settings(m):
+    """The vertex-group names a modifier's settings give (its STRING properties named
+    *vertex_group*, Cloth's and Soft Body's pin groups), empty ones left out."""
+    names = [getattr(m, p.identifier) for p in m.bl_rna.properties
+             if p.type == 'STRING' and "vertex_group" in p.identifier and getattr(m, p.identifier, "")]
+    settings = getattr(m, "settings", None)
+    for prop in ("vertex_group_mass", "vertex_group_goal"):
+        if settings is not None and getattr(settings, prop, ""):
+            names.append(getattr(settings, prop))
+    return names
+
+
+def _below(obj):
+    """The enabled modifiers below CCNURBS."""
+    ours, below, found = get_modifier(obj), False, []
     for m in obj.modifiers:
         if m == ours:
             below = True
-            continue
-        if not below or not m.show_viewport:
-            continue
-        names = [getattr(m, p.identifier) for p in m.bl_rna.properties
-                 if p.type == 'STRING' and "vertex_group" in p.identifier
-                 and getattr(m, p.identifier, "")]
-        settings = getattr(m, "settings", None)
-        for prop in ("vertex_group_mass", "vertex_group_goal"):
-            if settings is not None and getattr(settings, prop, ""):
-                names.append(getattr(settings, prop))
-        if names:
-            found.append((m.name, "vertex group " + ", ".join('"%s"' % n for n in names)))
-        elif m.type == 'ARMATURE' and m.use_vertex_groups:
-            found.append((m.name, "the vertex groups of its bones"))
+        elif below and m.show_viewport:
+            found.append(m)
     return found
+
+
+def groups_needed_below(obj):
+    """Names of the object's vertex groups that modifiers below CCNURBS name in their settings:
+    the limit mesh carries these (set_vertex_groups)."""
+    names = {n for m in _below(obj) for n in _vertex_group_settings(m) if n in obj.vertex_groups}
+    return sorted(names)
+
+
+def vertex_groups_below(obj):
+    """Names of the Armature modifiers below CCNURBS that deform by vertex groups: the bone
+    groups are not carried to the limit mesh (only groups named in settings are)."""
+    return [m.name for m in _below(obj) if m.type == 'ARMATURE' and m.use_vertex_groups]
 
 
 def is_cage(obj):
@@ -217,6 +230,7 @@ def build_group(owner_name, view, render):
     gout = nodes.new('NodeGroupOutput')
     gout.location = (1100, 0)
     sep = nodes.new('GeometryNodeSeparateComponents')
+    sep.name = sep.label = "Separate"
     sep.location = (-700, 0)
     _link(links, gin.outputs[0], sep.inputs[0])
     mesh_in = sep.outputs["Mesh"]
@@ -255,6 +269,7 @@ def build_group(owner_name, view, render):
     isview = nodes.new('GeometryNodeIsViewport')
     isview.location = (100, 450)
     vsw = nodes.new('GeometryNodeSwitch')
+    vsw.name = vsw.label = PROXY_SWITCH
     vsw.location = (300, 300)
     s, f_in, t_in, proxy_out = compat.switch_geometry_sockets(vsw)
     _link(links, isview.outputs[0], s)
@@ -269,6 +284,7 @@ def build_group(owner_name, view, render):
     nonempty.location = (650, 200)
     _link(links, size.outputs['Point Count'], nonempty.inputs[0])
     fallback = nodes.new('GeometryNodeSwitch')
+    fallback.name = fallback.label = FALLBACK_NODE
     fallback.location = (800, 50)
     s, cage_in, limit_in, out = compat.switch_geometry_sockets(fallback)
     _link(links, nonempty.outputs[0], s)
@@ -283,6 +299,106 @@ def build_group(owner_name, view, render):
     _link(links, hide.outputs[0], join.inputs[0])
     _link(links, join.outputs[0], gout.inputs[0])
     return group
+
+
+def _vg_node(nodes, kind, tag, location):
+    node = nodes.new(kind)
+    node.name = node.label = VG_NODE + tag
+    node.location = location
+    return node
+
+
+def _float_store(nodes, name, tag, location):
+    """A Store Named Attribute of float point values `name`: (node, its value socket)."""
+    node = _vg_node(nodes, 'GeometryNodeStoreNamedAttribute', tag, location)
+    node.data_type = 'FLOAT'
+    node.domain = 'POINT'
+    node.inputs["Name"].default_value = name
+    return node, [s for s in node.inputs if s.type == 'VALUE' and s.enabled][0]
+
+
+def _named_float(nodes, name, tag, location):
+    node = _vg_node(nodes, 'GeometryNodeInputNamedAttribute', tag, location)
+    node.data_type = 'FLOAT'
+    node.inputs["Name"].default_value = name
+    return [s for s in node.outputs if s.enabled and s.type == 'VALUE'][0]
+
+
+def set_vertex_groups(group, names):
+    """The vertex groups the limit mesh carries (those modifiers below CCNURBS use). On the
+    tap side each group becomes the float attribute VG_PREFIX + name (vertex groups are no
+    attributes to Python), interpolated like any point attribute (attrs.py) onto the proxy; on
+    the output side each such attribute is stored back into the group of that name, which the
+    proxies hold (names only: ensure_proxy_groups), and removed, so the result carries real
+    vertex groups for the modifiers below. Returns False if the group predates these chains."""
+    nodes, links = group.nodes, group.links
+    tap, fallback = nodes.get("Tap"), nodes.get(FALLBACK_NODE)
+    if tap is None or fallback is None:
+        return False
+    for n in [n for n in nodes if n.name.startswith(VG_NODE)]:
+        nodes.remove(n)  # their links go with them; the chain ends are relinked below
+    if "Separate" not in nodes or PROXY_SWITCH not in nodes:
+        return False
+    _, _, limit_in, _ = compat.switch_geometry_sockets(fallback)
+    mesh_src = nodes["Separate"].outputs["Mesh"]
+    proxy_src = compat.switch_geometry_sockets(nodes[PROXY_SWITCH])[3]
+    for k, name in enumerate(names):
+        store, value = _float_store(nodes, VG_PREFIX + name, "in " + name, (-650, -700 - 150 * k))
+        _link(links, _named_float(nodes, name, "read " + name, (-850, -750 - 150 * k)), value)
+        _link(links, mesh_src, store.inputs["Geometry"])
+        mesh_src = store.outputs[0]
+        back, bvalue = _float_store(nodes, name, "out " + name, (550, -300 - 150 * k))
+        _link(links, _named_float(nodes, VG_PREFIX + name, "limit " + name, (350, -350 - 150 * k)),
+              bvalue)
+        _link(links, proxy_src, back.inputs["Geometry"])
+        drop = _vg_node(nodes, 'GeometryNodeRemoveAttribute', "drop " + name, (750, -300 - 150 * k))
+        drop.inputs["Name"].default_value = VG_PREFIX + name
+        _link(links, back.outputs[0], drop.inputs["Geometry"])
+        proxy_src = drop.outputs[0]
+    _link(links, mesh_src, tap.inputs["Geometry"])
+    _link(links, proxy_src, limit_in)
+    group[VG_PROP] = list(names)
+    return True
+
+
+def carried_groups(obj):
+    """The vertex groups the object's limit mesh carries (set_vertex_groups)."""
+    mod = get_modifier(obj)
+    group = mod.node_group if mod is not None else None
+    return list(group.get(VG_PROP, [])) if group is not None else []
+
+
+def ensure_proxy_groups(p, names):
+    """Proxy p holds exactly the vertex groups `names` (names only, no weights)."""
+    if p is None:
+        return
+    have = [g.name for g in p.vertex_groups]
+    if have == list(names):
+        return
+    for g in [g for g in p.vertex_groups if g.name not in names]:
+        p.vertex_groups.remove(g)
+    for name in names:
+        if name not in have:
+            p.vertex_groups.new(name=name)
+
+
+def carry_vertex_groups(obj):
+    """Keeps the group's chains and the proxies' group names in step with the vertex groups
+    that modifiers below CCNURBS use (a no-op while that set is unchanged); a group from
+    before the chains is replaced by a fresh one. Returns True if anything changed."""
+    mod = get_modifier(obj)
+    group = mod.node_group if mod is not None else None
+    if group is None:
+        return False
+    names = groups_needed_below(obj)
+    if carried_groups(obj) == names:
+        return False
+    if not set_vertex_groups(group, names):
+        group = ensure(obj, fresh=True).node_group
+        set_vertex_groups(group, names)
+    for p in group_proxies(group):
+        ensure_proxy_groups(p, names)
+    return True
 
 
 def owner_of(group):

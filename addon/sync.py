@@ -191,6 +191,8 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             pending_normals.add(obj.name_full)
         me[proxies.TOPO_PROP] = faces
         me[proxies.PLAN_PROP] = topo
+        # the carried vertex groups' names live on the mesh, which a rebuild clears
+        modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:

@@ -91,8 +91,8 @@ def _draw_status(layout, obj):
                          " interval ratios beyond about 1:5)" % z["num_cap_fallbacks"])
         for name in modifier.subdivisions_above(obj):
             notes.append(modifier.SUBDIVIDED_NOTE % name)
-        for name, what in modifier.vertex_groups_below(obj):
-            notes.append(modifier.VGROUP_NOTE % (name, what))
+        for name in modifier.vertex_groups_below(obj):
+            notes.append(modifier.VGROUP_NOTE % name)
         if z.get("num_ignored_verts") or z.get("num_ignored_edges"):
             notes.append("ignored: %d loose verts, %d loose edges"
                          % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))

@@ -434,28 +434,66 @@ class TestModifier(AddonTestCase):
         self.assertNotIn("subdivides the cage first", labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)))
         self.assertMatchesCLI(ob)
 
-    def test_vertex_groups_below_are_pointed_out(self):
-        """The limit mesh carries no vertex groups (README): a modifier below CCNURBS that
-        needs one is named in the panel, with what to do; above CCNURBS it is fine."""
-        ob = grid(2, "Groups")
-        ob.vertex_groups.new(name="pin").add([0, 1], 1.0, 'REPLACE')
-        add_modifier(ob, levels=1)
+    def test_vertex_groups_reach_modifiers_below(self):
+        """A vertex group that a modifier below CCNURBS names is carried to the limit mesh as
+        a real vertex group, its weights the exact limit of the cage's (the positions' rules):
+        Displace (direction Z, mid-level 0) below moves each limit vertex by its weight, which
+        is the z of `ccnurbs limit` of the cage lifted to z = weight. An Armature below
+        (bone groups, not carried) is named in the panel."""
+        ob = grid(4, "Groups")
+        w = np.zeros(len(ob.data.vertices))
+        w[[0, 1, 5, 6, 12]] = (1.0, 0.5, 1.0, 0.25, 0.75)
+        vg = ob.vertex_groups.new(name="pin")
+        for i in np.nonzero(w)[0]:
+            vg.add([int(i)], float(w[i]), 'REPLACE')
+        ob.vertex_groups.new(name="unused").add([3], 1.0, 'REPLACE')
+        add_modifier(ob, levels=2)
         disp = ob.modifiers.new("Disp", 'DISPLACE')
+        disp.direction, disp.mid_level, disp.strength, disp.vertex_group = 'Z', 0.0, 1.0, "pin"
+        self.assertEqual(ccn.modifier.groups_needed_below(ob), ["pin"])
+        P = evaluated_positions(ob)
+        self.assertIsNone(ccn.sync.status(ob).error)
+        p = ccn.modifier.proxy(ob, 'VIEW')
+        self.assertEqual([g.name for g in p.vertex_groups], ["pin"])
+        disp.show_viewport = False  # the limit itself (no group needed below any more)
+        P0 = evaluated_positions(ob)
+        lifted = ob.data.copy()
+        co = cagelib.mesh_positions(lifted)
+        co[:, 2] = w
+        lifted.vertices.foreach_set("co", co.ravel())
+        R, _ = cagelib.cli_limit(CLI, lifted, 2, ob.ccnurbs.scheme, ob.ccnurbs.cap,
+                                 ob.ccnurbs.boundary_smooth)
+        bpy.data.meshes.remove(lifted)
+        dz = P[:, 2] - P0[:, 2]
+        self.assertGreater(np.abs(dz).max(), 0.5, "nothing displaced")
+        self.assertLessEqual(np.abs(dz - R[:, 2]).max(), POS_TOL, "weights are not the limit")
+        # an Armature below deforms by bone groups, which are not carried: the panel says so
+        disp.show_viewport = True
+        ob.modifiers.new("Rig", 'ARMATURE')
         update()
-        self.assertEqual(ccn.modifier.vertex_groups_below(ob), [])  # no group named
-        disp.vertex_group = "pin"
-        arm = ob.modifiers.new("Rig", 'ARMATURE')
-        update()
-        self.assertEqual(ccn.modifier.vertex_groups_below(ob),
-                         [("Disp", 'vertex group "pin"'), ("Rig", "the vertex groups of its bones")])
         bpy.context.view_layer.objects.active = ob
-        shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
-        self.assertIn('"Disp" below CCNURBS uses vertex group "pin", but the limit mesh carries no '
-                      'vertex groups: move it above CCNURBS', " ".join(shown.split()))
-        arm.show_viewport = False
-        with bpy.context.temp_override(object=ob, active_object=ob):
-            bpy.ops.object.modifier_move_to_index(modifier="Disp", index=0)
-        self.assertEqual(ccn.modifier.vertex_groups_below(ob), [])
+        shown = " ".join(labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)).split())
+        self.assertIn('"Rig" below CCNURBS deforms by the vertex groups of its bones', shown)
+        self.assertNotIn('"Disp"', shown)
+        ob.modifiers.remove(ob.modifiers["Rig"])
+        update()
+        self.assertEqual([g.name for g in p.vertex_groups], ["pin"])
+        # no group named below: the chains and the proxies' groups go
+        disp.vertex_group = ""
+        update()
+        group = ccn.modifier.get_modifier(ob).node_group
+        self.assertEqual(list(group.get(ccn.modifier.VG_PROP, [])), [])
+        self.assertFalse([n for n in group.nodes if n.name.startswith(ccn.modifier.VG_NODE)])
+        self.assertEqual(len(p.vertex_groups), 0)
+        # a group from before the chains (a file saved by an older add-on: unnamed nodes) is
+        # replaced by a fresh one when a group is needed below
+        group.nodes[ccn.modifier.FALLBACK_NODE].name = "Switch"
+        disp.vertex_group = "pin"
+        update()  # the fresh proxies are written during this evaluation, shown by the next
+        P2 = evaluated_positions(ob)
+        fresh = ccn.modifier.get_modifier(ob).node_group
+        self.assertEqual(list(fresh.get(ccn.modifier.VG_PROP, [])), ["pin"])
+        np.testing.assert_allclose(P2, P, atol=POS_TOL)
 
     def test_duplicate_gets_own_proxies(self):
         ob = add_modifier(grid(2, "Orig"))
