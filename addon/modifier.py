@@ -333,12 +333,10 @@ def set_vertex_groups(group, names):
     vertex groups for the modifiers below. Returns False if the group predates these chains."""
     nodes, links = group.nodes, group.links
     tap, fallback = nodes.get("Tap"), nodes.get(FALLBACK_NODE)
-    if tap is None or fallback is None:
+    if tap is None or fallback is None or "Separate" not in nodes or PROXY_SWITCH not in nodes:
         return False
     for n in [n for n in nodes if n.name.startswith(VG_NODE)]:
         nodes.remove(n)  # their links go with them; the chain ends are relinked below
-    if "Separate" not in nodes or PROXY_SWITCH not in nodes:
-        return False
     _, _, limit_in, _ = compat.switch_geometry_sockets(fallback)
     mesh_src = nodes["Separate"].outputs["Mesh"]
     proxy_src = compat.switch_geometry_sockets(nodes[PROXY_SWITCH])[3]
