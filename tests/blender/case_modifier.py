@@ -494,6 +494,14 @@ class TestModifier(AddonTestCase):
         fresh = ccn.modifier.get_modifier(ob).node_group
         self.assertEqual(list(fresh.get(ccn.modifier.VG_PROP, [])), ["pin"])
         np.testing.assert_allclose(P2, P, atol=POS_TOL)
+        # Apply keeps the group with the limit weights, and no helper attribute
+        with bpy.context.temp_override(object=ob, active_object=ob):
+            bpy.ops.object.modifier_apply(modifier=ccn.modifier.get_modifier(ob).name)
+        me, pin = ob.data, ob.vertex_groups["pin"].index
+        got = np.array([max((g.weight for g in v.groups if g.group == pin), default=0.0)
+                        for v in me.vertices])
+        np.testing.assert_allclose(got, R[:, 2], atol=POS_TOL)
+        self.assertFalse([a.name for a in me.attributes if a.name.startswith(ccn.modifier.VG_PREFIX)])
 
     def test_duplicate_gets_own_proxies(self):
         ob = add_modifier(grid(2, "Orig"))
