@@ -82,7 +82,7 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
         if o.library is not None and modifier.is_cage(o) and sync.status(o, kind) is None:
             sync.linked_cage(o, kind)
     objs = [o for o in objs if modifier.is_cage(o) and o.library is None and _shown(o, depsgraph)]
-    if [o for o in objs if modifier.carry_vertex_groups(o)]:
+    if any([modifier.carry_vertex_groups(o) for o in objs]):  # each object's, then one update
         depsgraph.update()  # the taps with the vertex groups the chains now carry
     taps = tap.read(depsgraph, objs)
     written = 0

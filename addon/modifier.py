@@ -71,16 +71,22 @@ DEFORM_ONLY = {'ARMATURE', 'CAST', 'CURVE', 'DISPLACE', 'HOOK', 'LAPLACIANDEFORM
                'LAPLACIANSMOOTH', 'SURFACE_DEFORM', 'WARP', 'WAVE'}
 
 
+def _enabled_around(obj):
+    """(above, below): the modifiers enabled in the viewport before and after CCNURBS (all of
+    them above when the object has no CCNURBS)."""
+    ours, above, below, past = get_modifier(obj), [], [], False
+    for m in obj.modifiers:
+        if m == ours:
+            past = True
+        elif m.show_viewport:
+            (below if past else above).append(m)
+    return above, below
+
+
 def stack_keeps_topology(obj):
     """Does every enabled modifier above CCNURBS only move vertices (so the cage the library
     sees has the object's own elements, in their order)?"""
-    ours = get_modifier(obj)
-    for m in obj.modifiers:
-        if m == ours:
-            return True
-        if m.show_viewport and m.type not in DEFORM_ONLY:
-            return False
-    return True
+    return all(m.type in DEFORM_ONLY for m in _enabled_around(obj)[0])
 
 
 SUBDIVIDED_NOTE = ("\"%s\" above CCNURBS subdivides the cage first: this is the limit of the "
@@ -91,13 +97,7 @@ def subdivisions_above(obj):
     """Names of the enabled Subdivision Surface / Multiresolution modifiers above CCNURBS: they
     subdivide the cage before CCNURBS sees it (an object that had Subsurf when CCNURBS was
     added), which the panel and the Add operator point out."""
-    ours, names = get_modifier(obj), []
-    for m in obj.modifiers:
-        if m == ours:
-            break
-        if m.show_viewport and m.type in ('SUBSURF', 'MULTIRES'):
-            names.append(m.name)
-    return names
+    return [m.name for m in _enabled_around(obj)[0] if m.type in ('SUBSURF', 'MULTIRES')]
 
 
 VGROUP_NOTE = ("\"%s\" below CCNURBS deforms by the vertex groups of its bones, which the limit "
@@ -116,28 +116,17 @@ def _vertex_group_settings(m):
     return names
 
 
-def _below(obj):
-    """The enabled modifiers below CCNURBS."""
-    ours, below, found = get_modifier(obj), False, []
-    for m in obj.modifiers:
-        if m == ours:
-            below = True
-        elif below and m.show_viewport:
-            found.append(m)
-    return found
-
-
 def groups_needed_below(obj):
     """Names of the object's vertex groups that modifiers below CCNURBS name in their settings:
     the limit mesh carries these (set_vertex_groups)."""
-    names = {n for m in _below(obj) for n in _vertex_group_settings(m) if n in obj.vertex_groups}
+    names = {n for m in _enabled_around(obj)[1] for n in _vertex_group_settings(m) if n in obj.vertex_groups}
     return sorted(names)
 
 
 def vertex_groups_below(obj):
     """Names of the Armature modifiers below CCNURBS that deform by vertex groups: the bone
     groups are not carried to the limit mesh (only groups named in settings are)."""
-    return [m.name for m in _below(obj) if m.type == 'ARMATURE' and m.use_vertex_groups]
+    return [m.name for m in _enabled_around(obj)[1] if m.type == 'ARMATURE' and m.use_vertex_groups]
 
 
 def is_cage(obj):
@@ -359,10 +348,14 @@ def set_vertex_groups(group, names):
     return True
 
 
+def _node_group(obj):
+    mod = get_modifier(obj)
+    return mod.node_group if mod is not None else None
+
+
 def carried_groups(obj):
     """The vertex groups the object's limit mesh carries (set_vertex_groups)."""
-    mod = get_modifier(obj)
-    group = mod.node_group if mod is not None else None
+    group = _node_group(obj)
     return list(group.get(VG_PROP, [])) if group is not None else []
 
 
@@ -384,12 +377,11 @@ def carry_vertex_groups(obj):
     """Keeps the group's chains and the proxies' group names in step with the vertex groups
     that modifiers below CCNURBS use (a no-op while that set is unchanged); a group from
     before the chains is replaced by a fresh one. Returns True if anything changed."""
-    mod = get_modifier(obj)
-    group = mod.node_group if mod is not None else None
+    group = _node_group(obj)
     if group is None:
         return False
     names = groups_needed_below(obj)
-    if carried_groups(obj) == names:
+    if list(group.get(VG_PROP, [])) == names:
         return False
     if not set_vertex_groups(group, names):
         group = ensure(obj, fresh=True).node_group

@@ -185,14 +185,14 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             plan.face_origin = res["face_origin"]
             proxies.write_topology(me, res, cage, exact)
             _write_extras(me, plan, cage, uv_chans, ekey, True)
+            # the carried vertex groups' names live on the mesh, which the rebuild cleared
+            modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))
             stats["rebuilds"] += 1
         me[proxies.KEY_PROP] = key + PENDING if deferred else key
         if deferred:
             pending_normals.add(obj.name_full)
         me[proxies.TOPO_PROP] = faces
         me[proxies.PLAN_PROP] = topo
-        # the carried vertex groups' names live on the mesh, which a rebuild clears
-        modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
     except native.CCNError as e:
