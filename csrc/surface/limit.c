@@ -184,8 +184,40 @@ void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn_
     g->dv[0] = sl[3] >= 0 ? beyond_end(m, v, sl[3], pinned) : e1;
 }
 
+/* An interior valence-4 vertex (most outputs): the grid of ccn__vertex_grid with +u along fan
+ * edge 0 (no ghosts, no sectors: its edges are smooth), its weights in tensor_stencil's order
+ * and arithmetic (the same numbers); 0 when two grid points are one vertex (a tiny closed
+ * mesh), which the general path merges. */
+static int interior_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    int32_t g[3][3] = {{fan_diag(m, v, 2), fan_end(m, v, 2), fan_diag(m, v, 1)},
+                       {fan_end(m, v, 3), v, fan_end(m, v, 1)},
+                       {fan_diag(m, v, 3), fan_end(m, v, 0), fan_diag(m, v, 0)}};
+    const int32_t *gv = &g[0][0];
+    for (int a = 1; a < 9; a++)
+        for (int b = 0; b < a; b++)
+            if (gv[a] == gv[b]) return 0;
+    double du[4] = {beyond_end(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
+                    m->eknot[ccn__fan_edge(m, v, 0)], beyond_end(m, v, 0, pinned)};
+    double dv[4] = {beyond_end(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
+                    m->eknot[ccn__fan_edge(m, v, 1)], beyond_end(m, v, 1, pinned)};
+    double wu[3], dwu[3], wv[3], dwv[3];
+    ccn__curve_limit_weights(du[0], du[1], du[2], du[3], wu, dwu);
+    ccn__curve_limit_weights(dv[0], dv[1], dv[2], dv[3], wv, dwv);
+    s->n = 9;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int k = 3 * i + j;
+            s->v[k] = g[i][j];
+            s->wp[k] = wu[i] * wv[j];
+            s->wu[k] = dwu[i] * wv[j];
+            s->wv[k] = wu[i] * dwv[j];
+        }
+    return 1;
+}
+
 /* Interior valence 4, boundary valence 3 or pinned corner. */
 static void regular_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    if (!m->vboundary[v] && interior_stencil(m, v, pinned, s)) return;
     ccn__vgrid g;
     ccn__vertex_grid(m, v, 0, pinned, &g);
     double wu[3], dwu[3], wv[3], dwv[3];
