@@ -9,8 +9,14 @@
   same names, in the same order, the active and the render-active one kept.
 * Point attributes (float, 2-D and 3-D vectors, colours): interpolated by the positions' rules
   through the same plan (ccn_plan_evaluate_vertex_data: their exact limit).
+* Corner attributes (float, 2-D and 3-D vectors, colours; e.g. vertex colours painted or
+  imported per face corner): interpolated bilinearly inside each cage face (a face-varying
+  channel with one value per cage corner and linear interpolation everywhere, OpenSubdiv's
+  FVAR_LINEAR_ALL), which is what Subdivision Surface does with corner data other than UV maps;
+  byte colours in their stored (sRGB) values, as Blender interpolates them. The channel's
+  topology does not depend on the values, so painting re-evaluates it without a new plan.
 * Face attributes (any type): copied from the cage face each limit face lies on (face_origin).
-Not carried: edge attributes and corner attributes other than UV maps, point attributes of
+Not carried: edge attributes, corner attributes of integer or boolean type, point attributes of
 integer or boolean type, Blender's internal layers (names starting with "."), position, the tap
 marker, creases, `sharp_face` (the limit is shaded smooth, its normals set by Normals) and
 `material_index` (proxies.py copies it). UVs and attributes do not depend on positions: a move
@@ -26,7 +32,7 @@ KEY_PROP = "ccnurbs_attr_key"     # on the proxy mesh: the key of the UVs / attr
 NAMES_PROP = "ccnurbs_attr_names"  # on the proxy mesh: the attributes this module wrote
 TAP_ATTR, LIMIT_ATTR = "ccn_co", "ccn_limit"
 SKIP = {"position", TAP_ATTR, LIMIT_ATTR, "crease_vert", "crease_edge", "sharp_face",
-        "material_index", "knot_interval"}
+        "material_index", "knot_interval", "custom_normal"}
 # data type -> (foreach property, components, numpy type)
 TYPES = {'FLOAT': ('value', 1, np.float32), 'FLOAT2': ('vector', 2, np.float32),
          'FLOAT_VECTOR': ('vector', 3, np.float32), 'FLOAT_COLOR': ('color', 4, np.float32),
@@ -42,11 +48,18 @@ _uv_cache = {}  # object name -> (data hash, UV channels)
 
 class Extras:
     """What a cage carries besides its geometry: UV maps, point and face attributes."""
-    __slots__ = ("uv_names", "uv_active", "uv_render", "uvs", "point", "face")
+    __slots__ = ("uv_names", "uv_active", "uv_render", "uvs", "point", "face", "corner")
+
+
+def _prop(data_type, domain):
+    """The foreach property of an attribute's values: byte colours on corners in their stored
+    sRGB values (Blender interpolates those), the others as TYPES says."""
+    return 'color_srgb' if data_type == 'BYTE_COLOR' and domain == 'CORNER' else TYPES[data_type][0]
 
 
 def _read_attr(att, n):
-    prop, k, dt = TYPES[att.data_type]
+    _, k, dt = TYPES[att.data_type]
+    prop = _prop(att.data_type, att.domain)
     a = np.empty(n * k, dt)
     att.data.foreach_get(prop, a)
     return a.reshape(n, k)
@@ -67,7 +80,7 @@ def read(me, perm=None):
         compat.get_uv(me, u, a)
         a = a.reshape(nl, 2)
         x.uvs.append(a[perm] if perm is not None else a)
-    x.point, x.face = [], []
+    x.point, x.face, x.corner = [], [], []
     uv_names = set(x.uv_names)
     for att in me.attributes:
         name = att.name
@@ -77,6 +90,9 @@ def read(me, perm=None):
             x.point.append((name, att.data_type, _read_attr(att, nv)))
         elif att.domain == 'FACE' and len(att.data) == nf:
             x.face.append((name, att.data_type, _read_attr(att, nf)))
+        elif att.domain == 'CORNER' and att.data_type in POINT_TYPES and len(att.data) == nl:
+            a = _read_attr(att, nl)
+            x.corner.append((name, att.data_type, a[perm] if perm is not None else a))
     return x
 
 
@@ -110,6 +126,23 @@ def uv_channels(name, x, face_verts):
     return res
 
 
+def corner_layout(x):
+    """Key of the corner attributes' channels (their names, types and corner count): a plan has
+    one channel per corner attribute, so it is rebuilt when the layout changes, not when values
+    do."""
+    if x is None or not x.corner:
+        return ""
+    return "|corners:" + repr([(n, t, len(a)) for n, t, a in x.corner])
+
+
+def add_corner_channels(plan, x):
+    """The plan's channel index of each corner attribute: one value per cage corner, bilinear."""
+    if x is None:
+        return []
+    return [plan.add_fvar(a.astype(np.float64), np.arange(len(a), dtype=np.int32), "NONE")
+            for _, _, a in x.corner]
+
+
 def forget(name):
     _uv_cache.pop(name, None)
 
@@ -119,8 +152,10 @@ def data_key(x, uv_smooth):
     if x is None:
         return "-"
     parts = [repr((x.uv_names, x.uv_active, x.uv_render, uv_smooth,
-                   [(n, t) for n, t, _ in x.point], [(n, t) for n, t, _ in x.face])).encode()]
+                   [(n, t) for n, t, _ in x.point], [(n, t) for n, t, _ in x.face],
+                   [(n, t) for n, t, _ in x.corner])).encode()]
     parts += x.uvs + [a for _, _, a in x.point] + [a for _, _, a in x.face]
+    parts += [a for _, _, a in x.corner]
     return _hash(parts)
 
 
@@ -137,9 +172,9 @@ def _attribute(me, name, data_type, domain):
     return a if a is not None else me.attributes.new(name, data_type, domain)
 
 
-def write(me, x, plan, chans, channel_ids, face_origin):
-    """UV maps, point and face attributes of the limit mesh `me` (the proxy, its topology just
-    written or unchanged), with the plan's channels."""
+def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None):
+    """UV maps, point, corner and face attributes of the limit mesh `me` (the proxy, its
+    topology just written or unchanged), with the plan's channels."""
     names = x.uv_names if x is not None else []
     if [u.name for u in me.uv_layers] != names:
         while len(me.uv_layers):
@@ -169,6 +204,14 @@ def write(me, x, plan, chans, channel_ids, face_origin):
             att = _attribute(me, name, t, 'POINT')
             att.data.foreach_set(TYPES[t][0], vals.astype(np.float32).ravel())
             written.append(name)
+    for (name, t, a), cid in zip(x.corner if x is not None else [], corner_ids or []):
+        out, fv = plan.evaluate_fvar(cid, a.astype(np.float64))
+        vals = out[fv.ravel()]
+        if t == 'BYTE_COLOR':
+            vals = np.clip(vals, 0.0, 1.0)
+        _attribute(me, name, t, 'CORNER').data.foreach_set(_prop(t, 'CORNER'),
+                                                           vals.astype(np.float32).ravel())
+        written.append(name)
     if x is not None and x.face:
         origin = np.clip(face_origin, 0, len(x.face[0][2]) - 1)
         for name, t, a in x.face:

@@ -109,6 +109,7 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
                        cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
                        levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
+    plan.corner_channels = attrs.add_corner_channels(plan, cage.extras)
     plan.face_origin = None
     _plans[key_name] = (topo, plan)
     return plan
@@ -120,7 +121,8 @@ def _write_extras(me, plan, cage, uv_chans, ekey, rebuilt):
         return
     if plan.face_origin is None and cage.extras is not None and cage.extras.face:
         plan.face_origin = plan.evaluate(cage.positions, topology=True)["face_origin"]
-    attrs.write(me, cage.extras, plan, uv_chans, plan.uv_channels, plan.face_origin)
+    attrs.write(me, cage.extras, plan, uv_chans, plan.uv_channels, plan.face_origin,
+                plan.corner_channels)
     me[attrs.KEY_PROP] = ekey
 
 
@@ -136,6 +138,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     p = None
     try:
         uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
+        uv_topo += attrs.corner_layout(cage.extras)
         memo = _key_memo.setdefault(key_name, {})
         topo, faces = (k + uv_topo for k in
                        cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases,

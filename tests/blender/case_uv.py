@@ -165,6 +165,63 @@ class TestUVs(AddonTestCase):
         add_modifier(ob)
         self.assertEqual(ob.ccnurbs.uv_smooth, new)
 
+    def test_corner_attributes_match_subdivision_surface(self):
+        """Corner attributes other than UV maps (vertex colours painted or imported per face
+        corner: float and byte colours, floats, vectors) equal Subdivision Surface's at every
+        face corner (bilinear inside each cage face, byte colours in their stored values) at
+        levels 1-2 on the cube and on Suzanne (triangles); painting (new values, same corners)
+        reaches the limit without a new plan; Apply keeps them."""
+        rng = np.random.default_rng(7)
+        for kind in ("cube", "suzanne"):
+            for levels in (1, 2):
+                with self.subTest(kind=kind, levels=levels):
+                    reset_scene()
+                    ob = setup(kind)
+                    me = ob.data
+                    n = len(me.loops)
+                    data = {"paint": ('FLOAT_COLOR', 'color', 4), "Col": ('BYTE_COLOR', 'color_srgb', 4),
+                            "wear": ('FLOAT', 'value', 1), "flow": ('FLOAT_VECTOR', 'vector', 3)}
+                    for name, (t, prop, k) in data.items():
+                        me.attributes.new(name, t, 'CORNER').data.foreach_set(
+                            prop, rng.random(n * k).astype(np.float32))
+                    ref = ob.copy()
+                    ref.data = me.copy()
+                    bpy.context.collection.objects.link(ref)
+                    sub = ref.modifiers.new("Subdivision", 'SUBSURF')
+                    sub.levels, sub.quality = levels, QUALITY
+                    add_modifier(ob, levels=levels, scheme='CATMULL_CLARK', cap='REFINE')
+                    dg = update()
+                    a, b = ob.evaluated_get(dg).data, ref.evaluated_get(dg).data
+                    idx, pos_err = match_corners(corner_data(a), corner_data(b))
+                    self.assertLess(pos_err, 1e-3, "limit surfaces differ: %g" % pos_err)
+                    worst = 0.0
+                    for name, (t, prop, k) in data.items():
+                        va, vb = (np.empty(len(m.loops) * k, np.float32) for m in (a, b))
+                        self.assertEqual(a.attributes[name].domain, 'CORNER')
+                        self.assertEqual(a.attributes[name].data_type, t)
+                        a.attributes[name].data.foreach_get(prop, va)
+                        b.attributes[name].data.foreach_get(prop, vb)
+                        tol = 1.01 / 255 if t == 'BYTE_COLOR' else 1e-5  # bytes: rounding
+                        err = float(np.abs(va.reshape(-1, k) - vb.reshape(-1, k)[idx]).max())
+                        self.assertLessEqual(err, tol, "%s %s L%d: %g" % (kind, name, levels, err))
+                        worst = max(worst, err if t != 'BYTE_COLOR' else 0.0)
+                    print("measure corner attributes %s L%d vs Subdivision Surface: %.2e (floats), "
+                          "byte colours within a byte step" % (kind, levels, worst))
+        # painting: new values, the same plan; then Apply keeps the attribute
+        plans = dict(ccn.sync.stats)
+        me = ob.data
+        me.attributes["wear"].data.foreach_set("value", np.full(len(me.loops), 0.25, np.float32))
+        me.update()
+        a = ob.evaluated_get(update()).data
+        w = np.empty(len(a.loops), np.float32)
+        a.attributes["wear"].data.foreach_get("value", w)
+        self.assertLess(float(np.abs(w - 0.25).max()), 1e-6)
+        self.assertEqual(ccn.sync.stats["rebuilds"], plans["rebuilds"], "painting rebuilt the mesh")
+        bpy.context.view_layer.objects.active = ob
+        bpy.ops.object.modifier_apply(modifier=ccn.modifier.get_modifier(ob).name)
+        self.assertEqual(ob.data.attributes["wear"].domain, 'CORNER')
+        self.assertEqual(len(ob.data.attributes["wear"].data), len(ob.data.loops))
+
     def test_uv_edit_updates(self):
         """A UV change alone (no vertex moved) reaches the limit; a move keeps the UVs."""
         ob = setup("cube")
