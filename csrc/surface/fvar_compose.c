@@ -22,6 +22,13 @@
  * compute only the points the other outputs read and colour only the value vertices around
  * the other faces (surface/fvar_probe.c). When every face's are written down, levels 1..L are
  * only numbered (numbered()).
+ *
+ * Mode ALL (every value linear: OpenSubdiv's FVAR_LINEAR_ALL) refines bilinearly (face points
+ * the average, edge points the midpoint), and a bilinear limit is the level-L value itself: the
+ * output at (u, v) of the level-1 quad (V_k, E(h_k), F, E(h_k-1)) of cage face f is the bilinear
+ * interpolation of c_k, (c_k + c_k+1)/2, the average of f's n corners and (c_k-1 + c_k)/2
+ * (bilinear_rows()), so its weights are written down for every face too (from level 1 on; the
+ * probed weights are the same numbers summed in another order, a few ulps).
  */
 #include "surface/fvar_compose.h"
 
@@ -457,8 +464,8 @@ static ccn_status build(const ccn_plan *p, const ccn_fvar_channel *ch, builder *
     if (st) return st;
     if (!c->bilinear && ccn__fvar_direct_build(&c->lev[0], p->threads, NULL, 0, &c->dir))
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
-    if (!c->bilinear && c->dir.count == c->lev[0].m->nf) { /* nothing to probe */
-        c->numbered_only = 1;
+    if ((!c->bilinear && c->dir.count == c->lev[0].m->nf) || (c->bilinear && c->L >= 1)) {
+        c->numbered_only = 1; /* nothing to probe */
         return numbered(p, c, err);
     }
     for (int32_t l = 0; l < c->L; l++) {
@@ -598,6 +605,55 @@ static ccn_status direct_tables(const ccn_plan *p, builder *c, ccn__fvar_stencil
     return st;
 }
 
+/* The rows in place: zero weights dropped, value vertices -> the caller's values (a value on two
+ * value vertices once), and every stencil sums to 1; each row within its own entries (in
+ * parallel), then the rows moved together. */
+static ccn_status finish_rows(const ccn_plan *p, const builder *c, ccn__fvar_stencils *s, ccn_error *err) {
+    const ccn_mesh *m0 = c->lev[0].m;
+    int32_t nout = s->nout;
+    ccn_status st = CCN_OK;
+    int32_t *len = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
+    double *sums = malloc(sizeof(double) * (size_t)(nout ? nout : 1));
+    if (!len || !sums) {
+        free(len); free(sums);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+    }
+    /* a row's candidates are distinct value vertices: they need merging only where two value
+     * vertices carry one of the caller's values */
+    int32_t maxval = 0;
+    for (int32_t v = 0; v < m0->nv; v++) if (c->value_of[v] > maxval) maxval = c->value_of[v];
+    uint8_t *used = calloc((size_t)maxval + 1, 1);
+    int unique = used != NULL;
+    for (int32_t v = 0; unique && v < m0->nv; v++) unique = !used[c->value_of[v]]++;
+    free(used);
+    merge_job mj = {s, c->value_of, len, sums, unique};
+    ccn__parallel_for(p->threads, nout, merge_range, &mj);
+    int32_t n = 0;
+    for (int32_t o = 0; o < nout && !st; o++) {
+        int32_t e0 = s->start[o], k = len[o];
+        if (k < 0) { /* weight outside the neighbourhood: cannot happen */
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
+                           "face-varying stencil of output value %d sums to %.17g", (int)o, sums[o]);
+            break;
+        }
+        if (n != e0) {
+            memmove(s->idx + n, s->idx + e0, sizeof(int32_t) * (size_t)k);
+            memmove(s->w + n, s->w + e0, sizeof(double) * (size_t)k);
+        }
+        s->start[o] = n;
+        n += k;
+    }
+    free(len); free(sums);
+    s->start[nout] = n;
+    if (!st) {
+        int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
+        double *b = realloc(s->w, sizeof(double) * (size_t)(n ? n : 1));
+        if (a) s->idx = a;
+        if (b) s->w = b;
+    }
+    return st;
+}
+
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m;
     int32_t nout = s->nout;
@@ -650,51 +706,74 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     }
     free(kperm); free(kcol);
     kperm = kcol = NULL;
-    /* in place: zero weights dropped, value vertices -> the caller's values (a value on two
-     * value vertices once), and every stencil sums to 1; each row within its own entries (in
-     * parallel), then the rows moved together */
-    int32_t *len = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
-    double *sums = malloc(sizeof(double) * (size_t)(nout ? nout : 1));
-    if (!len || !sums) {
-        free(len); free(sums);
+    st = finish_rows(p, c, s, err);
+done:
+    free(K.start); free(K.list); free(col); free(kperm); free(kcol);
+    return st;
+}
+
+/* Mode ALL from level 1 on (the file comment): output o's row is the bilinear weights of its
+ * cage face's corners at its grid point (u, v) in its level-1 quad k, over the value vertices
+ * of those corners (finish_rows maps them to the caller's values). */
+typedef struct { const ccn_plan *p; const builder *c; ccn__fvar_stencils *s; int32_t *g, *ab; } bilinear_job;
+
+static void bilinear_origin_range(void *ctx, int32_t b, int32_t end) {
+    const bilinear_job *j = ctx;
+    for (int32_t o = b; o < end; o++) j->g[o] = origin_at(j->p, j->c->firstL[o], 1, &j->ab[o]);
+}
+
+static void bilinear_range(void *ctx, int32_t b, int32_t end) {
+    const bilinear_job *j = ctx;
+    const ccn_mesh *m0 = j->c->lev[0].m; /* the value mesh: the cage's faces and corners */
+    double side = (double)(1 << (j->c->L - 1));
+    for (int32_t o = b; o < end; o++) {
+        int32_t g = j->g[o], f = m0->hface[g], f0 = m0->fstart[f], n = m0->fstart[f + 1] - f0;
+        int32_t k = g - f0, next = (k + 1) % n, prev = (k + n - 1) % n, e = j->s->start[o];
+        double u = (j->ab[o] & 0xffff) / side, v = (j->ab[o] >> 16) / side;
+        double a00 = (1.0 - u) * (1.0 - v), a10 = u * (1.0 - v), a11 = u * v, a01 = (1.0 - u) * v;
+        for (int32_t i = 0; i < n; i++) { /* V_k, E(h_k), F, E(h_k-1) at (0,0), (1,0), (1,1), (0,1) */
+            double w = a11 / n;
+            if (i == k) w += a00 + 0.5 * a10 + 0.5 * a01;
+            if (i == next) w += 0.5 * a10;
+            if (i == prev) w += 0.5 * a01;
+            j->s->idx[e + i] = m0->hvert[f0 + i];
+            j->s->w[e + i] = w;
+        }
+    }
+}
+
+static ccn_status bilinear_rows(const ccn_plan *p, const builder *c, ccn__fvar_stencils *s, ccn_error *err) {
+    const ccn_mesh *m0 = c->lev[0].m;
+    int32_t nout = s->nout;
+    bilinear_job j = {p, c, s, malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1)),
+                      malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1))};
+    s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
+    ccn_status st = CCN_OK;
+    if (!j.g || !j.ab || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
         goto done;
     }
-    /* a row's candidates are distinct value vertices: they need merging only where two value
-     * vertices carry one of the caller's values */
-    int32_t maxval = 0;
-    for (int32_t v = 0; v < m0->nv; v++) if (c->value_of[v] > maxval) maxval = c->value_of[v];
-    uint8_t *used = calloc((size_t)maxval + 1, 1);
-    int unique = used != NULL;
-    for (int32_t v = 0; unique && v < m0->nv; v++) unique = !used[c->value_of[v]]++;
-    free(used);
-    merge_job mj = {s, c->value_of, len, sums, unique};
-    ccn__parallel_for(p->threads, nout, merge_range, &mj);
-    int32_t n = 0;
-    for (int32_t o = 0; o < nout && !st; o++) {
-        int32_t e0 = s->start[o], k = len[o];
-        if (k < 0) { /* weight outside the neighbourhood: cannot happen */
-            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
-                           "face-varying stencil of output value %d sums to %.17g", (int)o, sums[o]);
-            break;
+    ccn__parallel_for(p->threads, nout, bilinear_origin_range, &j);
+    int64_t total = 0;
+    s->start[0] = 0;
+    for (int32_t o = 0; o < nout; o++) {
+        total += ccn__fsize(m0, m0->hface[j.g[o]]);
+        if (total > INT32_MAX) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large");
+            goto done;
         }
-        if (n != e0) {
-            memmove(s->idx + n, s->idx + e0, sizeof(int32_t) * (size_t)k);
-            memmove(s->w + n, s->w + e0, sizeof(double) * (size_t)k);
-        }
-        s->start[o] = n;
-        n += k;
+        s->start[o + 1] = (int32_t)total;
     }
-    free(len); free(sums);
-    s->start[nout] = n;
-    if (!st) {
-        int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
-        double *b = realloc(s->w, sizeof(double) * (size_t)(n ? n : 1));
-        if (a) s->idx = a;
-        if (b) s->w = b;
+    s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
+    s->w = malloc(sizeof(double) * (size_t)(total ? total : 1));
+    if (!s->idx || !s->w) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
     }
+    ccn__parallel_for(p->threads, nout, bilinear_range, &j);
+    st = finish_rows(p, c, s, err);
 done:
-    free(K.start); free(K.list); free(col); free(kperm); free(kcol);
+    free(j.g); free(j.ab);
     return st;
 }
 
@@ -707,7 +786,7 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
     if (!st && c.numbered_only) { /* level L's numbering is all that was made */
         s->nout = c.nvL;
         s->num_seams = c.lev[0].num_seams;
-        s->num_sharp = c.nsharpL;
+        s->num_sharp = c.bilinear ? c.nvL : c.nsharpL; /* ALL: every value is kept sharp */
         s->face_values = c.hvL;
         c.hvL = NULL;
     } else if (!st) {
@@ -719,7 +798,7 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
         if (!s->face_values) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         else memcpy(s->face_values, mL->hvert, sizeof(int32_t) * (size_t)mL->nh);
     }
-    if (!st) st = compose(p, &c, s, err);
+    if (!st) st = c.numbered_only && c.bilinear ? bilinear_rows(p, &c, s, err) : compose(p, &c, s, err);
     builder_free(&c);
     if (st) ccn__fvar_stencils_free(s);
     return st;
