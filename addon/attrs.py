@@ -16,7 +16,10 @@
   byte colours in their stored (sRGB) values, as Blender interpolates them. The channel's
   topology does not depend on the values, so painting re-evaluates it without a new plan.
 * Face attributes (any type): copied from the cage face each limit face lies on (face_origin).
-Not carried: edge attributes, corner attributes of integer or boolean type, point attributes of
+* Edge attributes (any type, e.g. 4.x's `bevel_weight_edge`) and UV seams: each limit edge that
+  lies on a cage edge gets that edge's value, the edges inside cage faces none (0 / False), as
+  on Subdivision Surface's result (corner_edge_origin).
+Not carried: `sharp_edge` (the limit's normals are set by Normals), corner attributes of integer or boolean type, point attributes of
 integer or boolean type, Blender's internal layers (names starting with "."), position, the tap
 marker, creases, `sharp_face` (the limit is shaded smooth, its normals set by Normals) and
 `material_index` (proxies.py copies it). UVs and attributes do not depend on positions: a move
@@ -30,9 +33,10 @@ from . import compat
 
 KEY_PROP = "ccnurbs_attr_key"     # on the proxy mesh: the key of the UVs / attributes written
 NAMES_PROP = "ccnurbs_attr_names"  # on the proxy mesh: the attributes this module wrote
+SEAM_PROP = "ccnurbs_seams"        # on the proxy mesh: UV seams were written
 TAP_ATTR, LIMIT_ATTR = "ccn_co", "ccn_limit"
 SKIP = {"position", TAP_ATTR, LIMIT_ATTR, "crease_vert", "crease_edge", "sharp_face",
-        "material_index", "knot_interval", "custom_normal"}
+        "material_index", "knot_interval", "custom_normal", "sharp_edge"}
 # data type -> (foreach property, components, numpy type)
 TYPES = {'FLOAT': ('value', 1, np.float32), 'FLOAT2': ('vector', 2, np.float32),
          'FLOAT_VECTOR': ('vector', 3, np.float32), 'FLOAT_COLOR': ('color', 4, np.float32),
@@ -48,7 +52,8 @@ _uv_cache = {}  # object name -> (data hash, UV channels)
 
 class Extras:
     """What a cage carries besides its geometry: UV maps, point and face attributes."""
-    __slots__ = ("uv_names", "uv_active", "uv_render", "uvs", "point", "face", "corner")
+    __slots__ = ("uv_names", "uv_active", "uv_render", "uvs", "point", "face", "corner",
+                 "edge", "seam")
 
 
 def _prop(data_type, domain):
@@ -80,7 +85,12 @@ def read(me, perm=None):
         compat.get_uv(me, u, a)
         a = a.reshape(nl, 2)
         x.uvs.append(a[perm] if perm is not None else a)
-    x.point, x.face, x.corner = [], [], []
+    x.point, x.face, x.corner, x.edge = [], [], [], []
+    ne = len(me.edges)
+    seam = np.zeros(ne, bool)
+    if ne:
+        me.edges.foreach_get("use_seam", seam)
+    x.seam = seam if seam.any() else None
     uv_names = set(x.uv_names)
     for att in me.attributes:
         name = att.name
@@ -90,6 +100,8 @@ def read(me, perm=None):
             x.point.append((name, att.data_type, _read_attr(att, nv)))
         elif att.domain == 'FACE' and len(att.data) == nf:
             x.face.append((name, att.data_type, _read_attr(att, nf)))
+        elif att.domain == 'EDGE' and len(att.data) == ne:
+            x.edge.append((name, att.data_type, _read_attr(att, ne)))
         elif att.domain == 'CORNER' and att.data_type in POINT_TYPES and len(att.data) == nl:
             a = _read_attr(att, nl)
             x.corner.append((name, att.data_type, a[perm] if perm is not None else a))
@@ -153,9 +165,11 @@ def data_key(x, uv_smooth):
         return "-"
     parts = [repr((x.uv_names, x.uv_active, x.uv_render, uv_smooth,
                    [(n, t) for n, t, _ in x.point], [(n, t) for n, t, _ in x.face],
-                   [(n, t) for n, t, _ in x.corner])).encode()]
+                   [(n, t) for n, t, _ in x.corner], [(n, t) for n, t, _ in x.edge],
+                   x.seam is not None)).encode()]
     parts += x.uvs + [a for _, _, a in x.point] + [a for _, _, a in x.face]
-    parts += [a for _, _, a in x.corner]
+    parts += [a for _, _, a in x.corner] + [a for _, _, a in x.edge]
+    parts += [x.seam] if x.seam is not None else []
     return _hash(parts)
 
 
@@ -172,9 +186,26 @@ def _attribute(me, name, data_type, domain):
     return a if a is not None else me.attributes.new(name, data_type, domain)
 
 
-def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None):
-    """UV maps, point, corner and face attributes of the limit mesh `me` (the proxy, its
-    topology just written or unchanged), with the plan's channels."""
+def needs_edge_origin(x):
+    return x is not None and (bool(x.edge) or x.seam is not None)
+
+
+def edge_origin(me, corner_edge_origin, cage_loop_edges):
+    """Per edge of the limit mesh `me`: the cage edge it lies on, -1 inside a cage face (from the
+    plan's corner_edge_origin: the cage corner whose edge each output corner's edge lies on)."""
+    origin = np.asarray(corner_edge_origin).ravel()
+    loop_edge = np.empty(len(me.loops), np.int32)
+    compat.get_array(me, "corner_edges", loop_edge)
+    out = np.full(len(me.edges), -1, np.int64)
+    on = origin >= 0
+    out[loop_edge[on]] = np.asarray(cage_loop_edges)[origin[on]]
+    return out
+
+
+def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None, edge_from=None):
+    """UV maps, point, corner, face and edge attributes (and UV seams) of the limit mesh `me`
+    (the proxy, its topology just written or unchanged), with the plan's channels; edge_from:
+    edge_origin() of me, when needs_edge_origin(x)."""
     names = x.uv_names if x is not None else []
     if [u.name for u in me.uv_layers] != names:
         while len(me.uv_layers):
@@ -217,6 +248,19 @@ def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None):
         for name, t, a in x.face:
             _attribute(me, name, t, 'FACE').data.foreach_set(TYPES[t][0], a[origin].ravel())
             written.append(name)
+    if needs_edge_origin(x) and edge_from is not None:
+        on = edge_from >= 0
+        for name, t, a in x.edge:
+            vals = np.zeros((len(me.edges), a.shape[1]), a.dtype)
+            vals[on] = a[edge_from[on]]
+            _attribute(me, name, t, 'EDGE').data.foreach_set(TYPES[t][0], vals.ravel())
+            written.append(name)
+    if x is not None and (x.seam is not None or me.get(SEAM_PROP)):
+        seam = np.zeros(len(me.edges), bool)
+        if x.seam is not None and edge_from is not None:
+            seam[edge_from >= 0] = x.seam[edge_from[edge_from >= 0]]
+        me.edges.foreach_set("use_seam", seam)
+        me[SEAM_PROP] = bool(seam.any())
     for name in me.get(NAMES_PROP, []):  # written before, gone from the cage now
         a = me.attributes.get(name)
         if name not in written and a is not None:

@@ -110,7 +110,7 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
                        levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
     plan.corner_channels = attrs.add_corner_channels(plan, cage.extras)
-    plan.face_origin = None
+    plan.face_origin = plan.corner_edge_origin = None
     _plans[key_name] = (topo, plan)
     return plan
 
@@ -119,10 +119,15 @@ def _write_extras(me, plan, cage, uv_chans, ekey, rebuilt):
     """UV maps and attributes (attrs.py), when they or the topology changed."""
     if not rebuilt and me.get(attrs.KEY_PROP) == ekey:
         return
-    if plan.face_origin is None and cage.extras is not None and cage.extras.face:
-        plan.face_origin = plan.evaluate(cage.positions, topology=True)["face_origin"]
-    attrs.write(me, cage.extras, plan, uv_chans, plan.uv_channels, plan.face_origin,
-                plan.corner_channels)
+    x = cage.extras
+    if (plan.face_origin is None and x is not None and x.face) or (
+            plan.corner_edge_origin is None and attrs.needs_edge_origin(x)):
+        res = plan.evaluate(cage.positions, topology=True)
+        plan.face_origin, plan.corner_edge_origin = res["face_origin"], res["corner_edge_origin"]
+    edge_from = (attrs.edge_origin(me, plan.corner_edge_origin, cage.loop_edges)
+                 if attrs.needs_edge_origin(x) else None)
+    attrs.write(me, x, plan, uv_chans, plan.uv_channels, plan.face_origin,
+                plan.corner_channels, edge_from)
     me[attrs.KEY_PROP] = ekey
 
 
@@ -185,7 +190,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             stats["position_updates"] += 1
         else:
             res = plan.evaluate(cage.positions, topology=True)
-            plan.face_origin = res["face_origin"]
+            plan.face_origin, plan.corner_edge_origin = res["face_origin"], res["corner_edge_origin"]
             proxies.write_topology(me, res, cage, exact)
             _write_extras(me, plan, cage, uv_chans, ekey, True)
             # the carried vertex groups' names live on the mesh, which the rebuild cleared

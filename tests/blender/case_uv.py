@@ -222,6 +222,65 @@ class TestUVs(AddonTestCase):
         self.assertEqual(ob.data.attributes["wear"].domain, 'CORNER')
         self.assertEqual(len(ob.data.attributes["wear"].data), len(ob.data.loops))
 
+    def test_edge_attributes_and_seams_match_subdivision_surface(self):
+        """UV seams and edge attributes (a float, an integer, a boolean) reach the limit edges
+        that lie on cage edges, as on Subdivision Surface's result (matched by edge midpoint),
+        and none reaches the edges inside cage faces; removing the seams clears them."""
+        rng = np.random.default_rng(3)
+        ob = setup("cube")
+        me = ob.data
+        ne = len(me.edges)
+        seam = np.zeros(ne, bool)
+        seam[[0, 3, 5, 9]] = True
+        me.edges.foreach_set("use_seam", seam)
+        data = {"wear_edge": ('FLOAT', rng.random(ne).astype(np.float32)),
+                "edge_id": ('INT', np.arange(1, ne + 1, dtype=np.int32)),
+                "cut": ('BOOLEAN', rng.random(ne) > 0.5)}
+        for name, (t, v) in data.items():
+            me.attributes.new(name, t, 'EDGE').data.foreach_set("value", v)
+        me.update()
+        ref = ob.copy()
+        ref.data = me.copy()
+        bpy.context.collection.objects.link(ref)
+        sub = ref.modifiers.new("Subdivision", 'SUBSURF')
+        sub.levels, sub.quality = 2, QUALITY
+        add_modifier(ob, levels=2, scheme='CATMULL_CLARK', cap='REFINE')
+        dg = update()
+        a, b = ob.evaluated_get(dg).data, ref.evaluated_get(dg).data
+
+        def midpoints(m):
+            co = cagelib.mesh_positions(m)
+            ev = np.empty(2 * len(m.edges), np.int32)
+            m.edges.foreach_get("vertices", ev)
+            return co[ev.reshape(-1, 2)].mean(1)
+        ma, mb = midpoints(a), midpoints(b)
+        self.assertEqual(len(ma), len(mb))
+        j = np.array([int(np.argmin(((mb - p) ** 2).sum(1))) for p in ma])
+        self.assertLess(float(np.sqrt(((mb[j] - ma) ** 2).sum(1)).max()), 1e-4)
+        sa, sb = np.zeros(len(a.edges), bool), np.zeros(len(b.edges), bool)
+        a.edges.foreach_get("use_seam", sa)
+        b.edges.foreach_get("use_seam", sb)
+        self.assertEqual(int(sa.sum()), 4 * 4, "each seam edge is 4 limit edges at level 2")
+        self.assertTrue(np.array_equal(sa, sb[j]), "seams differ from Subdivision Surface's")
+        for name, (t, v) in data.items():
+            va = np.empty(len(a.edges), v.dtype)
+            a.attributes[name].data.foreach_get("value", va)
+            self.assertEqual(a.attributes[name].domain, 'EDGE')
+            self.assertEqual(int(np.count_nonzero(va)), 4 * int(np.count_nonzero(v)), name)
+            if name in b.attributes:  # Subdivision Surface carries generic edge attributes too
+                vb = np.empty(len(b.edges), v.dtype)
+                b.attributes[name].data.foreach_get("value", vb)
+                self.assertTrue(np.array_equal(va, vb[j]), "%s differs from Subdivision Surface's" % name)
+            print("measure edge attribute %s: %d limit edges carry it%s" % (
+                name, int(np.count_nonzero(va)), ", equal to Subdivision Surface's"
+                if name in b.attributes else ""))
+        me.edges.foreach_set("use_seam", np.zeros(ne, bool))
+        me.update()
+        a = ob.evaluated_get(update()).data
+        sa = np.zeros(len(a.edges), bool)
+        a.edges.foreach_get("use_seam", sa)
+        self.assertFalse(sa.any(), "seams removed from the cage stay on the limit")
+
     def test_uv_edit_updates(self):
         """A UV change alone (no vertex moved) reaches the limit; a move keeps the UVs."""
         ob = setup("cube")
