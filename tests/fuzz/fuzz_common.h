@@ -72,7 +72,7 @@ static inline void fz_check_status(ccn_status st, const ccn_error *e, const char
              (int)st, e->message);
     if (st != CCN_OK) {
         FZ_CHECK(e->message[0] != '\0', "%s: error %d with an empty message", call, (int)st);
-        FZ_CHECK(e->element_kind >= CCN_ELEM_NONE && e->element_kind <= CCN_ELEM_LINE,
+        FZ_CHECK(e->element_kind >= CCN_ELEM_NONE && e->element_kind <= CCN_ELEM_VALUE,
                  "%s: element_kind %d", call, (int)e->element_kind);
         FZ_CHECK(e->element >= -1, "%s: element %d", call, (int)e->element);
     }

@@ -4,7 +4,8 @@
  * Checks: statuses in range, messages NUL-terminated, invalid options and cages rejected,
  * sizes consistent, every position and normal finite (normals of unit length), indices in
  * range, topology outputs identical between calls; ccn_plan_patches: degree 3 or 5, finite
- * control points, cage face in range. Output buffers are allocated at exactly
+ * control points, cage face in range; a face-varying channel and per-vertex data from the
+ * input (fvar_stage). Output buffers are allocated at exactly
  * the sizes ccn_plan_sizes gives, so ASan catches any write past them.
  * Input: byte 0 flags (as fuzz_mesh.c), the cage, then scheme, cap, levels, corners,
  * threads bytes, then positions for the second evaluation. Built only once the library
@@ -41,6 +42,88 @@ static void on_patch(void *user, int32_t degree, const double *points, int32_t c
     if (c->strict) /* KB2b */
         fz_check_finite(points, 3 * (size_t)(degree + 1) * (size_t)(degree + 1), "patch point");
     c->count++;
+}
+
+/* 4: a face-varying channel from the input (value indices per cage corner, some out of range;
+ * values, some non-finite; width 1..3; a mode, 6 invalid) and per-vertex data. A bad channel
+ * must be refused with CCN_ERR_ARGUMENT; a good one gives exactly sized outputs: finite values,
+ * face values in range, the same face values for new values, and vertex data finite. */
+static void fvar_stage(ccn_plan *plan, const ccn_cage *c, const ccn_sizes *z, rd *r) {
+    int32_t nc = 0;
+    for (int32_t f = 0; f < c->num_faces; f++) nc += c->face_sizes[f];
+    uint8_t hb = next(r);
+    int32_t width = 1 + hb % 3, nvals = 1 + next(r) % 32, mode = next(r) % 7;
+    int32_t *idx = malloc(sizeof(int32_t) * (size_t)(nc + 1));
+    double *vals = malloc(sizeof(double) * (size_t)width * (size_t)nvals);
+    FZ_CHECK(idx && vals, "harness out of memory");
+    int bad = mode > CCN_FVAR_LINEAR_ALL;
+    for (int32_t i = 0; i < nc; i++) {
+        uint8_t b = next(r);
+        idx[i] = b == 255 ? nvals : b == 254 ? -1 : (hb & 8) ? i % nvals : b % nvals;
+        bad |= idx[i] < 0 || idx[i] >= nvals;
+    }
+    for (int32_t k = 0; k < width * nvals; k++) {
+        uint8_t b = next(r);
+        vals[k] = b < 8 ? fz_special(b) : ((double)b - 128.0) / 32.0;
+        bad |= !isfinite(vals[k]) || fabs(vals[k]) > FZ_HUGE;
+    }
+    ccn_fvar_channel ch = {width, nvals, vals, idx, mode};
+    ccn_error e;
+    fz_err_init(&e);
+    int32_t id = -1;
+    ccn_status st = ccn_plan_add_fvar(plan, &ch, &id, &e);
+    fz_check_status(st, &e, "ccn_plan_add_fvar");
+    if (bad) FZ_CHECK(st == CCN_ERR_ARGUMENT, "a bad channel gave %d", (int)st);
+    else FZ_CHECK(st == CCN_OK || st == CCN_ERR_MEMORY, "add_fvar: %d %s", (int)st, e.message);
+    if (st == CCN_OK) {
+        ccn_fvar_sizes fs;
+        FZ_CHECK(ccn_plan_fvar_sizes(plan, id, &fs) == CCN_OK, "ccn_plan_fvar_sizes");
+        FZ_CHECK(fs.width == width && fs.num_cage_values == nvals && fs.num_values > 0 &&
+                     fs.num_values <= 4 * (int64_t)z->num_faces,
+                 "fvar sizes: width %d, %d cage values, %d values", fs.width, fs.num_cage_values,
+                 fs.num_values);
+        size_t nf4 = 4 * (size_t)z->num_faces;
+        double *out = malloc(sizeof(double) * (size_t)width * (size_t)fs.num_values);
+        int32_t *fvv = malloc(sizeof(int32_t) * nf4), *fvv2 = malloc(sizeof(int32_t) * nf4);
+        FZ_CHECK(out && fvv && fvv2, "harness out of memory");
+        fz_err_init(&e);
+        st = ccn_plan_evaluate_fvar(plan, id, NULL, out, fvv, &e);
+        fz_check_status(st, &e, "ccn_plan_evaluate_fvar");
+        FZ_CHECK(st == CCN_OK, "evaluate_fvar: %d %s", (int)st, e.message);
+        fz_check_finite(out, (size_t)width * (size_t)fs.num_values, "limit value");
+        for (size_t i = 0; i < nf4; i++)
+            FZ_CHECK(fvv[i] >= 0 && fvv[i] < fs.num_values, "face value %d of %d", fvv[i], fs.num_values);
+        for (int32_t k = 0; k < width * nvals; k++) vals[k] = 0.5 * vals[k] + 1.0;
+        fz_err_init(&e);
+        st = ccn_plan_evaluate_fvar(plan, id, vals, out, fvv2, &e);
+        fz_check_status(st, &e, "ccn_plan_evaluate_fvar(values)");
+        FZ_CHECK(st == CCN_OK, "evaluate_fvar(values): %d %s", (int)st, e.message);
+        fz_check_finite(out, (size_t)width * (size_t)fs.num_values, "limit value");
+        FZ_CHECK(memcmp(fvv, fvv2, sizeof(int32_t) * nf4) == 0, "face values changed");
+        free(out); free(fvv); free(fvv2);
+    }
+    /* per-vertex data: the cage's x coordinate and a constant (affine: stays within range) */
+    double *vd = malloc(sizeof(double) * 2 * (size_t)(c->num_verts + 1));
+    double *vo = malloc(sizeof(double) * 2 * (size_t)(z->num_verts + 1));
+    FZ_CHECK(vd && vo, "harness out of memory");
+    int vbad = 0;
+    for (int32_t v = 0; v < c->num_verts; v++) {
+        vd[2 * v] = c->positions[3 * (size_t)v];
+        vd[2 * v + 1] = 1.0;
+        vbad |= !isfinite(vd[2 * v]) || fabs(vd[2 * v]) > FZ_HUGE;
+    }
+    fz_err_init(&e);
+    st = ccn_plan_evaluate_vertex_data(plan, 2, vd, vo, &e);
+    fz_check_status(st, &e, "ccn_plan_evaluate_vertex_data");
+    if (!vbad) {
+        FZ_CHECK(st == CCN_OK || st == CCN_ERR_MEMORY, "vertex data: %d %s", (int)st, e.message);
+        if (st == CCN_OK) {
+            fz_check_finite(vo, 2 * (size_t)z->num_verts, "vertex data");
+            for (int32_t v = 0; v < z->num_verts; v++)
+                FZ_CHECK(fabs(vo[2 * v + 1] - 1.0) <= 1e-9, "a constant gave %.17g", vo[2 * v + 1]);
+        }
+    }
+    free(vd); free(vo); free(idx); free(vals);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -190,6 +273,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     fz_check_status(st, &e, "ccn_plan_evaluate(NULL out)");
     FZ_CHECK(st == CCN_ERR_ARGUMENT, "NULL out gave %d", (int)st);
 
+    fvar_stage(plan, &c, &z, &r);
     free(p2); free(pos1); free(pos); free(nrm); free(fv); free(fo); free(fv2); free(fo2);
     ccn_plan_destroy(plan);
     return 0;
