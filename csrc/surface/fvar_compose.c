@@ -15,7 +15,7 @@
  * The weights are those evaluation would apply, summed in another order (a few ulps); each
  * stencil's weights must sum to 1 (affine invariance), which checks the neighbourhood bound.
  * Evaluation is then one sparse product per channel, and the levels are freed. Mode ALL
- * (bilinear) composes the same way from its level-L values.
+ * (bilinear) at level 0 composes the same way from its level-0 values.
  *
  * Outputs on a cage face whose value mesh is a regular grid around it get their weights
  * written down instead (the bicubic B-spline patch, surface/fvar_direct.c); the probes then
@@ -23,12 +23,8 @@
  * the other faces (surface/fvar_probe.c). When every face's are written down, levels 1..L are
  * only numbered (numbered()).
  *
- * Mode ALL (every value linear: OpenSubdiv's FVAR_LINEAR_ALL) refines bilinearly (face points
- * the average, edge points the midpoint), and a bilinear limit is the level-L value itself: the
- * output at (u, v) of the level-1 quad (V_k, E(h_k), F, E(h_k-1)) of cage face f is the bilinear
- * interpolation of c_k, (c_k + c_k+1)/2, the average of f's n corners and (c_k-1 + c_k)/2
- * (bilinear_rows()), so its weights are written down for every face too (from level 1 on; the
- * probed weights are the same numbers summed in another order, a few ulps).
+ * Mode ALL from level 1 on is written down for every face (surface/fvar_bilinear.c); the rows'
+ * last step, over the caller's values, is surface/fvar_rows.c's.
  */
 #include "surface/fvar_compose.h"
 
@@ -36,8 +32,10 @@
 #include "base/parallel.h"
 #include "refine/fvar.h"
 #include "rules/crease.h"
+#include "surface/fvar_bilinear.h"
 #include "surface/fvar_direct.h"
 #include "surface/fvar_probe.h"
+#include "surface/fvar_rows.h"
 #include "surface/limit.h"
 
 #include <math.h>
@@ -58,13 +56,6 @@ static void builder_free(builder *c) {
     for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
     free(c->pl);
     memset(c, 0, sizeof *c);
-}
-
-void ccn__fvar_stencils_free(ccn__fvar_stencils *s) {
-    if (!s) return;
-    free(s->start); free(s->idx); free(s->w); free(s->face_values);
-    free(s->dface); free(s->dab); free(s->dvals); free(s->dN);
-    memset(s, 0, sizeof *s);
 }
 
 /* ---- the channel's levels and limit stencils -------------------------------------------- */
@@ -272,33 +263,8 @@ done:
     return st;
 }
 
-/* The cage face a level-L value vertex lies on, through its corner h, and its grid point
- * there, a + (b << 16) in level-L face sizes, when that face is a quad: each level's face is
- * the child quad (V_j, E(h_j), F, E(h_j-1)) at corner j of its parent (refine/level.c), a
- * quarter of the parent's square. Integers: (x, y) in level-L face sizes within a face of side
- * z, so the parent's is (2 z c_0 + x (c_1 - c_0) + y (c_-1 - c_0)) with side 2 z. */
-static int32_t origin_at(const ccn_plan *p, int32_t h, int32_t stop, int32_t *ab) {
-    static const int32_t C[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    const ccn_mesh *mL = p->lev[p->L]; /* the value mesh's faces and corners are the vertices' */
-    int32_t g = mL->hface[h], j = h - mL->fstart[g];
-    int32_t x = C[j & 3][0], y = C[j & 3][1], z = 1;
-    for (int32_t l = p->L; l > stop; l--) {
-        const ccn_mesh *m = p->lev[l - 1];
-        int32_t f = m->hface[g], k = g - m->fstart[f];
-        if (ccn__fsize(m, f) == 4) {
-            const int32_t *c0 = C[k], *c1 = C[(k + 1) & 3], *cm = C[(k + 3) & 3];
-            int32_t nx = 2 * z * c0[0] + x * (c1[0] - c0[0]) + y * (cm[0] - c0[0]);
-            int32_t ny = 2 * z * c0[1] + x * (c1[1] - c0[1]) + y * (cm[1] - c0[1]);
-            x = nx; y = ny; z *= 2;
-        }
-        g = f;
-    }
-    int32_t sc = (1 << (p->L - stop)) / z;
-    *ab = x * sc + ((y * sc) << 16);
-    return g;
-}
 
-static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) { return origin_at(p, h, 0, ab); }
+static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) { return ccn__fvar_origin_at(p, h, 0, ab); }
 
 typedef struct { const ccn_plan *p; builder *c; } origin_job;
 
@@ -307,7 +273,7 @@ static void origin1_range(void *ctx, int32_t b, int32_t end) {
     builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
     for (int32_t o = b; o < end; o++)
-        c->d1[o] = c->direct[o] ? -1 : origin_at(j->p, mL->vfan[mL->vfan_start[o]], 1, &c->d1ab[o]);
+        c->d1[o] = c->direct[o] ? -1 : ccn__fvar_origin_at(j->p, mL->vfan[mL->vfan_start[o]], 1, &c->d1ab[o]);
 }
 
 /* The probed outputs that lie in a level-1 face whose block is regular at level 1 (the level-L
@@ -527,35 +493,6 @@ static void cand_range(void *ctx, int32_t b, int32_t end) {
     }
 }
 
-typedef struct { ccn__fvar_stencils *s; const int32_t *value_of; int32_t *len; double *sum; int unique; } merge_job;
-
-/* Row o in place: zero weights dropped, value vertices -> the caller's values (summed where two
- * value vertices carry one value); len[o] its new length, -1 if the weights do not sum to 1. */
-static void merge_range(void *ctx, int32_t b, int32_t end) {
-    const merge_job *j = ctx;
-    int32_t *idx = j->s->idx;
-    double *w = j->s->w;
-    for (int32_t o = b; o < end; o++) {
-        int32_t first = j->s->start[o], n = first;
-        double sum = 0.0;
-        if (j->s->dface && j->s->dface[o] >= 0) { /* a regular face's point: no row */
-            j->len[o] = 0;
-            j->sum[o] = 1.0;
-            continue;
-        }
-        for (int32_t e = first; e < j->s->start[o + 1]; e++) {
-            double we = w[e];
-            if (we == 0.0) continue;
-            sum += we;
-            int32_t val = j->value_of[idx[e]], q = j->unique ? n : first;
-            while (q < n && idx[q] != val) q++;
-            if (q < n) w[q] += we;
-            else { idx[n] = val; w[n++] = we; }
-        }
-        j->len[o] = fabs(sum - 1.0) <= 1e-9 ? n - first : -1;
-        j->sum[o] = sum;
-    }
-}
 
 typedef struct { const builder *c; ccn__fvar_stencils *s; const int32_t *compact; int32_t *bad; } table_job;
 
@@ -605,54 +542,6 @@ static ccn_status direct_tables(const ccn_plan *p, builder *c, ccn__fvar_stencil
     return st;
 }
 
-/* The rows in place: zero weights dropped, value vertices -> the caller's values (a value on two
- * value vertices once), and every stencil sums to 1; each row within its own entries (in
- * parallel), then the rows moved together. */
-static ccn_status finish_rows(const ccn_plan *p, const builder *c, ccn__fvar_stencils *s, ccn_error *err) {
-    const ccn_mesh *m0 = c->lev[0].m;
-    int32_t nout = s->nout;
-    ccn_status st = CCN_OK;
-    int32_t *len = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1));
-    double *sums = malloc(sizeof(double) * (size_t)(nout ? nout : 1));
-    if (!len || !sums) {
-        free(len); free(sums);
-        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-    }
-    /* a row's candidates are distinct value vertices: they need merging only where two value
-     * vertices carry one of the caller's values */
-    int32_t maxval = 0;
-    for (int32_t v = 0; v < m0->nv; v++) if (c->value_of[v] > maxval) maxval = c->value_of[v];
-    uint8_t *used = calloc((size_t)maxval + 1, 1);
-    int unique = used != NULL;
-    for (int32_t v = 0; unique && v < m0->nv; v++) unique = !used[c->value_of[v]]++;
-    free(used);
-    merge_job mj = {s, c->value_of, len, sums, unique};
-    ccn__parallel_for(p->threads, nout, merge_range, &mj);
-    int32_t n = 0;
-    for (int32_t o = 0; o < nout && !st; o++) {
-        int32_t e0 = s->start[o], k = len[o];
-        if (k < 0) { /* weight outside the neighbourhood: cannot happen */
-            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
-                           "face-varying stencil of output value %d sums to %.17g", (int)o, sums[o]);
-            break;
-        }
-        if (n != e0) {
-            memmove(s->idx + n, s->idx + e0, sizeof(int32_t) * (size_t)k);
-            memmove(s->w + n, s->w + e0, sizeof(double) * (size_t)k);
-        }
-        s->start[o] = n;
-        n += k;
-    }
-    free(len); free(sums);
-    s->start[nout] = n;
-    if (!st) {
-        int32_t *a = realloc(s->idx, sizeof(int32_t) * (size_t)(n ? n : 1));
-        double *b = realloc(s->w, sizeof(double) * (size_t)(n ? n : 1));
-        if (a) s->idx = a;
-        if (b) s->w = b;
-    }
-    return st;
-}
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m;
@@ -706,76 +595,12 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     }
     free(kperm); free(kcol);
     kperm = kcol = NULL;
-    st = finish_rows(p, c, s, err);
+    st = ccn__fvar_finish_rows(p->threads, c->value_of, c->lev[0].m->nv, s, err);
 done:
     free(K.start); free(K.list); free(col); free(kperm); free(kcol);
     return st;
 }
 
-/* Mode ALL from level 1 on (the file comment): output o's row is the bilinear weights of its
- * cage face's corners at its grid point (u, v) in its level-1 quad k, over the value vertices
- * of those corners (finish_rows maps them to the caller's values). */
-typedef struct { const ccn_plan *p; const builder *c; ccn__fvar_stencils *s; int32_t *g, *ab; } bilinear_job;
-
-static void bilinear_origin_range(void *ctx, int32_t b, int32_t end) {
-    const bilinear_job *j = ctx;
-    for (int32_t o = b; o < end; o++) j->g[o] = origin_at(j->p, j->c->firstL[o], 1, &j->ab[o]);
-}
-
-static void bilinear_range(void *ctx, int32_t b, int32_t end) {
-    const bilinear_job *j = ctx;
-    const ccn_mesh *m0 = j->c->lev[0].m; /* the value mesh: the cage's faces and corners */
-    double side = (double)(1 << (j->c->L - 1));
-    for (int32_t o = b; o < end; o++) {
-        int32_t g = j->g[o], f = m0->hface[g], f0 = m0->fstart[f], n = m0->fstart[f + 1] - f0;
-        int32_t k = g - f0, next = (k + 1) % n, prev = (k + n - 1) % n, e = j->s->start[o];
-        double u = (j->ab[o] & 0xffff) / side, v = (j->ab[o] >> 16) / side;
-        double a00 = (1.0 - u) * (1.0 - v), a10 = u * (1.0 - v), a11 = u * v, a01 = (1.0 - u) * v;
-        for (int32_t i = 0; i < n; i++) { /* V_k, E(h_k), F, E(h_k-1) at (0,0), (1,0), (1,1), (0,1) */
-            double w = a11 / n;
-            if (i == k) w += a00 + 0.5 * a10 + 0.5 * a01;
-            if (i == next) w += 0.5 * a10;
-            if (i == prev) w += 0.5 * a01;
-            j->s->idx[e + i] = m0->hvert[f0 + i];
-            j->s->w[e + i] = w;
-        }
-    }
-}
-
-static ccn_status bilinear_rows(const ccn_plan *p, const builder *c, ccn__fvar_stencils *s, ccn_error *err) {
-    const ccn_mesh *m0 = c->lev[0].m;
-    int32_t nout = s->nout;
-    bilinear_job j = {p, c, s, malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1)),
-                      malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1))};
-    s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
-    ccn_status st = CCN_OK;
-    if (!j.g || !j.ab || !s->start) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-        goto done;
-    }
-    ccn__parallel_for(p->threads, nout, bilinear_origin_range, &j);
-    int64_t total = 0;
-    s->start[0] = 0;
-    for (int32_t o = 0; o < nout; o++) {
-        total += ccn__fsize(m0, m0->hface[j.g[o]]);
-        if (total > INT32_MAX) {
-            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large");
-            goto done;
-        }
-        s->start[o + 1] = (int32_t)total;
-    }
-    s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
-    s->w = malloc(sizeof(double) * (size_t)(total ? total : 1));
-    if (!s->idx || !s->w) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
-        goto done;
-    }
-    ccn__parallel_for(p->threads, nout, bilinear_range, &j);
-    st = finish_rows(p, c, s, err);
-done:
-    free(j.g); free(j.ab);
-    return st;
-}
 
 ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn__fvar_stencils *s,
                              ccn_error *err) {
@@ -798,7 +623,7 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
         if (!s->face_values) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         else memcpy(s->face_values, mL->hvert, sizeof(int32_t) * (size_t)mL->nh);
     }
-    if (!st) st = c.numbered_only && c.bilinear ? bilinear_rows(p, &c, s, err) : compose(p, &c, s, err);
+    if (!st) st = c.numbered_only && c.bilinear ? ccn__fvar_bilinear_rows(p, &c, s, err) : compose(p, &c, s, err);
     builder_free(&c);
     if (st) ccn__fvar_stencils_free(s);
     return st;

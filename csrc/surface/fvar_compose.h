@@ -2,28 +2,13 @@
 #ifndef CCN_SURFACE_FVAR_COMPOSE_H
 #define CCN_SURFACE_FVAR_COMPOSE_H
 
+#include "surface/fvar_rows.h"
 #include "surface/plan_types.h"
 
-/* Each output value (a level-L value vertex) as weights over the channel's cage values: a CSR
- * row, or on a regular cage face (surface/fvar_direct.c) the face's bicubic patch at a grid
- * point, N_i(u_a) N_j(v_b) over its 16 values with the basis functions tabulated per face. */
-typedef struct {
-    int32_t nout;           /* output values */
-    int32_t *start, *idx;   /* CSR, nout + 1 offsets; idx: the caller's value indices */
-    double *w;
-    int32_t *dface;         /* nout or NULL: the output's regular face (below), -1: its CSR row */
-    int32_t *dab;           /* nout: grid point a + (b << 16) on that face, a, b in 0..side-1 */
-    int32_t nd, side;       /* regular faces; grid points per side (2^L + 1) */
-    int32_t *dvals;         /* 16 per regular face: the caller's value at P_ij, i + 4 j */
-    double *dN;             /* 8 * side per regular face: N_0..3(u_a), then N_0..3(v_b) */
-    int32_t *face_values;   /* 4 * num_faces: the output value of each output face corner */
-    int32_t num_seams, num_sharp;
-} ccn__fvar_stencils;
 
 /* Builds the channel's value levels and limit stencils (refine/fvar.c, surface/limit.c), composes
  * them into stencils over the cage values, and frees the levels. */
 ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn__fvar_stencils *out,
                              ccn_error *err);
-void ccn__fvar_stencils_free(ccn__fvar_stencils *s);
 
 #endif
