@@ -19,8 +19,8 @@
 * Edge attributes (any type, e.g. 4.x's `bevel_weight_edge`) and UV seams: each limit edge that
   lies on a cage edge gets that edge's value, the edges inside cage faces none (0 / False), as
   on Subdivision Surface's result (corner_edge_origin).
-Not carried: `sharp_edge` (the limit's normals are set by Normals), corner attributes of integer or boolean type, point attributes of
-integer or boolean type, Blender's internal layers (names starting with "."), position, the tap
+Not carried: point and corner attributes of integer or boolean type, `sharp_edge` (the limit's
+normals are set by Normals), Blender's internal layers (names starting with "."), position, the tap
 marker, creases, `sharp_face` (the limit is shaded smooth, its normals set by Normals) and
 `material_index` (proxies.py copies it). UVs and attributes do not depend on positions: a move
 rewrites neither. All bulk data goes through foreach_get / foreach_set and numpy.
