@@ -68,8 +68,8 @@ static double beyond_creased(const ccn_mesh *m, int32_t v, int32_t k, int pinned
 double ccn__beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
     if (m->esharp) return beyond_creased(m, v, k, pinned);
     int32_t n = ccn__valence(m, v);
-    int32_t e = ccn__fan_edge(m, v, k);
     if (m->vboundary[v]) {
+        int32_t e = ccn__fan_edge(m, v, k);
         if (k != 0 && k != n - 1) return m->eknot[e];
         if (pinned && n == 2) return m->eknot[e];
         return m->eknot[ccn__fan_edge(m, v, k == 0 ? n - 1 : 0)];

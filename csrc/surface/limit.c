@@ -64,13 +64,17 @@ static int32_t fan_diag(const ccn_mesh *m, int32_t v, int32_t k) {
     int32_t h = m->vfan[m->vfan_start[v] + k];
     return m->hvert[ccn__next(m, ccn__next(m, h))];
 }
-/* Interval straight beyond the end of fan edge k (away from v). */
+/* Interval straight beyond the end of fan edge k (away from v): the far end and the edge's
+ * place in its fan through the twin where there is one. */
 static double beyond_end(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
     int32_t nfan = m->vfan_start[v + 1] - m->vfan_start[v];
-    int32_t end = fan_end(m, v, k), pos;
-    if (k < nfan) pos = ccn__pos_at_end(m, m->vfan[m->vfan_start[v] + k]);
-    else pos = 0; /* the incoming boundary edge is its origin's outgoing boundary edge */
-    return ccn__beyond(m, end, pos, pinned);
+    if (k < nfan) {
+        int32_t h = m->vfan[m->vfan_start[v] + k], t = m->htwin[h];
+        if (t >= 0) return ccn__beyond(m, m->hvert[t], m->hfanpos[t], pinned);
+        return ccn__beyond(m, fan_end(m, v, k), ccn__pos_at_end(m, h), pinned);
+    }
+    /* the incoming boundary edge is its origin's outgoing boundary edge */
+    return ccn__beyond(m, fan_end(m, v, k), 0, pinned);
 }
 
 /* Tensor stencil over a 3x3 grid of virtual points g[i+1][j+1], i along u, j along v. */
@@ -184,17 +188,6 @@ void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn_
     g->dv[0] = sl[3] >= 0 ? beyond_end(m, v, sl[3], pinned) : e1;
 }
 
-/* beyond_end for fan edge k of an interior vertex v: where the far end w is itself an interior
- * valence-4 vertex of an uncreased mesh, the interval of w's spoke opposite the edge, which is
- * what ccn__beyond returns there (the same look-up, without its general cases). */
-static double interior_beyond(const ccn_mesh *m, int32_t v, int32_t k, int pinned) {
-    int32_t t = m->htwin[m->vfan[m->vfan_start[v] + k]], w = m->hvert[t];
-    int32_t ws = m->vfan_start[w];
-    if (!m->esharp && !m->vboundary[w] && m->vfan_start[w + 1] - ws == 4)
-        return m->eknot[m->hedge[m->vfan[ws + ((m->hfanpos[t] + 2) & 3)]]];
-    return beyond_end(m, v, k, pinned);
-}
-
 /* An interior valence-4 vertex (most outputs): the grid of ccn__vertex_grid with +u along fan
  * edge 0 (no ghosts, no sectors: its edges are smooth), its weights in tensor_stencil's order
  * and arithmetic (the same numbers); 0 when two grid points are one vertex (a tiny closed
@@ -208,10 +201,10 @@ static int interior_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stenc
     for (int a = 1; a < 9; a++)
         for (int b = 0; b < a; b++) dup |= gv[a] == gv[b];
     if (dup) return 0;
-    double du[4] = {interior_beyond(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
-                    m->eknot[ccn__fan_edge(m, v, 0)], interior_beyond(m, v, 0, pinned)};
-    double dv[4] = {interior_beyond(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
-                    m->eknot[ccn__fan_edge(m, v, 1)], interior_beyond(m, v, 1, pinned)};
+    double du[4] = {beyond_end(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
+                    m->eknot[ccn__fan_edge(m, v, 0)], beyond_end(m, v, 0, pinned)};
+    double dv[4] = {beyond_end(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
+                    m->eknot[ccn__fan_edge(m, v, 1)], beyond_end(m, v, 1, pinned)};
     double wu[3], dwu[3], wv[3], dwv[3];
     ccn__curve_limit_weights(du[0], du[1], du[2], du[3], wu, dwu);
     ccn__curve_limit_weights(dv[0], dv[1], dv[2], dv[3], wv, dwv);
