@@ -405,6 +405,7 @@ static ccn_status numbered(const ccn_plan *p, builder *c, ccn_error *err) {
     free(cnt); free(he); free(ev);
     c->hvL = hv;
     c->nvL = nv;
+    if (c->bilinear) nsharp = nv; /* ALL: every point is kept sharp (refine/fvar.c) */
     c->nsharpL = nsharp > INT32_MAX ? INT32_MAX : (int32_t)nsharp;
     if (st) return st;
     c->fo = malloc(sizeof(int32_t) * (size_t)(nv ? nv : 1));
@@ -611,7 +612,7 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
     if (!st && c.numbered_only) { /* level L's numbering is all that was made */
         s->nout = c.nvL;
         s->num_seams = c.lev[0].num_seams;
-        s->num_sharp = c.bilinear ? c.nvL : c.nsharpL; /* ALL: every value is kept sharp */
+        s->num_sharp = c.nsharpL;
         s->face_values = c.hvL;
         c.hvL = NULL;
     } else if (!st) {
