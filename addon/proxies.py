@@ -11,7 +11,7 @@ written as it is (never rebuilt by saving).
 import bpy
 import numpy as np
 
-from . import compat, idmem
+from . import attrs, compat, idmem
 
 EMPTY_NAME = ".CCNURBS empty"
 KEY_PROP = "ccnurbs_key"
@@ -44,27 +44,13 @@ def write_normals(me, res, exact):
 
 def write_creases(me, res, cage):
     """The cage's edge creases on the limit mesh's edges that lie on creased cage edges
-    (corner_edge_origin), so a crease survives Apply as on Subdivision Surface's result."""
+    (attrs.edge_origin), so a crease survives Apply as on Subdivision Surface's result."""
     if cage.edge_creases is None or not np.any(cage.edge_creases > 0) or "corner_edge_origin" not in res:
         return
-    fs = np.asarray(cage.face_sizes, np.int64)
-    fv = np.asarray(cage.face_verts, np.int64)
-    start = np.repeat(np.cumsum(fs) - fs, fs)
-    nxt = np.arange(len(fv)) + 1
-    nxt = np.where(nxt - start >= np.repeat(fs, fs), start, nxt)  # the face's next corner
-    a, b = np.minimum(fv, fv[nxt]), np.maximum(fv, fv[nxt])
-    ev = np.asarray(cage.edge_verts, np.int64).reshape(-1, 2)
-    nvk = int(max(fv.max(), ev.max())) + 1
-    ekey = np.minimum(ev[:, 0], ev[:, 1]) * nvk + np.maximum(ev[:, 0], ev[:, 1])
-    order = np.argsort(ekey)
-    pos = np.searchsorted(ekey[order], a * nvk + b).clip(0, len(ekey) - 1)
-    corner_crease = np.where(ekey[order][pos] == a * nvk + b, cage.edge_creases[order][pos], 0.0)
-    origin = res["corner_edge_origin"].ravel()
-    loop_edge = np.empty(len(me.loops), np.int32)
-    compat.get_array(me, "corner_edges", loop_edge)
+    edge_from = attrs.edge_origin(me, res["corner_edge_origin"], cage.loop_edges)
     out = np.zeros(len(me.edges), np.float32)
-    on = origin >= 0
-    np.maximum.at(out, loop_edge[on], corner_crease[origin[on]].astype(np.float32))
+    on = edge_from >= 0
+    out[on] = np.maximum(cage.edge_creases[edge_from[on]], 0.0)
     compat.set_edge_creases(me, out)
 
 
