@@ -263,7 +263,6 @@ done:
     return st;
 }
 
-
 static int32_t origin(const ccn_plan *p, int32_t h, int32_t *ab) { return ccn__fvar_origin_at(p, h, 0, ab); }
 
 typedef struct { const ccn_plan *p; builder *c; } origin_job;
@@ -494,7 +493,6 @@ static void cand_range(void *ctx, int32_t b, int32_t end) {
     }
 }
 
-
 typedef struct { const builder *c; ccn__fvar_stencils *s; const int32_t *compact; int32_t *bad; } table_job;
 
 static void table_range(void *ctx, int32_t b, int32_t e) {
@@ -542,7 +540,6 @@ static ccn_status direct_tables(const ccn_plan *p, builder *c, ccn__fvar_stencil
     free(bad);
     return st;
 }
-
 
 static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, ccn_error *err) {
     const ccn_mesh *m0 = c->lev[0].m;
@@ -601,7 +598,6 @@ done:
     free(K.start); free(K.list); free(col); free(kperm); free(kcol);
     return st;
 }
-
 
 ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn__fvar_stencils *s,
                              ccn_error *err) {
