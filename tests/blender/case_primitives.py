@@ -36,17 +36,39 @@ STACKS = (
 NON_MANIFOLD = {("monkey", "TRIANGULATE"), ("monkey", "DECIMATE")}
 
 
+def has_boundary_corner(me):
+    """A boundary vertex with two edges: OpenSubdiv (and so Subdivision Surface) makes it an
+    infinitely sharp corner, whose neighbourhood its patch table only approximates, better with
+    each isolation level (Quality)."""
+    ne = len(me.edges)
+    ev = np.zeros(2 * ne, np.int64)
+    me.edges.foreach_get("vertices", ev)
+    le = np.zeros(len(me.loops), np.int64)
+    me.loops.foreach_get("edge_index", le)
+    faces_per_edge = np.bincount(le, minlength=ne)
+    edges_per_vert = np.bincount(ev, minlength=len(me.vertices))
+    on_boundary = np.zeros(len(me.vertices), bool)
+    on_boundary[ev.reshape(-1, 2)[faces_per_edge == 1].ravel()] = True
+    return bool((on_boundary & (edges_per_vert == 2)).any())
+
+
 def subsurf_of(ob, levels):
-    """Blender's limit of the same object: CCNURBS replaced by Subdivision Surface."""
+    """Blender's limit of the same object: CCNURBS replaced by Subdivision Surface. Quality 10
+    (converged) where the cage the stack above makes has a boundary corner; elsewhere Quality
+    4, isolating beyond level 2 around each extraordinary vertex (measured on 3.4: worst 3.65e-7
+    of size at 4, 3.60e-7 at 10; with 3 every corner-free primitive x stack is still within
+    TOL, the grid and the filled circle are 5.5e-4 off), at 18 s instead of 45 s a run."""
     cp = ob.copy()
     cp.data = ob.data.copy()
     bpy.context.scene.collection.objects.link(cp)
     cp.modifiers.remove(ccn.modifier.get_modifier(cp))
     cp.ccnurbs.role = 'NONE'
+    cage = cp.evaluated_get(update()).data
+    quality = case_creases.QUALITY if has_boundary_corner(cage) else 4
     m = cp.modifiers.new("Subsurf", 'SUBSURF')
     m.levels = levels
     m.use_limit_surface = True
-    m.quality = case_creases.QUALITY
+    m.quality = quality
     P = evaluated_positions(cp)
     bpy.data.objects.remove(cp)
     return P

@@ -12,6 +12,7 @@ then runs the case_*.py modules in order; TestZ* last. Prints "N passed, N faile
 """
 import os
 import sys
+import time
 import unittest
 
 import bpy
@@ -33,6 +34,16 @@ class _Result(unittest.TestResult):
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
         self.rows = []
+        self.secs = {}  # test id -> wall seconds (printed with its line: the slow ones show)
+        self._t0 = 0.0
+
+    def startTest(self, test):
+        super().startTest(test)
+        self._t0 = time.perf_counter()
+
+    def stopTest(self, test):
+        self.secs[test.id()] = time.perf_counter() - self._t0
+        super().stopTest(test)
 
     def addSuccess(self, test):
         super().addSuccess(test)
@@ -75,7 +86,8 @@ def main():
         name = test.id().replace("__main__.", "")
         if kind == "ok" and test.id() in failed_ids:
             continue  # a test with a failing subtest is reported as failing
-        print("%-5s %s" % (kind, name))
+        secs = result.secs.get(test.id())
+        print("%-5s %s%s" % (kind, name, " (%.1f s)" % secs if secs is not None else ""))
         if tb:
             print("      " + tb.rstrip().replace("\n", "\n      "))
     failed = len({t.id() for k, t, _ in result.rows if k != "ok"} |

@@ -253,10 +253,15 @@ static void report(const char *what, const cap_stats *st) {
     CHECK(st->surround <= 1e-9, "%s: ring 0 / surround C2 %g", what, st->surround);
 }
 
+/* the number of random fans per test: 140, or 28 (every valence, both parities) in the
+ * sanitizer run (CCN_TEST_SMALL), where the paths matter and the plain build checks the figures */
+static int fan_cases(void) { return getenv("CCN_TEST_SMALL") ? 28 : 140; }
+
 static void test_random_fans(void) {
     static const int valences[] = {3, 5, 6, 7, 8, 10, 16};
     cap_stats st = {0};
-    for (int k = 0; k < 140; k++) {
+    int ncases = fan_cases();
+    for (int k = 0; k < ncases; k++) {
         cage_buf c;
         make_fan(valences[k % 7], 0.3, &c);
         ccn_cage cage = {0};
@@ -265,7 +270,9 @@ static void test_random_fans(void) {
         compare_cage(&cage, 3 + k % 2, &st); /* levels above K = 2: no cap is built at L <= K */
         free(c.pos); free(c.fv); free(c.fs);
     }
-    report("140 random fans", &st);
+    char what[64];
+    snprintf(what, sizeof what, "%d random fans", ncases);
+    report(what, &st);
 }
 
 
@@ -365,8 +372,8 @@ static void test_nonuniform_period4(void) {
 static void test_nonuniform_general(void) {
     static const int valences[] = {3, 5, 6, 7, 8, 10, 16};
     cap_stats st = {0};
-    int fallbacks = 0, cases = 0;
-    for (int k = 0; k < 140; k++) {
+    int fallbacks = 0, cases = 0, ncases = fan_cases();
+    for (int k = 0; k < ncases; k++) {
         int n = valences[k % 7];
         cage_buf c;
         make_fan(n, 0.3, &c);
@@ -394,7 +401,9 @@ static void test_nonuniform_general(void) {
     /* G1 is what the cap promises; with non-uniform spokes the sectors' curvatures at the centre
      * agree only approximately (the centre's cubic expansion is fitted, not interpolated) */
     st.tol_curv = 1e-3;
-    report("140 fans, intervals 1 +- 0.02 or alternating 1, r (r in [0.5, 2])", &st);
+    char what[96];
+    snprintf(what, sizeof what, "%d fans, intervals 1 +- 0.02 or alternating 1, r (r in [0.5, 2])", ncases);
+    report(what, &st);
     CHECK(fallbacks == 0, "%d of %d cages fell back", fallbacks, cases);
     CHECK(st.surround_caps == cases, "%d of %d caps on the exact surround", st.surround_caps, cases);
 }

@@ -438,17 +438,32 @@ static ccn_mesh *refine_data(const mdata *d, double s, int levels) {
     return r;
 }
 
-/* Largest distance from a point of one set to the other set, both ways (n^2: small meshes). */
+/* Largest distance from a point of one set to the other set, both ways: the nearest point is
+ * found exactly by a sweep over the other set sorted by x, stopped once |dx| exceeds the best. */
+static const double *sd_keys;
+static int sd_cmp(const void *a, const void *b) {
+    double x = sd_keys[3 * *(const int *)a], y = sd_keys[3 * *(const int *)b];
+    return (x > y) - (x < y);
+}
 static double set_diff(const double *A, int na, const double *B, int nb) {
     double w = na == nb ? 0 : 1e300;
     for (int pass = 0; pass < 2; pass++) {
         const double *X = pass ? B : A, *Y = pass ? A : B;
         int nx = pass ? nb : na, ny = pass ? na : nb;
+        int *ord = NEW(int, ny > 0 ? ny : 1);
+        for (int j = 0; j < ny; j++) ord[j] = j;
+        sd_keys = Y;
+        qsort(ord, (size_t)ny, sizeof *ord, sd_cmp);
         for (int i = 0; i < nx; i++) {
+            const double *p = X + 3 * i;
+            int lo = 0, hi = ny; /* first index whose x >= p's x */
+            while (lo < hi) { int m = (lo + hi) / 2; if (Y[3 * ord[m]] < p[0]) lo = m + 1; else hi = m; }
             double best = 1e300;
-            for (int j = 0; j < ny; j++) best = fmin(best, dist(X + 3 * i, Y + 3 * j));
+            for (int j = lo; j < ny && Y[3 * ord[j]] - p[0] <= best; j++) best = fmin(best, dist(p, Y + 3 * ord[j]));
+            for (int j = lo - 1; j >= 0 && p[0] - Y[3 * ord[j]] <= best; j--) best = fmin(best, dist(p, Y + 3 * ord[j]));
             w = fmax(w, best);
         }
+        free(ord);
     }
     return w;
 }
@@ -485,14 +500,14 @@ static void test_semisharp_levels(void) {
             ccn_mesh *fs = refine_data(&bd, 10, 1), *fw = refine_data(&bd, 0, 1);
             mdata F = mesh_data(f), S = mesh_data(fs), W = mesh_data(fw);
             double *want = NEW(double, 3 * S.nv);
-            for (int v = 0; v < S.nv; v++) { /* fs and fw share their numbering */
-                int on = 0; /* on the refined crease: an endpoint of a sharp edge of fs */
-                for (int e = 0; e < S.ne && !on; e++) on = S.es[e] > 0 && (S.ev[2 * e] == v || S.ev[2 * e + 1] == v);
+            char *on = calloc((size_t)S.nv, 1); /* on the refined crease: an endpoint of a sharp edge of fs */
+            for (int e = 0; e < S.ne; e++)
+                if (S.es[e] > 0) on[S.ev[2 * e]] = on[S.ev[2 * e + 1]] = 1;
+            for (int v = 0; v < S.nv; v++) /* fs and fw share their numbering */
                 for (int q = 0; q < 3; q++)
-                    want[3 * v + q] = on ? 0.5 * (S.pos[3 * v + q] + W.pos[3 * v + q]) : W.pos[3 * v + q];
-            }
+                    want[3 * v + q] = on[v] ? 0.5 * (S.pos[3 * v + q] + W.pos[3 * v + q]) : W.pos[3 * v + q];
             double e3 = set_diff(F.pos, F.nv, want, S.nv);
-            free(want);
+            free(want); free(on);
             CHECK(e3 <= 1e-14 * bbox(F.pos, F.nv), "s = %d.5: level %d is not the blend (%.3g)", k, k + 1, e3);
             md_free(&F); md_free(&S); md_free(&W); md_free(&bd);
             ccn_mesh_destroy(a); ccn_mesh_destroy(b); ccn_mesh_destroy(c); ccn_mesh_destroy(d);

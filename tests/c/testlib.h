@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static int tl_passed, tl_failed, tl_cur_failed;
 static const char *tl_cur_name;
@@ -25,12 +26,20 @@ static const char *tl_cur_name;
     CHECK(fabs((double)(a) - (double)(b)) <= (tol), "%s: %.17g vs %.17g (tol %g)",   \
           (what), (double)(a), (double)(b), (double)(tol))
 
+static double tl_now(void) {
+    struct timespec t;
+    timespec_get(&t, TIME_UTC);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+/* runs one test; its wall time is printed so the slow ones can be found (issue 15) */
 static void tl_run(const char *name, void (*fn)(void)) {
     tl_cur_name = name;
     tl_cur_failed = 0;
+    double t0 = tl_now();
     fn();
-    if (tl_cur_failed) { tl_failed++; fprintf(stderr, "not ok - %s\n", name); }
-    else { tl_passed++; printf("ok - %s\n", name); }
+    double dt = tl_now() - t0;
+    if (tl_cur_failed) { tl_failed++; fprintf(stderr, "not ok - %s (%.1f s)\n", name, dt); }
+    else { tl_passed++; printf("ok - %s (%.1f s)\n", name, dt); }
 }
 #define RUN(fn) tl_run(#fn, fn)
 #define TEST_SUMMARY() (printf("%d passed, %d failed\n", tl_passed, tl_failed), tl_failed != 0)
