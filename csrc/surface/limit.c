@@ -29,6 +29,7 @@
 #include "base/error.h"
 #include "rules/bspline.h"
 #include "rules/crease.h"
+#include "surface/ev_circulant.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -292,15 +293,42 @@ int32_t ccn__ev_ring(const ccn_mesh *m, int32_t v, int32_t *ring) {
     return 2 * n + 1;
 }
 
+/* G = [l_i . r_j] and the ring polygon's area in the characteristic map (r1, r2; stride rs):
+ * l2 is negated when their signs disagree (the orientation rule of left_eigvecs) */
+static void orient(double *l1, double *l2, const double *r1, const double *r2, size_t rs, int32_t sz) {
+    int32_t n = (sz - 1) / 2;
+    double area = 0, g11 = 0, g12 = 0, g21 = 0, g22 = 0;
+    for (int32_t r = 0; r < sz; r++) {
+        g11 += l1[r] * r1[(size_t)r * rs]; g12 += l1[r] * r2[(size_t)r * rs];
+        g21 += l2[r] * r1[(size_t)r * rs]; g22 += l2[r] * r2[(size_t)r * rs];
+    }
+    for (int32_t k = 0; k < 2 * n; k++) { /* polygon E_0, F_0, E_1, F_1, ... */
+        int32_t a = k & 1 ? k / 2 : n + k / 2, kb = (k + 1) % (2 * n), b = kb & 1 ? kb / 2 : n + kb / 2;
+        area += r1[(size_t)a * rs] * r2[(size_t)b * rs] - r1[(size_t)b * rs] * r2[(size_t)a * rs];
+    }
+    if ((area < 0) != (g11 * g22 - g12 * g21 < 0))
+        for (int32_t r = 0; r < sz; r++) l2[r] = -l2[r];
+}
+
 /* Left eigenvectors of M (sz x sz, row-major; ring order F_0..F_{n-1}, E_0..E_{n-1}, V): l0
  * for eigenvalue 1 (sum 1), l1/l2 spanning the subdominant pair (real pair or real/imaginary
  * parts of a complex pair), l2's sign chosen so that (l1.P) x (l2.P) is the outward normal:
  * the ring polygon E_0, F_0, E_1, ... runs counter-clockwise in the characteristic map (the
  * right eigenvectors r1, r2) and G = [l_i . r_j] has positive determinant (see
- * surface/ring_limit.c), whatever the geometry of the net. */
+ * surface/ring_limit.c), whatever the geometry of the net. From valence
+ * CCN_EV_CIRCULANT_MIN_VALENCE on, a block-circulant M (equal spokes) takes the Fourier path
+ * (surface/ev_circulant.c) instead of dgeev. */
 static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *l1, double *l2,
                                ccn_error *err) {
     size_t s2 = (size_t)sz * sz;
+    if ((sz - 1) / 2 >= CCN_EV_CIRCULANT_MIN_VALENCE) { /* equal spokes: Fourier blocks, O(n^2) */
+        double *r = malloc(sizeof(double) * 2 * (size_t)sz);
+        int got = r ? ccn__ev_circulant_eigvecs(M, (sz - 1) / 2, l0, l1, l2, r, r + sz) : -1;
+        if (got == 0) orient(l1, l2, r, r + sz, 1, sz);
+        free(r);
+        if (got < 0) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
+        if (got == 0) return CCN_OK;
+    }
     double *A = malloc(sizeof(double) * (3 * s2 + 2 * (size_t)sz));
     if (!A) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (EV limit)");
     double *VL = A + s2, *VR = VL + s2, *wr = VR + s2, *wi = wr + sz;
@@ -325,21 +353,13 @@ static ccn_status left_eigvecs(const double *M, int32_t sz, double *l0, double *
     for (int32_t r = 0; r < sz; r++) sum += VL[(size_t)r * sz + i0];
     int cplx = wi[i1] != 0.0;
     if (cplx && wi[i1] < 0) i1 = i1 - 1; /* LAPACK stores a pair as (re, im) columns i, i+1 */
-    int32_t j2 = cplx ? i1 + 1 : i2, n = (sz - 1) / 2;
-    double area = 0, g11 = 0, g12 = 0, g21 = 0, g22 = 0;
+    int32_t j2 = cplx ? i1 + 1 : i2;
     for (int32_t r = 0; r < sz; r++) {
         l0[r] = VL[(size_t)r * sz + i0] / sum;
         l1[r] = VL[(size_t)r * sz + i1];
         l2[r] = VL[(size_t)r * sz + j2];
-        g11 += l1[r] * VR[(size_t)r * sz + i1]; g12 += l1[r] * VR[(size_t)r * sz + j2];
-        g21 += l2[r] * VR[(size_t)r * sz + i1]; g22 += l2[r] * VR[(size_t)r * sz + j2];
     }
-    for (int32_t k = 0; k < 2 * n; k++) { /* polygon E_0, F_0, E_1, F_1, ... */
-        int32_t a = k & 1 ? k / 2 : n + k / 2, kb = (k + 1) % (2 * n), b = kb & 1 ? kb / 2 : n + kb / 2;
-        area += VR[(size_t)a * sz + i1] * VR[(size_t)b * sz + j2] - VR[(size_t)b * sz + i1] * VR[(size_t)a * sz + j2];
-    }
-    if ((area < 0) != (g11 * g22 - g12 * g21 < 0))
-        for (int32_t r = 0; r < sz; r++) l2[r] = -l2[r];
+    orient(l1, l2, VR + i1, VR + j2, (size_t)sz, sz);
     free(A);
     if (!(fabs(sum) > 1e-300))
         return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "no eigenvalue 1 in M");

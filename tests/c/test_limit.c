@@ -2,7 +2,10 @@
  * finite differences of positions (and converge), plan reuse equals a fresh plan, argument
  * errors. Positions themselves are checked against OpenSubdiv in tests/oracle/run_limit.sh. */
 #include "ccnurbs.h"
+#include "surface/ev_circulant.h"
 #include "testlib.h"
+
+#include <lapacke.h>
 
 typedef struct { int32_t nv, nf; double *pos, *nrm; int32_t *fv, *origin, *ev, *ce; ccn_sizes s; } limit_mesh;
 
@@ -342,6 +345,113 @@ static void test_nonuniform_finite(void) {
     }
 }
 
+/* High-valence EVs with equal spokes (surface/ev_circulant.c): the Fourier blocks give M's
+ * eigenvectors as LAPACK's dgeev (the oracle, run here) does -- l0 equal, l1 and l2 left
+ * eigenvectors spanning dgeev's subdominant pair -- and unequal spokes are refused (dgeev
+ * stays). Through a plan: a 300-gon cone's apex and cap centre lie on the axis with axial
+ * normals (the symmetry), at levels 1 and 2. */
+static double dot(const double *a, const double *b, int n) {
+    double s = 0;
+    for (int i = 0; i < n; i++) s += a[i] * b[i];
+    return s;
+}
+
+static void check_fourier_vs_dgeev(int n, ccn_scheme scheme) {
+    int sz = 2 * n + 1;
+    double *d = malloc(sizeof(double) * n), *M = malloc(sizeof(double) * sz * sz);
+    double *A = malloc(sizeof(double) * sz * sz), *VL = malloc(sizeof(double) * sz * sz);
+    double *wr = malloc(sizeof(double) * sz), *wi = malloc(sizeof(double) * sz);
+    double *l = malloc(sizeof(double) * 5 * sz), *lm = malloc(sizeof(double) * sz);
+    for (int k = 0; k < n; k++) d[k] = 1;
+    ccn_error err;
+    if (ccn_ev_matrix(n, d, scheme, M, NULL, &err)) { CHECK(0, "ev_matrix n %d: %s", n, err.message); goto done; }
+    double *l0 = l, *l1 = l + sz, *l2 = l + 2 * sz;
+    int got = ccn__ev_circulant_eigvecs(M, n, l0, l1, l2, l + 3 * sz, l + 4 * sz);
+    CHECK(got == 0, "n %d scheme %d: equal spokes take the Fourier path (%d)", n, (int)scheme, got);
+    if (got) goto done;
+    memcpy(A, M, sizeof(double) * sz * sz);
+    if (LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'V', 'N', sz, A, sz, wr, wi, VL, sz, NULL, 1)) { CHECK(0, "dgeev"); goto done; }
+    int i0 = 0, i1 = -1, i2 = -1;
+    for (int i = 1; i < sz; i++)
+        if (fabs(wr[i] - 1) + fabs(wi[i]) < fabs(wr[i0] - 1) + fabs(wi[i0])) i0 = i;
+    for (int i = 0; i < sz; i++) {
+        if (i == i0) continue;
+        double m = hypot(wr[i], wi[i]);
+        if (i1 < 0 || m > hypot(wr[i1], wi[i1])) { i2 = i1; i1 = i; }
+        else if (i2 < 0 || m > hypot(wr[i2], wi[i2])) i2 = i;
+    }
+    double sum = 0, e0 = 0;
+    for (int r = 0; r < sz; r++) sum += VL[r * sz + i0];
+    for (int r = 0; r < sz; r++) e0 = fmax(e0, fabs(VL[r * sz + i0] / sum - l0[r]));
+    CHECK(e0 <= 1e-12, "n %d: l0 %.3g from dgeev's", n, e0);
+    double lam = wr[i1], res = 0, span = 0; /* a real double eigenvalue for these symmetric rules */
+    CHECK(fabs(wi[i1]) < 1e-12 && fabs(wr[i2] - lam) < 1e-10, "n %d: subdominant pair %g%+gi, %g", n, wr[i1], wi[i1], wr[i2]);
+    for (int t = 0; t < 2; t++) {
+        const double *x = t ? l2 : l1;
+        for (int c = 0; c < sz; c++) {
+            double s = 0;
+            for (int r = 0; r < sz; r++) s += x[r] * M[r * sz + c];
+            res = fmax(res, fabs(s - lam * x[c]));
+        }
+    }
+    CHECK(res <= 1e-12, "n %d: l1, l2 M - lambda l %.3g", n, res);
+    double g11 = dot(l1, l1, sz), g12 = dot(l1, l2, sz), g22 = dot(l2, l2, sz), det = g11 * g22 - g12 * g12;
+    CHECK(det > 1e-6 * g11 * g22, "n %d: l1, l2 independent", n);
+    for (int t = 0; t < 2; t++) { /* dgeev's vectors i1, i2 in span(l1, l2) */
+        const double *y = VL + (t ? i2 : i1);
+        double y1 = 0, y2 = 0, yy = 0;
+        for (int r = 0; r < sz; r++) { y1 += y[r * sz] * l1[r]; y2 += y[r * sz] * l2[r]; yy += y[r * sz] * y[r * sz]; }
+        double a = (g22 * y1 - g12 * y2) / det, b = (g11 * y2 - g12 * y1) / det, e = 0;
+        for (int r = 0; r < sz; r++) e = fmax(e, fabs(y[r * sz] - a * l1[r] - b * l2[r]));
+        span = fmax(span, e / sqrt(yy));
+    }
+    CHECK(span <= 1e-10, "n %d: dgeev's pair %.3g outside span(l1, l2)", n, span);
+    d[n / 3] = 1.25; /* one unequal spoke: not circulant (Catmull-Clark's rules ignore it) */
+    if (scheme != CCN_SCHEME_CATMULL_CLARK && !ccn_ev_matrix(n, d, scheme, M, NULL, &err))
+        CHECK(ccn__ev_circulant_eigvecs(M, n, l0, l1, l2, l + 3 * sz, l + 4 * sz) == 1, "n %d: unequal spokes refused", n);
+done:
+    free(d); free(M); free(A); free(VL); free(wr); free(wi); free(l); free(lm);
+}
+
+static void test_high_valence_fourier(void) {
+    static const int ns[] = {16, 17, 24, 40, 64};
+    for (int i = 0; i < 5; i++) {
+        check_fourier_vs_dgeev(ns[i], CCN_SCHEME_CATMULL_CLARK);
+        check_fourier_vs_dgeev(ns[i], CCN_SCHEME_NURSS);
+        check_fourier_vs_dgeev(ns[i], CCN_SCHEME_EIGEN);
+    }
+    enum { N = 300 };
+    static double pos[3 * (N + 1)];
+    static int32_t fs[N + 1], fv[4 * N];
+    for (int i = 0; i < N; i++) {
+        double a = 2 * 3.14159265358979323846 * i / N;
+        pos[3 * i] = cos(a); pos[3 * i + 1] = sin(a); pos[3 * i + 2] = 0;
+        fs[i] = 3; fv[3 * i] = i; fv[3 * i + 1] = (i + 1) % N; fv[3 * i + 2] = N;
+        fv[3 * N + i] = N - 1 - i; /* the cap, seen from below */
+    }
+    pos[3 * N + 2] = 2; fs[N] = N;
+    ccn_cage cage = {0};
+    cage.num_verts = N + 1; cage.num_faces = N + 1; cage.positions = pos; cage.face_sizes = fs; cage.face_verts = fv;
+    for (int L = 1; L <= 2; L++) {
+        ccn_options o = {0};
+        o.levels = L;
+        limit_mesh lm;
+        double t0 = tl_now();
+        if (evaluate(&cage, &o, NULL, &lm)) { CHECK(0, "cone L%d", L); continue; }
+        double dt = tl_now() - t0, ea = 1, ec = 1, na = 1, nc = 1;
+        for (int v = 0; v < lm.nv; v++) {
+            const double *p = lm.pos + 3 * v, *q = lm.nrm + 3 * v;
+            double off = fmax(fabs(p[0]), fabs(p[1])), nerr = fmax(fabs(q[0]), fabs(q[1]));
+            if (p[2] > 1.9) { ea = off; na = nerr + fabs(q[2] - 1); }          /* the apex */
+            if (off < 1e-6 && p[2] < 0.1) { ec = off; nc = nerr + fabs(q[2] + 1); } /* the cap centre */
+        }
+        printf("#   300-gon cone L%d (default options): %.3f s; apex off axis %.1e, normal %.1e; cap centre %.1e, %.1e\n",
+               L, dt, ea, na, ec, nc);
+        CHECK(ea <= 1e-12 && na <= 1e-12 && ec <= 1e-12 && nc <= 1e-12, "cone L%d: apex %g %g, centre %g %g", L, ea, na, ec, nc);
+        free_lm(&lm);
+    }
+}
+
 /* Threads split work into disjoint ranges: bitwise identical output for 1 and 3 threads. */
 static void test_threads_deterministic(void) {
     ccn_cage cage;
@@ -371,5 +481,6 @@ int main(void) {
     RUN(test_plan_reuse);
     RUN(test_plan_arguments);
     RUN(test_nonuniform_finite);
+    RUN(test_high_valence_fourier);
     return TEST_SUMMARY();
 }
