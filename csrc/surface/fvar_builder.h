@@ -9,8 +9,9 @@
 /* The points of one level that the probes compute: those the composed outputs read. */
 typedef struct { int32_t nf, ne, nv, *f, *e, *v; } ccn__fvar_probe_list;
 
-/* The channel's refinement, kept while its stencils are composed. */
-typedef struct {
+/* The channel's refinement, kept while its stencils are composed (and after, for a channel
+ * evaluated through its levels: ccn__fvar_stencils.levels). */
+typedef struct ccn__fvar_builder {
     int32_t L;
     ccn__fvar_level *lev;     /* L + 1 levels */
     ccn__level *prep;         /* L prepared levels */

@@ -43,6 +43,15 @@
 
 typedef ccn__fvar_builder builder;
 
+#define CCN_FVAR_MAX_PASSES 16 /* probe passes (3 colours each) before a channel keeps its levels */
+
+static void builder_free(builder *c);
+
+void ccn__fvar_builder_destroy(builder *c) {
+    builder_free(c);
+    free(c);
+}
+
 static void builder_free(builder *c) {
     for (int32_t l = 0; c->lev && l <= c->L; l++) ccn__fvar_free(&c->lev[l]);
     for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
@@ -476,6 +485,7 @@ typedef struct {
     const ccn__fvar_csr *K; const int32_t *fo, *start, *compact;
     int32_t *idx;
     ccn__fvar_stencils *s;
+    int by_levels;
 } cand_job;
 
 /* The candidates of each output: the value vertices of its cage face's neighbourhood; on a
@@ -488,6 +498,7 @@ static void cand_range(void *ctx, int32_t b, int32_t end) {
             j->s->dface[o] = j->compact[j->fo[o]];
             continue;
         }
+        if (j->by_levels) { j->s->dface[o] = CCN_FVAR_BY_LEVELS; continue; }
         if (j->s->dface) j->s->dface[o] = -1;
         for (int32_t k = j->K->start[j->fo[o]]; k < j->K->start[j->fo[o] + 1]; k++, n++) j->idx[n] = j->K->list[k];
     }
@@ -550,6 +561,11 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     int32_t ncol = -1, *kperm = NULL, *kcol = NULL;
     ccn_status st = CCN_OK;
     if (col && fo && !ccn__fvar_neighbourhoods(m0, c->dir.slot, &K)) ncol = c->nouts ? ccn__fvar_colour(m0, &K, col) : 0;
+    /* a value vertex of high valence puts its whole neighbourhood into every face around it,
+     * each value there needs a colour of its own and the passes grow with the valence (n^2 in
+     * all): beyond CCN_FVAR_MAX_PASSES the probed outputs keep the levels instead and are
+     * evaluated through them (ccn__fvar_levels_evaluate: one pass per evaluation) */
+    int by_levels = c->nouts && ncol > 3 * CCN_FVAR_MAX_PASSES;
     s->start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
     if (ncol < 0 || !s->start) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
@@ -557,7 +573,7 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     }
     /* the candidates: for each output, the value vertices of its cage face's neighbourhood */
     int64_t total = 0;
-    for (int32_t o = 0; o < nout; o++) total += c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]];
+    for (int32_t o = 0; o < nout; o++) total += c->direct[o] || by_levels ? 0 : K.start[fo[o] + 1] - K.start[fo[o]];
     if (total > INT32_MAX) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "face-varying stencils too large"); goto done; }
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     s->w = calloc((size_t)(total ? total : 1), sizeof(double));
@@ -575,16 +591,27 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
         }
     s->start[0] = 0;
     for (int32_t o = 0; o < nout; o++)
-        s->start[o + 1] = s->start[o] + (c->direct[o] ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
+        s->start[o + 1] = s->start[o] + (c->direct[o] || by_levels ? 0 : K.start[fo[o] + 1] - K.start[fo[o]]);
     int32_t *compact = NULL;
     if (c->dir.count > 0 && (st = direct_tables(p, c, s, &compact, err))) { free(compact); goto done; }
-    cand_job cj = {c, &K, fo, s->start, compact, s->idx, s};
+    if (by_levels && !s->dface && !(s->dface = malloc(sizeof(int32_t) * (size_t)(nout ? nout : 1)))) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)");
+        goto done;
+    }
+    cand_job cj = {c, &K, fo, s->start, compact, s->idx, s, by_levels};
     ccn__parallel_for(p->threads, nout, cand_range, &cj);
     free(compact);
     if (c->dir.count > 0 && c->nouts) { /* probes of the other outputs: their points only, the rest zero */
         if (ccn__fvar_probe_lists(c)) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
         for (int32_t l = 1; l <= c->L; l++)
             memset(c->lev[l].m->pos, 0, sizeof(double) * 3 * (size_t)c->lev[l].m->nv);
+    }
+    if (by_levels) { /* the direct rows made final; the builder moves into s */
+        st = ccn__fvar_finish_rows(p->threads, c->value_of, c->lev[0].m->nv, s, err);
+        if (!st && !(s->levels = malloc(sizeof *s->levels)))
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
+        if (!st) { *s->levels = *c; memset(c, 0, sizeof *c); }
+        goto done;
     }
     ccn__fvar_cands cd = {s->start, K.start, kperm, kcol};
     if (ccn__fvar_probe_all(p, c, c->nouts ? (ncol + 2) / 3 : 0, col, &cd, s->w)) {

@@ -17,42 +17,47 @@ typedef struct {
     const builder *c; const double *PL, *PS, *P1; const ccn__fvar_cands *cd; const int32_t *outs; double *cw; int32_t b;
 } limit_job;
 
+/* Output o's limit of the level-L values PL (its level-(L+1) points PS, level 1's P1). */
+static inline void limit_point(const builder *c, int32_t o, const double *PL, const double *PS,
+                               const double *P1, int32_t nvL, double x[3]) {
+    if (c->bilinear) memcpy(x, PL + 3 * (size_t)o, sizeof(double) * 3);
+    else if (c->d1 && c->d1[o] >= 0) { /* the level-1 block's patch (ccn__fvar_builder.d1) */
+        int32_t t = c->d1[o], a1 = c->d1ab[o] & 0xffff, b1 = c->d1ab[o] >> 16;
+        const double *Nu = c->d1N + 8 * (size_t)c->side1 * t + 4 * (size_t)a1;
+        const double *Nv = c->d1N + 8 * (size_t)c->side1 * t + 4 * ((size_t)c->side1 + b1);
+        const int32_t *P = c->d1verts + 16 * (size_t)t;
+        double x0 = 0, x1 = 0, x2 = 0;
+        for (int jj = 0; jj < 4; jj++) {
+            double r0 = 0, r1 = 0, r2 = 0;
+            for (int ii = 0; ii < 4; ii++) {
+                const double *q = P1 + 3 * (size_t)P[ii + 4 * jj];
+                r0 += Nu[ii] * q[0]; r1 += Nu[ii] * q[1]; r2 += Nu[ii] * q[2];
+            }
+            x0 += Nv[jj] * r0; x1 += Nv[jj] * r1; x2 += Nv[jj] * r2;
+        }
+        x[0] = x0; x[1] = x1; x[2] = x2;
+    } else {
+        double x0 = 0, x1 = 0, x2 = 0;
+        for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
+            int32_t i = c->st_v[k];
+            const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
+            double w = c->st_w[k];
+            x0 += w * q[0]; x1 += w * q[1]; x2 += w * q[2];
+        }
+        x[0] = x0; x[1] = x1; x[2] = x2;
+    }
+}
+
 static void limit_range(void *ctx, int32_t b, int32_t end) {
     const limit_job *j = ctx;
     const builder *c = j->c;
     const ccn_mesh *mL = c->lev[c->L].m;
-    const double *PL = j->PL, *PS = j->PS;
     const int32_t *start = j->cd->start, *kst = j->cd->kstart, *kp = j->cd->perm, *kc = j->cd->col, c0 = 3 * j->b;
     int32_t nvL = mL->nv;
     for (int32_t i = b; i < end; i++) {
         int32_t o = j->outs ? j->outs[i] : i;
         double x[3];
-        if (c->bilinear) memcpy(x, PL + 3 * (size_t)o, sizeof x);
-        else if (c->d1 && c->d1[o] >= 0) { /* the level-1 block's patch (ccn__fvar_builder.d1) */
-            int32_t t = c->d1[o], a1 = c->d1ab[o] & 0xffff, b1 = c->d1ab[o] >> 16;
-            const double *Nu = c->d1N + 8 * (size_t)c->side1 * t + 4 * (size_t)a1;
-            const double *Nv = c->d1N + 8 * (size_t)c->side1 * t + 4 * ((size_t)c->side1 + b1);
-            const int32_t *P = c->d1verts + 16 * (size_t)t;
-            double x0 = 0, x1 = 0, x2 = 0;
-            for (int jj = 0; jj < 4; jj++) {
-                double r0 = 0, r1 = 0, r2 = 0;
-                for (int ii = 0; ii < 4; ii++) {
-                    const double *q = j->P1 + 3 * (size_t)P[ii + 4 * jj];
-                    r0 += Nu[ii] * q[0]; r1 += Nu[ii] * q[1]; r2 += Nu[ii] * q[2];
-                }
-                x0 += Nv[jj] * r0; x1 += Nv[jj] * r1; x2 += Nv[jj] * r2;
-            }
-            x[0] = x0; x[1] = x1; x[2] = x2;
-        } else {
-            double x0 = 0, x1 = 0, x2 = 0;
-            for (int32_t k = c->st_start[o]; k < c->st_start[o + 1]; k++) {
-                int32_t i = c->st_v[k];
-                const double *q = i < nvL ? PL + 3 * (size_t)i : PS + 3 * ((size_t)i - nvL);
-                double w = c->st_w[k];
-                x0 += w * q[0]; x1 += w * q[1]; x2 += w * q[2];
-            }
-            x[0] = x0; x[1] = x1; x[2] = x2;
-        }
+        limit_point(c, o, j->PL, j->PS, j->P1, nvL, x);
         int32_t a = kst[c->fo[o]], n = kst[c->fo[o] + 1] - a, lo = 0, hi = n;
         while (lo < hi) { /* the first of o's candidates with colour >= c0 */
             int32_t mid = (lo + hi) / 2;
@@ -375,4 +380,39 @@ int ccn__fvar_probe_all(const ccn_plan *p, builder *c, int32_t npass, const int3
     free(sets);
     free(ownpos);
     return 0;
+}
+
+typedef struct { const builder *c; const double *PL, *PS, *P1; double *out; int32_t width, c0; double up; } levels_job;
+
+static void levels_range(void *ctx, int32_t b, int32_t end) {
+    const levels_job *j = ctx;
+    const builder *c = j->c;
+    int32_t nvL = c->lev[c->L].m->nv;
+    for (int32_t i = b; i < end; i++) {
+        int32_t o = c->outs[i];
+        double x[3];
+        limit_point(c, o, j->PL, j->PS, j->P1, nvL, x);
+        for (int k = 0; k < 3 && j->c0 + k < j->width; k++) j->out[(size_t)j->width * o + j->c0 + k] = j->up * x[k];
+    }
+}
+
+void ccn__fvar_levels_evaluate(const ccn_plan *p, builder *c, const double *vals, int32_t width,
+                               double down, double up, double *out) {
+    ccn_mesh *m0 = c->lev[0].m;
+    for (int32_t c0 = 0; c0 < width; c0 += 3) { /* the probe pass, on the caller's values */
+        for (int32_t v = 0; v < m0->nv; v++)
+            for (int k = 0; k < 3; k++)
+                m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * vals[(size_t)width * c->value_of[v] + c0 + k] : 0.0;
+        for (int32_t l = 0; l < c->L; l++) {
+            const probe_list *q = c->pl ? &c->pl[l] : NULL;
+            if (q) ccn__level_points_lists(&c->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, c->lev[l + 1].m->pos);
+            else ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
+        }
+        if (c->has_sub) {
+            ccn__level_tabulate_subset(&c->sub, c->near, c->nnear);
+            ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
+        }
+        levels_job j = {c, c->lev[c->L].m->pos, c->posS, c->L >= 1 ? c->lev[1].m->pos : NULL, out, width, c0, up};
+        ccn__parallel_for(p->threads, c->nouts, levels_range, &j);
+    }
 }

@@ -23,6 +23,11 @@ int32_t ccn__fvar_colour(const ccn_mesh *m, const ccn__fvar_csr *K, int32_t *col
 int ccn__fvar_probe_lists(ccn__fvar_builder *c);
 /* npass passes (colours 3b .. 3b+2 set to 1, col per level-0 value vertex): each candidate e
  * of an output c->outs[i] (cd) gets its weight cw[e]. -1 out of memory. */
+/* The outputs c->outs of a channel that kept its levels (ccn__fvar_stencils.levels): the
+ * levels and limit stencils run on the caller's values (width per value, scaled by `down`,
+ * the results by `up`), written to out (width per output value). */
+void ccn__fvar_levels_evaluate(const ccn_plan *p, ccn__fvar_builder *c, const double *vals, int32_t width,
+                               double down, double up, double *out);
 int ccn__fvar_probe_all(const ccn_plan *p, ccn__fvar_builder *c, int32_t npass, const int32_t *col,
                         const ccn__fvar_cands *cd, double *cw);
 

@@ -12,6 +12,7 @@ void ccn__fvar_stencils_free(ccn__fvar_stencils *s) {
     if (!s) return;
     free(s->start); free(s->idx); free(s->w); free(s->face_values);
     free(s->dface); free(s->dab); free(s->dvals); free(s->dN);
+    if (s->levels) ccn__fvar_builder_destroy(s->levels);
     memset(s, 0, sizeof *s);
 }
 
@@ -52,7 +53,7 @@ static void merge_range(void *ctx, int32_t b, int32_t end) {
     for (int32_t o = b; o < end; o++) {
         int32_t first = j->s->start[o], n = first;
         double sum = 0.0;
-        if (j->s->dface && j->s->dface[o] >= 0) { /* a regular face's point: no row */
+        if (j->s->dface && j->s->dface[o] != -1) { /* a regular face's point, or by levels: no row */
             j->len[o] = 0;
             j->sum[o] = 1.0;
             continue;

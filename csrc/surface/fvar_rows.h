@@ -19,8 +19,15 @@ typedef struct {
     double *dN;             /* 8 * side per regular face: N_0..3(u_a), then N_0..3(v_b) */
     int32_t *face_values;   /* 4 * num_faces: the output value of each output face corner */
     int32_t num_seams, num_sharp;
+    /* not NULL: the outputs whose dface is CCN_FVAR_BY_LEVELS have no row; they are evaluated
+     * through these kept value levels, one pass per 3 components (surface/fvar_compose.c says
+     * when: a neighbourhood too large to probe, as around a high-valence n-gon) */
+    struct ccn__fvar_builder *levels;
 } ccn__fvar_stencils;
+#define CCN_FVAR_BY_LEVELS (-2)
 void ccn__fvar_stencils_free(ccn__fvar_stencils *s);
+/* Frees a builder made by surface/fvar_compose.c (and the struct itself). */
+void ccn__fvar_builder_destroy(struct ccn__fvar_builder *c);
 
 /* The face of level `stop` that level-L corner h lies in, and its grid point there, a + (b << 16)
  * in level-L face sizes (quad faces; see the definition). */

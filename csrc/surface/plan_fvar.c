@@ -1,7 +1,9 @@
 /* Face-varying channels and per-vertex data on a plan's output (surface/plan_fvar.h).
  *
  * A channel is its composed limit stencils (surface/fvar_compose.c): each output value as
- * weights over the caller's values, so evaluating new values is one sparse product. Per-vertex
+ * weights over the caller's values, so evaluating new values is one sparse product; where the
+ * neighbourhoods are too large to compose (high-valence n-gons), the outputs without a row run
+ * through the channel's kept levels (surface/fvar_probe.c, one pass per 3 components). Per-vertex
  * data runs through the plan's own levels and stencils, on scratch positions, so the plan's
  * geometry stays that of the last ccn_plan_evaluate.
  */
@@ -12,6 +14,7 @@
 #include "base/vec3.h"
 #include "refine/fvar.h"
 #include "surface/fvar_compose.h"
+#include "surface/fvar_probe.h"
 
 #include <math.h>
 #include <string.h>
@@ -228,6 +231,10 @@ ccn_status ccn_plan_evaluate_fvar(ccn_plan *p, int32_t channel, const double *va
     if (st) return st;
     spmv_job j = {&c->s, vals, out_values, c->width};
     ccn__parallel_for(p->threads, c->s.nout, spmv_range, &j);
+    if (c->s.levels) { /* the outputs without a row: through the channel's levels, in a unit scale */
+        int e = value_exponent(vals, (size_t)c->width * (size_t)c->ncage);
+        ccn__fvar_levels_evaluate(p, c->s.levels, vals, c->width, ldexp(1.0, -e), ldexp(1.0, e), out_values);
+    }
     if (face_values) memcpy(face_values, c->s.face_values, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
 }

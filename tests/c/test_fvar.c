@@ -613,6 +613,78 @@ static void test_uv_follows_polyhedron(void) {
     ccn_obj_destroy(obj);
 }
 
+/* A channel evaluated through its levels (tests/data/fvar_cylinder64.obj: a 64-gon cap disk
+ * needs more probe colours than surface/fvar_compose.c composes): new values without a new
+ * plan, in every mode and width 1-5, equal a new plan's (bitwise), the evaluation is linear
+ * (a blend of two value sets gives the blend of the outputs, 1e-13), repeatable, and a plan
+ * and a width the levels evaluate in several passes (width 5: 3 + 2 components) agree with
+ * their components evaluated one by one. OpenSubdiv checks the values themselves
+ * (tests/oracle/run_fvar_shapes.sh). */
+static void test_levels_channel(void) {
+    size_t len = 0;
+    char *t = tl_slurp("tests/data/fvar_cylinder64.obj", &len);
+    ccn_obj *obj = NULL;
+    ccn_error err;
+    if (!t || ccn_obj_parse(t, len, &obj, &err)) { CHECK(0, "load fvar_cylinder64.obj"); free(t); return; }
+    free(t);
+    ccn_cage cage;
+    ccn_fvar_channel uv;
+    ccn_obj_cage(obj, &cage);
+    ccn_obj_fvar(obj, &uv);
+    int nv = uv.num_values;
+    for (int mode = 0; mode < 6; mode++)
+        for (int W = 1; W <= 5; W += 2) {
+            double *A = malloc(sizeof(double) * W * nv), *B = malloc(sizeof(double) * W * nv), *C = malloc(sizeof(double) * W * nv);
+            for (int i = 0; i < W * nv; i++) { A[i] = tl_rand01(); B[i] = 3 * tl_rand01() - 1; C[i] = 0.25 * A[i] + 0.75 * B[i]; }
+            ccn_fvar_channel ch = {W, nv, A, uv.indices, mode}, chB = ch;
+            chB.values = B;
+            ccn_options o = {0};
+            o.levels = 2;
+            ccn_plan *p = NULL, *q = NULL;
+            int32_t c = -1, cq = -1;
+            if (ccn_plan_create(&cage, &o, &p, &err) || ccn_plan_add_fvar(p, &ch, &c, &err) ||
+                ccn_plan_create(&cage, &o, &q, &err) || ccn_plan_add_fvar(q, &chB, &cq, &err)) {
+                CHECK(0, "mode %d width %d: %s", mode, W, err.message);
+            } else {
+                ccn_fvar_sizes fs;
+                ccn_plan_fvar_sizes(p, c, &fs);
+                size_t n = (size_t)W * fs.num_values;
+                double *a = malloc(sizeof(double) * n), *b = malloc(sizeof(double) * n), *bq = malloc(sizeof(double) * n);
+                double *cc = malloc(sizeof(double) * n), *a2 = malloc(sizeof(double) * n);
+                ccn_plan_evaluate_fvar(p, c, NULL, a, NULL, &err);
+                ccn_plan_evaluate_fvar(p, c, B, b, NULL, &err);
+                ccn_plan_evaluate_fvar(q, cq, NULL, bq, NULL, &err);
+                ccn_plan_evaluate_fvar(p, c, C, cc, NULL, &err);
+                ccn_plan_evaluate_fvar(p, c, A, a2, NULL, &err);
+                double lin = 0;
+                for (size_t i = 0; i < n; i++) lin = fmax(lin, fabs(cc[i] - (0.25 * a[i] + 0.75 * b[i])));
+                CHECK(memcmp(b, bq, sizeof(double) * n) == 0, "mode %d width %d: new values != a new plan's", mode, W);
+                CHECK(memcmp(a, a2, sizeof(double) * n) == 0, "mode %d width %d: not repeatable", mode, W);
+                CHECK(lin <= 1e-13, "mode %d width %d: not linear (%.3g)", mode, W, lin);
+                int finite = 1;
+                for (size_t i = 0; i < n; i++) finite &= isfinite(a[i]);
+                CHECK(finite, "mode %d width %d: non-finite output", mode, W);
+                if (W == 5) { /* component 4 (the second pass) alone, as a width-1 channel */
+                    double *A4 = malloc(sizeof(double) * nv), *o4 = malloc(sizeof(double) * fs.num_values);
+                    for (int i = 0; i < nv; i++) A4[i] = A[5 * i + 4];
+                    ccn_fvar_channel c1 = {1, nv, A4, uv.indices, mode};
+                    int32_t k = -1;
+                    double e = 1e300;
+                    if (!ccn_plan_add_fvar(q, &c1, &k, &err) && !ccn_plan_evaluate_fvar(q, k, NULL, o4, NULL, &err)) {
+                        e = 0;
+                        for (int i = 0; i < fs.num_values; i++) e = fmax(e, fabs(o4[i] - a[5 * (size_t)i + 4]));
+                    }
+                    CHECK(e <= 1e-14, "mode %d: component 4 of width 5 vs alone %.3g", mode, e);
+                    free(A4); free(o4);
+                }
+                free(a); free(b); free(bq); free(cc); free(a2);
+            }
+            ccn_plan_destroy(p); ccn_plan_destroy(q);
+            free(A); free(B); free(C);
+        }
+    ccn_obj_destroy(obj);
+}
+
 int main(void) {
     RUN(test_uv_bspline_no_seam);
     RUN(test_uv_bspline_seam);
@@ -621,5 +693,6 @@ int main(void) {
     RUN(test_plan_reuse_and_vertex_data);
     RUN(test_refine_and_obj);
     RUN(test_uv_follows_polyhedron);
+    RUN(test_levels_channel);
     return TEST_SUMMARY();
 }
