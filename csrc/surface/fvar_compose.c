@@ -45,27 +45,6 @@ typedef ccn__fvar_builder builder;
 
 #define CCN_FVAR_MAX_PASSES 16 /* probe passes (3 colours each) before a channel keeps its levels */
 
-static void builder_free(builder *c);
-
-void ccn__fvar_builder_destroy(builder *c) {
-    builder_free(c);
-    free(c);
-}
-
-static void builder_free(builder *c) {
-    for (int32_t l = 0; c->lev && l <= c->L; l++) ccn__fvar_free(&c->lev[l]);
-    for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
-    if (c->has_sub) ccn__level_free(&c->sub);
-    free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
-    free(c->posS); free(c->value_of); free(c->fo); free(c->ab); free(c->direct); free(c->outs);
-    free(c->hvL); free(c->firstL);
-    ccn__fvar_direct_free(&c->dir1);
-    free(c->d1); free(c->d1ab); free(c->d1verts); free(c->d1N); free(c->skip);
-    ccn__fvar_direct_free(&c->dir);
-    for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
-    free(c->pl);
-    memset(c, 0, sizeof *c);
-}
 
 /* ---- the channel's levels and limit stencils -------------------------------------------- */
 
@@ -648,7 +627,7 @@ ccn_status ccn__fvar_compose(const ccn_plan *p, const ccn_fvar_channel *ch, ccn_
         else memcpy(s->face_values, mL->hvert, sizeof(int32_t) * (size_t)mL->nh);
     }
     if (!st) st = c.numbered_only && c.bilinear ? ccn__fvar_bilinear_rows(p, &c, s, err) : compose(p, &c, s, err);
-    builder_free(&c);
+    ccn__fvar_builder_free(&c);
     if (st) ccn__fvar_stencils_free(s);
     return st;
 }

@@ -4,9 +4,30 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "surface/fvar_builder.h"
 
 #include <math.h>
 #include <string.h>
+
+void ccn__fvar_builder_free(ccn__fvar_builder *c) {
+    for (int32_t l = 0; c->lev && l <= c->L; l++) ccn__fvar_free(&c->lev[l]);
+    for (int32_t l = 0; c->prep && l < c->L; l++) ccn__level_free(&c->prep[l]);
+    if (c->has_sub) ccn__level_free(&c->sub);
+    free(c->lev); free(c->prep); free(c->near); free(c->st_start); free(c->st_v); free(c->st_w);
+    free(c->posS); free(c->value_of); free(c->fo); free(c->ab); free(c->direct); free(c->outs);
+    free(c->hvL); free(c->firstL);
+    ccn__fvar_direct_free(&c->dir1);
+    free(c->d1); free(c->d1ab); free(c->d1verts); free(c->d1N); free(c->skip);
+    ccn__fvar_direct_free(&c->dir);
+    for (int32_t l = 0; c->pl && l < c->L; l++) { free(c->pl[l].f); free(c->pl[l].e); free(c->pl[l].v); }
+    free(c->pl);
+    memset(c, 0, sizeof *c);
+}
+
+void ccn__fvar_builder_destroy(ccn__fvar_builder *c) {
+    ccn__fvar_builder_free(c);
+    free(c);
+}
 
 void ccn__fvar_stencils_free(ccn__fvar_stencils *s) {
     if (!s) return;

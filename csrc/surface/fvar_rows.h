@@ -26,7 +26,8 @@ typedef struct {
 } ccn__fvar_stencils;
 #define CCN_FVAR_BY_LEVELS (-2)
 void ccn__fvar_stencils_free(ccn__fvar_stencils *s);
-/* Frees a builder made by surface/fvar_compose.c (and the struct itself). */
+/* Frees what a builder (surface/fvar_builder.h) holds; _destroy also the struct itself. */
+void ccn__fvar_builder_free(struct ccn__fvar_builder *c);
 void ccn__fvar_builder_destroy(struct ccn__fvar_builder *c);
 
 /* The face of level `stop` that level-L corner h lies in, and its grid point there, a + (b << 16)
