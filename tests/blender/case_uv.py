@@ -14,6 +14,8 @@ Suzanne at Quality 3 (Subdivision Surface's default), 1.0e-5 and 4.1e-6 at 6, 1.
 4x closer per level. test_smooth_all_quality checks that convergence."""
 from bltest import *  # noqa: F401,F403
 
+import time
+
 UV_TOL = 1e-5
 QUALITY = 10  # Subdivision Surface's Quality = OpenSubdiv's isolation level: its closest
 MODES = ('NONE', 'PRESERVE_CORNERS', 'PRESERVE_CORNERS_AND_JUNCTIONS',
@@ -63,6 +65,8 @@ def match_corners(a, b):
 def setup(kind):
     if kind == "cube":
         bpy.ops.mesh.primitive_cube_add(size=2)  # Blender's unwrap: a cross with seams
+    elif kind == "cylinder128":  # two 128-gon caps, each its own UV disk (evaluated by levels)
+        bpy.ops.mesh.primitive_cylinder_add(vertices=128)
     else:
         bpy.ops.mesh.primitive_monkey_add()      # Suzanne: several islands, triangles
     return bpy.context.object
@@ -130,6 +134,18 @@ class TestUVs(AddonTestCase):
                         reset_scene()
                         self.compare_with_subsurf(kind, levels, mode,
                                                   second_map=(kind == "cube" and levels == 1))
+
+    def test_high_valence_cylinder_uvs(self):
+        """A 128-sided cylinder (its cap disks' centres have 128 UV neighbours, so the library
+        evaluates them through the channel's levels, not composed stencils): the default UV
+        Smooth (Keep Boundaries) equals Subdivision Surface's at level 1, at Quality 3 (the one
+        mode: Blender's own evaluation of the two valence-128 points takes about 8 s a mode,
+        CCNURBS's 0.04 s; the C suite and OpenSubdiv check all six on a 64-sided one)."""
+        reset_scene()
+        t0 = time.perf_counter()
+        self.compare_with_subsurf("cylinder128", 1, 'PRESERVE_BOUNDARIES', quality=3)
+        print("measure uv cylinder128 L1 PRESERVE_BOUNDARIES: both evaluated in %.2f s"
+              % (time.perf_counter() - t0))
 
     def test_smooth_all_quality(self):
         """UV Smooth "All" at Subdivision Surface's Quality 3..10: away from UV island corners
