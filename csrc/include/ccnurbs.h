@@ -304,7 +304,9 @@ ccn_status ccn_plan_add_fvar(ccn_plan *plan, const ccn_fvar_channel *ch, int32_t
                              ccn_error *err);
 ccn_status ccn_plan_fvar_sizes(const ccn_plan *plan, int32_t channel, ccn_fvar_sizes *sizes);
 /* values: width * num_cage_values, or NULL for the values given to ccn_plan_add_fvar;
- * out_values: width * num_values (required); face_values: 4 * num_faces, may be NULL. */
+ * out_values: width * num_values (required); face_values: 4 * num_faces, may be NULL. Like
+ * ccn_plan_evaluate, one call at a time per plan (a channel over a high-valence n-gon runs
+ * the plan's kept value levels). */
 ccn_status ccn_plan_evaluate_fvar(ccn_plan *plan, int32_t channel, const double *values,
                                   double *out_values, int32_t *face_values, ccn_error *err);
 /* Per-vertex data (colours, weights, any float attribute): width doubles per cage vertex

@@ -25,6 +25,12 @@
  *
  * Mode ALL from level 1 on is written down for every face (surface/fvar_bilinear.c); the rows'
  * last step, over the caller's values, is surface/fvar_rows.c's.
+ *
+ * Around a value vertex of high valence (a UV-mapped n-gon cap) every face's neighbourhood
+ * holds the whole cap, so each of its values needs its own colour and probing would take n/3
+ * passes over the region. Beyond CCN_FVAR_MAX_PASSES the probed outputs get no row: the
+ * builder is kept in the stencils and they are evaluated through it, one pass per three
+ * components of the caller's values (ccn__fvar_levels_evaluate, surface/fvar_probe.c).
  */
 #include "surface/fvar_compose.h"
 
@@ -44,7 +50,6 @@
 typedef ccn__fvar_builder builder;
 
 #define CCN_FVAR_MAX_PASSES 16 /* probe passes (3 colours each) before a channel keeps its levels */
-
 
 /* ---- the channel's levels and limit stencils -------------------------------------------- */
 
