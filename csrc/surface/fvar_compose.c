@@ -562,11 +562,11 @@ static ccn_status compose(const ccn_plan *p, builder *c, ccn__fvar_stencils *s, 
     s->idx = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     s->w = calloc((size_t)(total ? total : 1), sizeof(double));
     if (!s->idx || !s->w) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
-    int32_t nk = K.start[m0->nf]; /* each K row's entries by colour (ccn__fvar_cands) */
-    kperm = malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
-    kcol = malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
-    if (!kperm || !kcol) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
-    for (int32_t f = 0; f < m0->nf; f++)
+    int32_t nk = K.start[m0->nf]; /* each K row's entries by colour (ccn__fvar_cands; probes only) */
+    kperm = by_levels ? NULL : malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
+    kcol = by_levels ? NULL : malloc(sizeof(int32_t) * (size_t)(nk ? nk : 1));
+    if (!by_levels && (!kperm || !kcol)) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying stencils)"); goto done; }
+    for (int32_t f = 0; !by_levels && f < m0->nf; f++)
         for (int32_t a = K.start[f], i = a; i < K.start[f + 1]; i++) { /* insertion sort by colour */
             int32_t cv = col[K.list[i]], q = i;
             for (; q > a && kcol[q - 1] > cv; q--) { kcol[q] = kcol[q - 1]; kperm[q] = kperm[q - 1]; }

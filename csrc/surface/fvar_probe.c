@@ -276,13 +276,9 @@ typedef struct {
     ccn__level subcopy;
 } probe_set;
 
-/* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
- * stencil run; each candidate weight of those colours is read off (limit_range). */
-static void probe(const builder *c, const probe_set *w, int threads, const int32_t *col, int32_t b,
-                  const ccn__fvar_cands *cd, double *cw) {
-    double *P0 = w->pos[0];
-    for (int32_t v = 0; v < c->lev[0].m->nv; v++)
-        for (int k = 0; k < 3; k++) P0[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
+/* Levels 1..L from level 0's points (w->pos[0]), only the points the probed outputs read
+ * (c->pl), and the level-(L+1) points around near[]. */
+static void run_levels(const builder *c, const probe_set *w) {
     for (int32_t l = 0; l < c->L; l++) {
         const probe_list *q = c->pl ? &c->pl[l] : NULL;
         if (q) ccn__level_points_lists(&w->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, w->pos[l + 1]);
@@ -292,6 +288,16 @@ static void probe(const builder *c, const probe_set *w, int threads, const int32
         ccn__level_tabulate_subset(w->sub, c->near, c->nnear); /* the first pass, before the copies */
         ccn__level_points_subset(w->sub, c->near, c->nnear, w->posS);
     }
+}
+
+/* One probe pass: colours 3b .. 3b+2 set to 1 (components 0..2), every level and limit
+ * stencil run; each candidate weight of those colours is read off (limit_range). */
+static void probe(const builder *c, const probe_set *w, int threads, const int32_t *col, int32_t b,
+                  const ccn__fvar_cands *cd, double *cw) {
+    double *P0 = w->pos[0];
+    for (int32_t v = 0; v < c->lev[0].m->nv; v++)
+        for (int k = 0; k < 3; k++) P0[3 * (size_t)v + k] = col[v] == 3 * b + k ? 1.0 : 0.0;
+    run_levels(c, w);
     limit_job j = {c, w->pos[c->L], w->posS, c->L >= 1 ? w->pos[1] : NULL, cd, c->outs, cw, b};
     ccn__parallel_for(threads, c->nouts, limit_range, &j);
 }
@@ -396,23 +402,20 @@ static void levels_range(void *ctx, int32_t b, int32_t end) {
     }
 }
 
-void ccn__fvar_levels_evaluate(const ccn_plan *p, builder *c, const double *vals, int32_t width,
-                               double down, double up, double *out) {
-    ccn_mesh *m0 = c->lev[0].m;
+int ccn__fvar_levels_evaluate(const ccn_plan *p, builder *c, const double *vals, int32_t width,
+                              double down, double up, double *out) {
+    double **ownpos = malloc(sizeof(double *) * ((size_t)c->L + 1));
+    if (!ownpos) return -1;
+    for (int32_t l = 0; l <= c->L; l++) ownpos[l] = c->lev[l].m->pos;
+    probe_set own = {ownpos, c->posS, c->prep, &c->sub, NULL, {0}};
     for (int32_t c0 = 0; c0 < width; c0 += 3) { /* the probe pass, on the caller's values */
-        for (int32_t v = 0; v < m0->nv; v++)
+        for (int32_t v = 0; v < c->lev[0].m->nv; v++)
             for (int k = 0; k < 3; k++)
-                m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * vals[(size_t)width * c->value_of[v] + c0 + k] : 0.0;
-        for (int32_t l = 0; l < c->L; l++) {
-            const probe_list *q = c->pl ? &c->pl[l] : NULL;
-            if (q) ccn__level_points_lists(&c->prep[l], q->f, q->nf, q->e, q->ne, q->v, q->nv, c->lev[l + 1].m->pos);
-            else ccn__level_points(&c->prep[l], c->lev[l + 1].m->pos);
-        }
-        if (c->has_sub) {
-            ccn__level_tabulate_subset(&c->sub, c->near, c->nnear);
-            ccn__level_points_subset(&c->sub, c->near, c->nnear, c->posS);
-        }
-        levels_job j = {c, c->lev[c->L].m->pos, c->posS, c->L >= 1 ? c->lev[1].m->pos : NULL, out, width, c0, up};
+                ownpos[0][3 * (size_t)v + k] = c0 + k < width ? down * vals[(size_t)width * c->value_of[v] + c0 + k] : 0.0;
+        run_levels(c, &own);
+        levels_job j = {c, ownpos[c->L], c->posS, c->L >= 1 ? ownpos[1] : NULL, out, width, c0, up};
         ccn__parallel_for(p->threads, c->nouts, levels_range, &j);
     }
+    free(ownpos);
+    return 0;
 }

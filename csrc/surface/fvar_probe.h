@@ -25,9 +25,9 @@ int ccn__fvar_probe_lists(ccn__fvar_builder *c);
  * of an output c->outs[i] (cd) gets its weight cw[e]. -1 out of memory. */
 /* The outputs c->outs of a channel that kept its levels (ccn__fvar_stencils.levels): the
  * levels and limit stencils run on the caller's values (width per value, scaled by `down`,
- * the results by `up`), written to out (width per output value). */
-void ccn__fvar_levels_evaluate(const ccn_plan *p, ccn__fvar_builder *c, const double *vals, int32_t width,
-                               double down, double up, double *out);
+ * the results by `up`), written to out (width per output value). Returns -1 out of memory. */
+int ccn__fvar_levels_evaluate(const ccn_plan *p, ccn__fvar_builder *c, const double *vals, int32_t width,
+                              double down, double up, double *out);
 int ccn__fvar_probe_all(const ccn_plan *p, ccn__fvar_builder *c, int32_t npass, const int32_t *col,
                         const ccn__fvar_cands *cd, double *cw);
 

@@ -233,7 +233,8 @@ ccn_status ccn_plan_evaluate_fvar(ccn_plan *p, int32_t channel, const double *va
     ccn__parallel_for(p->threads, c->s.nout, spmv_range, &j);
     if (c->s.levels) { /* the outputs without a row: through the channel's levels, in a unit scale */
         int e = value_exponent(vals, (size_t)c->width * (size_t)c->ncage);
-        ccn__fvar_levels_evaluate(p, c->s.levels, vals, c->width, ldexp(1.0, -e), ldexp(1.0, e), out_values);
+        if (ccn__fvar_levels_evaluate(p, c->s.levels, vals, c->width, ldexp(1.0, -e), ldexp(1.0, e), out_values))
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying channel)");
     }
     if (face_values) memcpy(face_values, c->s.face_values, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     return CCN_OK;
