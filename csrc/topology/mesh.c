@@ -142,11 +142,34 @@ void ccn__mesh_update_info(ccn_mesh *m) {
 
 typedef struct { int32_t a, b, h; } hkey;
 
-static int cmp_hkey(const void *x, const void *y) {
-    const hkey *p = x, *q = y;
-    if (p->a != q->a) return p->a < q->a ? -1 : 1;
-    if (p->b != q->b) return p->b < q->b ? -1 : 1;
-    return (p->h > q->h) - (p->h < q->h);
+/* The half-edges' keys (min end, max end, half-edge) of m (faces filled), sorted by (a, b, h):
+ * counted into one bucket per a (made in increasing h, so each bucket is in h order), then
+ * each bucket -- a vertex's few edges -- by b, stably (insertion sort). The order qsort with
+ * the (a, b, h) comparison gives, in O(nh) and without a call per comparison. -1: no memory. */
+static int sorted_keys(const ccn_mesh *m, hkey *keys) {
+    int32_t nh = m->nh, nv = m->nv;
+    int32_t *start = calloc((size_t)nv + 1, sizeof(int32_t));
+    if (!start) return -1;
+    for (int32_t h = 0; h < nh; h++) {
+        int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
+        start[(a < b ? a : b) + 1]++;
+    }
+    for (int32_t v = 0; v < nv; v++) start[v + 1] += start[v];
+    for (int32_t h = 0; h < nh; h++) {
+        int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)], lo = a < b ? a : b;
+        hkey k = {lo, a < b ? b : a, h};
+        keys[start[lo]++] = k;
+    }
+    /* start[v] is now the end of bucket v (the start of v + 1) */
+    for (int32_t v = 0, b0 = 0; v < nv; b0 = start[v], v++)
+        for (int32_t i = b0 + 1; i < start[v]; i++) {
+            hkey k = keys[i];
+            int32_t j = i;
+            for (; j > b0 && keys[j - 1].b > k.b; j--) keys[j] = keys[j - 1];
+            keys[j] = k;
+        }
+    free(start);
+    return 0;
 }
 
 static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err) {
@@ -220,16 +243,12 @@ static ccn_status fill_faces(ccn_mesh *m, const ccn_cage *c, ccn_error *err) {
     return CCN_OK;
 }
 
-/* Pairs half-edges into edges (sorted keys), numbering edges by first appearance. */
-static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, ccn_error *err) {
+/* Pairs half-edges into edges (sorted keys, left sorted for find_edge), numbering edges by
+ * first appearance; grp and gmap: nh ints of scratch each. */
+static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, int32_t *gmap, ccn_error *err) {
     int32_t nh = m->nh;
-    for (int32_t h = 0; h < nh; h++) {
-        int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
-        keys[h].a = a < b ? a : b;
-        keys[h].b = a < b ? b : a;
-        keys[h].h = h;
-    }
-    qsort(keys, (size_t)nh, sizeof *keys, cmp_hkey);
+    if (sorted_keys(m, keys))
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory for %d corners", (int)nh);
     int32_t ng = 0;
     for (int32_t i = 0; i < nh;) {
         int32_t j = i + 1;
@@ -256,18 +275,18 @@ static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, ccn_error *e
         ng++;
         i = j;
     }
-    /* grp ids -> edge ids by first appearance; reuse keys[].a as the map */
-    for (int32_t g = 0; g < ng; g++) keys[g].a = -1;
+    /* grp ids -> edge ids by first appearance */
+    for (int32_t g = 0; g < ng; g++) gmap[g] = -1;
     int32_t ne = 0;
     for (int32_t h = 0; h < nh; h++) {
         int32_t g = grp[h];
-        if (keys[g].a < 0) {
-            keys[g].a = ne;
+        if (gmap[g] < 0) {
+            gmap[g] = ne;
             m->everts[2 * ne] = m->hvert[h];
             m->everts[2 * ne + 1] = m->hvert[ccn__next(m, h)];
             ne++;
         }
-        m->hedge[h] = keys[g].a;
+        m->hedge[h] = gmap[g];
     }
     m->ne = ne;
     return CCN_OK;
@@ -287,18 +306,12 @@ static int32_t find_edge(const ccn_mesh *m, const hkey *sorted, int32_t a, int32
     return -1;
 }
 
-static ccn_status apply_knots(ccn_mesh *m, const ccn_cage *c, hkey *keys, ccn_error *err) {
+static ccn_status apply_knots(ccn_mesh *m, const ccn_cage *c, const hkey *keys, ccn_error *err) {
     double *val = malloc(sizeof(double) * (size_t)(m->ne ? m->ne : 1));
     if (!val) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     for (int32_t e = 0; e < m->ne; e++) val[e] = 0.0;
     m->info.num_ignored_edges = 0;
     if ((c->edge_knots || c->edge_creases) && c->edge_verts) {
-        /* keys must be sorted by (a,b): rebuild them (pair_edges reused .a as a map) */
-        for (int32_t h = 0; h < m->nh; h++) {
-            int32_t a = m->hvert[h], b = m->hvert[ccn__next(m, h)];
-            keys[h].a = a < b ? a : b; keys[h].b = a < b ? b : a; keys[h].h = h;
-        }
-        qsort(keys, (size_t)m->nh, sizeof *keys, cmp_hkey);
         for (int32_t i = 0; i < c->num_edges; i++) {
             int32_t a = c->edge_verts[2 * i], b = c->edge_verts[2 * i + 1];
             int32_t e = (a >= 0 && b >= 0 && a < m->nv && b < m->nv) ? find_edge(m, keys, a, b)
@@ -321,7 +334,7 @@ static float sharpness_value(double s) {
     return (float)s;
 }
 
-/* Edge sharpness from edge_creases (keys sorted by apply_knots), vertex sharpness. */
+/* Edge sharpness from edge_creases (keys sorted by pair_edges), vertex sharpness. */
 static ccn_status apply_creases(ccn_mesh *m, const ccn_cage *c, const hkey *keys, ccn_error *err) {
     int any = 0;
     for (int32_t i = 0; c->edge_creases && c->edge_verts && i < c->num_edges && !any; i++)
@@ -352,7 +365,7 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
     if (st) return st;
     ccn_mesh *m = ccn__mesh_alloc(cage->num_verts, cage->num_faces, (int32_t)nh, (int32_t)nh);
     hkey *keys = malloc(sizeof(hkey) * (size_t)nh);
-    int32_t *grp = malloc(sizeof(int32_t) * (size_t)nh);
+    int32_t *grp = malloc(sizeof(int32_t) * 2 * (size_t)nh);
     if (!m || !keys || !grp) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory for %lld corners",
                        (long long)nh);
@@ -360,7 +373,7 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
     }
     memcpy(m->pos, cage->positions, sizeof(double) * 3 * (size_t)m->nv);
     if ((st = fill_faces(m, cage, err))) goto done;
-    if ((st = pair_edges(m, keys, grp, err))) goto done;
+    if ((st = pair_edges(m, keys, grp, grp + nh, err))) goto done;
     int32_t bad = ccn__mesh_build_fans(m);
     if (bad) {
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, bad - 1,
