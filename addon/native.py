@@ -1,7 +1,7 @@
 """ctypes binding to libccnurbs.so, shipped inside this package.
 
-Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) /
-ccn_plan_sizes / ccn_plan_evaluate / ccn_plan_destroy, and its face-varying channels and
+Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) or, after
+an edit, ccn_plan_recreate (from the plan it replaces) / ccn_plan_sizes / ccn_plan_evaluate / ccn_plan_destroy, and its face-varying channels and
 per-vertex data (ccn_plan_add_fvar / ccn_plan_fvar_sizes / ccn_plan_evaluate_fvar /
 ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
 buffers passed by pointer; a failing call raises CCNError carrying the library's message.
@@ -132,6 +132,9 @@ def _bind(lib):
     lib.ccn_plan_create_cached.argtypes = [ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
                                            P, ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
     lib.ccn_plan_create_cached.restype = ctypes.c_int
+    lib.ccn_plan_recreate.argtypes = [P, ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
+                                      P, ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
+    lib.ccn_plan_recreate.restype = ctypes.c_int
     lib.ccn_cache_create.argtypes = [ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
     lib.ccn_cache_create.restype = ctypes.c_int
     lib.ccn_plan_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
@@ -226,11 +229,15 @@ class Plan:
     edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None and
     vertex_sharpness (V,) or None (OpenSubdiv sharpness: ccn_cage.edge_creases / vertex_creases).
     options: scheme/cap/boundary/crease_method (enum identifiers), levels.
+    previous: the open Plan this one replaces after an edit (ccn_plan_recreate: where topology,
+    creases and options are the same, e.g. an interval edit, its topology and unchanged
+    stencils are reused; otherwise it is ignored). It stays open: close it afterwards.
     """
 
     def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
                  scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", levels=2, threads=0,
-                 edge_sharpness=None, vertex_sharpness=None, crease_method="UNIFORM"):
+                 edge_sharpness=None, vertex_sharpness=None, crease_method="UNIFORM",
+                 previous=None):
         lib = load()
         self._lib = lib
         self._handle = None
@@ -270,8 +277,13 @@ class Plan:
                            crease_method=CREASE_METHODS[crease_method])
         handle = ctypes.c_void_p()
         err = ccn_error()
-        st = lib.ccn_plan_create_cached(ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
-                                        ctypes.byref(handle), ctypes.byref(err))
+        prev = previous._handle if previous is not None else None
+        if prev is not None:
+            st = lib.ccn_plan_recreate(prev, ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
+                                       ctypes.byref(handle), ctypes.byref(err))
+        else:
+            st = lib.ccn_plan_create_cached(ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
+                                            ctypes.byref(handle), ctypes.byref(err))
         if st != 0:
             _raise(st, err)
         self._handle = handle

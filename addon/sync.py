@@ -96,18 +96,26 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
     cached = _plans.get(key_name)
     if cached is not None and cached[0] == topo:
         return cached[1]
+    old = None
     if cached is not None:
-        cached[1].close()
+        old = cached[1]
         del _plans[key_name]
-    why = memory.refusal(cage.face_sizes, levels,
-                         "Levels Viewport" if key_name[1] == 'VIEW' else "Render levels")
-    if why:  # before anything is allocated (memory.py)
-        raise native.CCNError("CCN_ERR_MEMORY", why)
-    sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
-    vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
-    plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
-                       cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
-                       levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp)
+    try:
+        why = memory.refusal(cage.face_sizes, levels,
+                             "Levels Viewport" if key_name[1] == 'VIEW' else "Render levels")
+        if why:  # before anything is allocated (memory.py)
+            raise native.CCNError("CCN_ERR_MEMORY", why)
+        sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
+        vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
+        # the old plan lends its topology and unchanged stencils to an interval edit's plan
+        # (ccn_plan_recreate; ignored by the library when topology, creases or options differ)
+        plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
+                           cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
+                           levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp,
+                           previous=old)
+    finally:
+        if old is not None:
+            old.close()
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
     plan.corner_channels = attrs.add_corner_channels(plan, cage.extras)
     plan.face_origin = plan.corner_edge_origin = None

@@ -424,10 +424,9 @@ void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hv
     ccn__parallel_for(threads, m->nf, numbering_face_range, &j);
 }
 
-static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand, int threads) {
+static void refine_topology(const ccn_mesh *m, ccn_mesh *r, int threads) {
     int32_t nf = m->nf, ne = m->ne;
     ccn__level_child_numbering(m, ne, m->hvert, m->hedge, m->everts, r->hvert, r->hedge, r->everts, threads);
-    for (int32_t e = 0; e < ne; e++) cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
     for (int32_t f = 0; f < nf; f++) {
         int32_t s = m->fstart[f], n = ccn__fsize(m, f);
         for (int32_t j = 0; j < n; j++) {
@@ -437,13 +436,25 @@ static void refine_topology(const ccn_mesh *m, ccn_mesh *r, double *cand, int th
             r->htwin[q + 1] = 4 * hn + 2;
             r->htwin[q + 2] = 4 * hp + 1;
             r->htwin[q + 3] = tp >= 0 ? 4 * tp : -1;
-            /* NURSS Fig. 10: half the mean of the two sides adjacent to edge j (for a quad
-             * with consistent rings: half the parallel ring's interval) */
-            cand[2 * ne + h] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
             for (int k = 0; k < 4; k++) r->hface[q + k] = h;
         }
     }
     for (int32_t q = 0; q <= r->nf; q++) r->fstart[q] = 4 * q;
+}
+
+/* The child edges' candidate intervals: the two halves of each edge, and for the edge from
+ * face point to edge point of half-edge h (NURSS Fig. 10) half the mean of the two sides
+ * adjacent to edge h (for a quad with consistent rings: half the parallel ring's interval). */
+static void child_candidates(const ccn_mesh *m, double *cand) {
+    int32_t ne = m->ne;
+    for (int32_t e = 0; e < ne; e++) cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
+    for (int32_t f = 0; f < m->nf; f++) {
+        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
+        for (int32_t j = 0; j < n; j++) {
+            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n;
+            cand[2 * ne + h] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
+        }
+    }
 }
 
 static int all_quads(const ccn_mesh *m) {
@@ -648,10 +659,17 @@ static ccn_status child_sharpness(const ccn__level *c, ccn_mesh *r, ccn_error *e
 }
 
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err) {
+    return ccn__level_topology_like(c, NULL, out, err);
+}
+
+ccn_status ccn__level_topology_like(const ccn__level *c, const ccn_mesh *like, ccn_mesh **out,
+                                    ccn_error *err) {
     const ccn_mesh *m = c->m;
     int64_t nv2 = (int64_t)m->nf + m->ne + m->nv, nh2 = 4 * (int64_t)m->nh;
     int64_t ne2 = 2 * (int64_t)m->ne + m->nh;
     *out = NULL;
+    if (like && (like->nv != nv2 || like->nf != m->nh || like->nh != nh2 || like->ne != ne2))
+        like = NULL; /* not this level's child: build it */
     if (nh2 > INT32_MAX / 8 || nv2 > INT32_MAX / 8 || ne2 > INT32_MAX / 8)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
                          "refined mesh would have %lld face corners: too large", (long long)nh2);
@@ -663,11 +681,26 @@ ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *e
                        "out of memory for a refined mesh of %lld face corners", (long long)nh2);
         goto done;
     }
-    refine_topology(m, r, cand, c->threads);
-    if (ccn__mesh_build_fans(r)) {
-        st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
-        goto done;
+    if (like) { /* the same parent topology: the same child topology */
+        memcpy(r->fstart, like->fstart, sizeof(int32_t) * ((size_t)r->nf + 1));
+        memcpy(r->hvert, like->hvert, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->htwin, like->htwin, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->hedge, like->hedge, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->hface, like->hface, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->everts, like->everts, sizeof(int32_t) * 2 * (size_t)r->ne);
+        memcpy(r->vfan_start, like->vfan_start, sizeof(int32_t) * ((size_t)r->nv + 1));
+        memcpy(r->vfan, like->vfan, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->hfanpos, like->hfanpos, sizeof(int32_t) * (size_t)r->nh);
+        memcpy(r->vlast_edge, like->vlast_edge, sizeof(int32_t) * (size_t)r->nv);
+        memcpy(r->vboundary, like->vboundary, (size_t)r->nv);
+    } else {
+        refine_topology(m, r, c->threads);
+        if (ccn__mesh_build_fans(r)) {
+            st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
+            goto done;
+        }
     }
+    child_candidates(m, cand);
     if ((st = new_intervals(m, r, cand, err))) goto done;
     if ((st = child_sharpness(c, r, err))) goto done;
     ccn__mesh_update_info(r);

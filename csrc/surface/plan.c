@@ -122,8 +122,42 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
     return ccn_plan_create_cached(cage, opts, NULL, out, err);
 }
 
+/* Does the earlier plan q have cage mesh m's topology and sharpness, and options o (but for
+ * the thread count, which changes no number)? Then every level's topology and the output mesh
+ * are q's. */
+static int same_plan_topology(const ccn_plan *q, const ccn_options *o, const ccn_mesh *m) {
+    const ccn_options *a = &q->opts;
+    if (a->scheme != o->scheme || a->cap != o->cap || a->levels != o->levels ||
+        a->boundary_corners != o->boundary_corners || a->crease_method != o->crease_method ||
+        a->ev_polyhedron != o->ev_polyhedron)
+        return 0;
+    const ccn_mesh *c = q->lev[0];
+    if (c->nv != m->nv || c->nf != m->nf || c->ne != m->ne || c->nh != m->nh) return 0;
+    if (!c->esharp != !m->esharp || !c->vsharp != !m->vsharp) return 0;
+    size_t nh = sizeof(int32_t) * (size_t)m->nh;
+    return !memcmp(c->fstart, m->fstart, sizeof(int32_t) * ((size_t)m->nf + 1)) &&
+           !memcmp(c->hvert, m->hvert, nh) && !memcmp(c->htwin, m->htwin, nh) &&
+           !memcmp(c->hedge, m->hedge, nh) &&
+           !memcmp(c->everts, m->everts, sizeof(int32_t) * 2 * (size_t)m->ne) &&
+           (!m->esharp || !memcmp(c->esharp, m->esharp, sizeof(float) * (size_t)m->ne)) &&
+           (!m->vsharp || !memcmp(c->vsharp, m->vsharp, sizeof(float) * (size_t)m->nv));
+}
+
+static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
+                         const ccn_plan *prev, ccn_plan **out, ccn_error *err);
+
 ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
                                   ccn_plan **out, ccn_error *err) {
+    return create(cage, opts, cache, NULL, out, err);
+}
+
+ccn_status ccn_plan_recreate(const ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
+                             ccn_cache *cache, ccn_plan **out, ccn_error *err) {
+    return create(cage, opts, cache, prev, out, err);
+}
+
+static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
+                         const ccn_plan *prev, ccn_plan **out, ccn_error *err) {
     ccn__ok(err);
     if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
     *out = NULL;
@@ -163,6 +197,7 @@ ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts,
                            "face %d has %d sides; the limit surface supports at most %d",
                            (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE);
     if (st) goto fail;
+    if (prev && prev->R >= 1 && same_plan_topology(prev, &o, cage_mesh)) p->hint = prev;
     p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
     int64_t corners = cage_mesh->nh; /* fail before any work if the output cannot be indexed */
     for (int32_t l = 0; l < p->L + 1 && !st; l++)
@@ -177,9 +212,11 @@ ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts,
     if ((st = ccn__tess_output(p, err))) goto fail;
     if (p->ncap && (st = ccn__tess_holes(p, err))) goto fail;
     fill_sizes(p);
+    p->hint = NULL;
     *out = p;
     return CCN_OK;
 fail:
+    p->hint = NULL;
     ccn_plan_destroy(p);
     return st;
 }

@@ -7,10 +7,39 @@
 #include "base/parallel.h"
 #include "surface/limit.h"
 
+#include <math.h>
 #include <string.h>
+
+static int32_t *dup_i32(const int32_t *a, size_t n) {
+    int32_t *b = malloc(sizeof(int32_t) * (n ? n : 1));
+    if (b && n) memcpy(b, a, sizeof(int32_t) * n);
+    return b;
+}
+
+/* The earlier plan's output mesh (ccn_plan_recreate: the same level-L topology). */
+static ccn_status output_topology_like(ccn_plan *p, const ccn_plan *q, ccn_error *err) {
+    const ccn_mesh *mL = p->lev[p->L];
+    p->nout_v = q->nout_v;
+    p->nout_f = q->nout_f;
+    p->nout_e = q->nout_e;
+    p->vmapL = dup_i32(q->vmapL, (size_t)mL->nv);
+    p->out_fv = dup_i32(q->out_fv, (size_t)mL->nh);
+    p->out_origin = dup_i32(q->out_origin, (size_t)mL->nf);
+    p->out_ce = dup_i32(q->out_ce, (size_t)mL->nh);
+    p->out_ev = dup_i32(q->out_ev, 2 * (size_t)q->nout_e);
+    p->out_vL = dup_i32(q->out_vL, (size_t)q->nout_v);
+    p->out_eorigin = dup_i32(q->out_eorigin, (size_t)mL->nh);
+    if (!p->vmapL || !p->out_fv || !p->out_origin || !p->out_ce || !p->out_ev || !p->out_vL ||
+        !p->out_eorigin)
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+    return CCN_OK;
+}
 
 static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
+    if (p->hint && p->hint->L == p->L && p->hint->lev[p->L]->nv == mL->nv &&
+        p->hint->lev[p->L]->nh == mL->nh)
+        return output_topology_like(p, p->hint, err);
     p->vmapL = malloc(sizeof(int32_t) * (size_t)mL->nv);
     p->out_fv = malloc(sizeof(int32_t) * (size_t)mL->nh);
     p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
@@ -180,8 +209,53 @@ typedef struct {
     csr_buf *b;            /* the table */
     uint64_t *hash;        /* per regular output vertex: a hash of its weights (ref < 0) */
     int32_t *ref;          /* per regular output vertex: an earlier one with the same weights,
-                              or -1 (its weights are in the table) */
+                              or -1 (its weights are in the table), -2 (the same, not hashed),
+                              or -3 - k: the earlier plan's weight set k (ccn_plan_recreate) */
+    const uint8_t *moved;  /* ccn_plan_recreate: per level-L vertex, 1 where an interval its
+                              regular stencil reads may have changed; else NULL */
 } stencil_job;
+
+/* ccn_plan_recreate: the intervals of level L are q's but near the edges whose interval
+ * changed. A regular output vertex's stencil (surface/limit.c) reads the intervals of the
+ * edges at its fan's vertices (its own and the ones beyond each neighbour), so it may change
+ * where a vertex of one of its faces ends a changed edge: those vertices get 1 in the
+ * returned mask (NULL: out of memory, or nothing to compare). Intervals are compared in the
+ * caller's units (eknot * knot_scale), as the normalisation may differ. */
+static uint8_t *moved_vertices(const ccn_mesh *m, const ccn_mesh *q) {
+    if (!q || q->ne != m->ne || q->nv != m->nv) return NULL;
+    uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1), *moved = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    if (!ends || !moved) { free(ends); free(moved); return NULL; }
+    for (int32_t e = 0; e < m->ne; e++) {
+        double a = m->eknot[e] * m->knot_scale, b = q->eknot[e] * q->knot_scale;
+        if (!(fabs(a - b) <= 1e-14 * fmax(fabs(a), fabs(b))))
+            ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
+    }
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!ends[v]) continue;
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) moved[m->hvert[h]] = 1;
+        }
+    }
+    free(ends);
+    return moved;
+}
+
+/* Output o's row in the earlier plan q, if it is a regular one (level-L indices only, at most
+ * FAST_MAX entries): 1 and s filled, else 0. */
+static int earlier_row(const ccn_plan *q, int32_t o, ccn__stencil *s) {
+    int32_t b = q->st_start[o], n = q->st_start[o + 1] - b, nvL = q->lev[q->L]->nv;
+    if (n > FAST_MAX) return 0;
+    const double *wp, *wu, *wv;
+    ccn__plan_row_weights(q, o, &wp, &wu, &wv);
+    for (int32_t k = 0; k < n; k++) {
+        if (q->st_v[b + k] >= nvL) return 0;
+        s->v[k] = q->st_v[b + k];
+        s->wp[k] = wp[k]; s->wu[k] = wu[k]; s->wv[k] = wv[k];
+    }
+    s->n = n;
+    return 1;
+}
 
 /* FNV-1a over the bits of the position weights and the first derivative weights (and their
  * count), finalised; equal weights are then told by comparing them all. */
@@ -241,7 +315,14 @@ static void fill_range(void *ctx, int32_t begin, int32_t end) {
         }
         j->len[o] = -1; /* failed: no scratch, or more than FAST_MAX entries */
         if (!s || !rc) continue;
-        ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
+        int copied = j->moved && !j->moved[j->p->out_vL[o]] && earlier_row(j->p->hint, o, s);
+        if (copied && j->p->hint->st_w[o] < 0) { /* the earlier plan's shared set: named only */
+            memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
+            j->len[o] = s->n;
+            j->ref[o] = -3 - (-1 - j->p->hint->st_w[o]);
+            continue;
+        }
+        if (!copied) ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
         if (s->n > FAST_MAX) continue;
         memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
         j->len[o] = s->n;
@@ -282,18 +363,22 @@ static void fill_range(void *ctx, int32_t begin, int32_t end) {
  * found through an open-addressing table on the hashes fill_range made. */
 static ccn_status weight_sets(ccn_plan *p, const stencil_job *j, int32_t nout, ccn_error *err) {
     csr_buf *b = j->b;
+    const ccn_plan *q = p->hint;
     int64_t nfast = 0, heads = 0;
     for (int32_t o = 0; o < nout; o++) {
         nfast += j->fast[o];
-        heads += j->fast[o] && j->ref[o] < 0;
+        heads += j->fast[o] && j->ref[o] < 0 && j->ref[o] > -3;
     }
     if (2 * heads > nfast) { /* mostly distinct (non-uniform intervals): every row its own */
         for (int32_t o = 0; o < nout; o++) {
-            if (!j->fast[o] || j->ref[o] < 0) continue;
-            int32_t at = j->slot[o], from = j->slot[j->ref[o]], n = j->len[o];
-            memcpy(b->wp + at, b->wp + from, sizeof(double) * (size_t)n);
-            memcpy(b->wu + at, b->wu + from, sizeof(double) * (size_t)n);
-            memcpy(b->wv + at, b->wv + from, sizeof(double) * (size_t)n);
+            if (!j->fast[o] || (j->ref[o] < 0 && j->ref[o] > -3)) continue;
+            int32_t at = j->slot[o], n = j->len[o];
+            const double *w = j->ref[o] <= -3 ? q->ws + 27 * (size_t)(-3 - j->ref[o]) : NULL;
+            const double *fp = w ? w : b->wp + j->slot[j->ref[o]], *fu = w ? w + 9 : b->wu + j->slot[j->ref[o]];
+            const double *fv = w ? w + 18 : b->wv + j->slot[j->ref[o]];
+            memcpy(b->wp + at, fp, sizeof(double) * (size_t)n);
+            memcpy(b->wu + at, fu, sizeof(double) * (size_t)n);
+            memcpy(b->wv + at, fv, sizeof(double) * (size_t)n);
         }
         p->nws = 0;
         return CCN_OK;
@@ -303,20 +388,24 @@ static ccn_status weight_sets(ccn_plan *p, const stencil_job *j, int32_t nout, c
     int32_t *table = malloc(sizeof(int32_t) * size), cap = 16;
     uint64_t *sh = malloc(sizeof(uint64_t) * (size_t)cap);
     int32_t *sn = malloc(sizeof(int32_t) * (size_t)cap);
+    int32_t *qmap = q && q->nws ? malloc(sizeof(int32_t) * (size_t)q->nws) : NULL; /* q's set -> ours */
     p->ws = malloc(sizeof(double) * 27 * (size_t)cap);
     p->nws = 0;
     ccn_status st = CCN_OK;
-    if (!table || !sh || !sn || !p->ws) {
+    if (!table || !sh || !sn || !p->ws || (q && q->nws && !qmap)) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
         goto done;
     }
     for (size_t i = 0; i < size; i++) table[i] = -1;
+    for (int32_t k = 0; qmap && k < q->nws; k++) qmap[k] = -1;
     for (int32_t o = 0; o < nout; o++) {
         if (!j->fast[o]) continue;
         if (j->ref[o] >= 0) { p->st_w[o] = p->st_w[j->ref[o]]; continue; } /* an earlier one's */
-        int32_t at = j->slot[o], n = j->len[o], set = -1;
+        int32_t at = j->slot[o], n = j->len[o], set = -1, qk = j->ref[o] <= -3 ? -3 - j->ref[o] : -1;
+        if (qk >= 0 && qmap[qk] >= 0) { p->st_w[o] = -1 - qmap[qk]; continue; }
         const double *wp = b->wp + at, *wu = b->wu + at, *wv = b->wv + at;
-        uint64_t h = j->ref[o] == -2 ? weights_hash(n, wp, wu, wv) : j->hash[o];
+        if (qk >= 0) { wp = q->ws + 27 * (size_t)qk; wu = wp + 9; wv = wp + 18; }
+        uint64_t h = j->ref[o] == -2 || qk >= 0 ? weights_hash(n, wp, wu, wv) : j->hash[o];
         size_t i = (size_t)h & (size - 1);
         for (; table[i] >= 0; i = (i + 1) & (size - 1)) {
             int32_t t = table[i];
@@ -351,10 +440,11 @@ static ccn_status weight_sets(ccn_plan *p, const stencil_job *j, int32_t nout, c
             sn[set] = n;
             table[i] = set;
         }
+        if (qk >= 0) qmap[qk] = set;
         p->st_w[o] = -1 - set;
     }
 done:
-    free(table); free(sh); free(sn);
+    free(table); free(sh); free(sn); free(qmap);
     return st;
 }
 
@@ -373,7 +463,11 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     int32_t *slot = malloc(sizeof(int32_t) * (nslot + 1)), *len = malloc(sizeof(int32_t) * nslot);
     int32_t *istart = malloc(sizeof(int32_t) * nslot);
     stencil_job j = {p, mL, pinned, malloc((size_t)(mL->nv ? mL->nv : 1)), malloc(nslot), slot,
-                     len, &ib, istart, &b, malloc(sizeof(uint64_t) * nslot), malloc(sizeof(int32_t) * nslot)};
+                     len, &ib, istart, &b, malloc(sizeof(uint64_t) * nslot), malloc(sizeof(int32_t) * nslot),
+                     NULL};
+    uint8_t *moved = NULL; /* ccn_plan_recreate: the earlier plan's rows where nothing moved */
+    if (p->hint && p->hint->L == p->L && p->hint->nout_v == nout && p->hint->st_start)
+        j.moved = moved = moved_vertices(mL, p->hint->lev[p->L]);
     p->st_start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
     p->st_w = malloc(sizeof(int32_t) * nslot);
     p->near = malloc(sizeof(int32_t) * (size_t)(mL->nv ? mL->nv : 1));
@@ -384,8 +478,13 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
         goto done;
     }
     p->nnear = 0;
-    ccn__parallel_for(p->threads, mL->nv, irr_range, &j);
-    ccn__parallel_for(p->threads, nout, fast_range, &j);
+    if (moved) { /* the same topology and creases: the same regular outputs (not in near) */
+        memset(j.fast, 1, nslot);
+        for (int32_t i = 0; i < p->hint->nnear; i++) j.fast[p->hint->vmapL[p->hint->near[i]]] = 0;
+    } else {
+        ccn__parallel_for(p->threads, mL->nv, irr_range, &j);
+        ccn__parallel_for(p->threads, nout, fast_range, &j);
+    }
     /* the irregular ones, in output order */
     for (int32_t o = 0; o < nout; o++) {
         if (j.fast[o]) continue;
@@ -468,6 +567,7 @@ done:
     free(sb.wp);
     free(ib.v); free(ib.wp); free(ib.wu); free(ib.wv);
     free(slot); free(len); free(istart); free(j.irr); free(j.fast); free(j.hash); free(j.ref);
+    free(moved);
     free(s);
     free(ring);
     ccn__ring_work_destroy(work);

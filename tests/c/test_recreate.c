@@ -1,0 +1,227 @@
+/* ccn_plan_recreate (issue 15, interval edits): a plan made from the previous plan of the same
+ * cage topology equals a new ccn_plan_create_cached plan of the edited cage, output vertex by
+ * output vertex (positions, normals, corner normals; same sizes and output mesh), within
+ * 1e-12 of the cage's size, along a chain of edits (each plan made from the one before):
+ * one ring's interval changed, the largest interval raised (every normalised interval
+ * changes), nothing changed, an interval set back. The oracle is the plan made from scratch,
+ * whose surface the other suites check against OpenSubdiv, B-spline oracles and the papers.
+ * A previous plan of another topology, other creases or other options is ignored: the
+ * result is then byte-identical to a new plan. */
+#include "ccnurbs.h"
+#include "testlib.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct {
+    ccn_obj *obj;
+    ccn_cage cage;
+    int32_t ne, *ev;
+    double *knots, *creases;
+} edit_cage;
+
+/* The cage of an OBJ file with every edge listed (intervals 1, or random in [0.05, 20]). */
+static int load(const char *path, int random_knots, int random_creases, edit_cage *c) {
+    memset(c, 0, sizeof *c);
+    size_t len = 0;
+    char *text = tl_slurp(path, &len);
+    ccn_error err;
+    if (!text || ccn_obj_parse(text, len, &c->obj, &err) != CCN_OK) { free(text); return 0; }
+    free(text);
+    ccn_obj_cage(c->obj, &c->cage);
+    int64_t nh = 0;
+    for (int32_t f = 0; f < c->cage.num_faces; f++) nh += c->cage.face_sizes[f];
+    c->ev = malloc(sizeof(int32_t) * 2 * (size_t)nh);
+    c->knots = malloc(sizeof(double) * (size_t)nh);
+    c->creases = malloc(sizeof(double) * (size_t)nh);
+    int64_t at = 0;
+    for (int32_t f = 0; f < c->cage.num_faces; f++) {
+        int32_t n = c->cage.face_sizes[f];
+        for (int32_t k = 0; k < n; k++) {
+            int32_t a = c->cage.face_verts[at + k], b = c->cage.face_verts[at + (k + 1) % n];
+            if (a > b) continue; /* each interior edge once (its other half runs b -> a) */
+            c->ev[2 * c->ne] = a;
+            c->ev[2 * c->ne + 1] = b;
+            c->knots[c->ne] = random_knots ? 0.05 + 19.95 * tl_rand01() * tl_rand01() : 1.0;
+            c->creases[c->ne] = random_creases && tl_rand01() < 0.1 ? 3 * tl_rand01() : 0.0;
+            c->ne++;
+        }
+        at += n;
+    }
+    /* boundary edges running b -> a with a > b were skipped: add them */
+    at = 0;
+    for (int32_t f = 0; f < c->cage.num_faces; f++) {
+        int32_t n = c->cage.face_sizes[f];
+        for (int32_t k = 0; k < n; k++) {
+            int32_t a = c->cage.face_verts[at + k], b = c->cage.face_verts[at + (k + 1) % n], found = 0;
+            if (a < b) continue;
+            for (int32_t e = 0; e < c->ne && !found; e++) found = c->ev[2 * e] == b && c->ev[2 * e + 1] == a;
+            if (found) continue;
+            c->ev[2 * c->ne] = b;
+            c->ev[2 * c->ne + 1] = a;
+            c->knots[c->ne] = random_knots ? 0.05 + 19.95 * tl_rand01() : 1.0;
+            c->creases[c->ne] = 0.0;
+            c->ne++;
+        }
+        at += n;
+    }
+    c->cage.num_edges = c->ne;
+    c->cage.edge_verts = c->ev;
+    c->cage.edge_knots = c->knots;
+    c->cage.edge_creases = random_creases ? c->creases : NULL;
+    return 1;
+}
+
+static void unload(edit_cage *c) {
+    ccn_obj_destroy(c->obj);
+    free(c->ev); free(c->knots); free(c->creases);
+}
+
+typedef struct { ccn_sizes s; double *x; int32_t *fv; } result;
+
+static int evaluate(ccn_plan *p, result *r) {
+    ccn_error err;
+    ccn_plan_sizes(p, &r->s);
+    size_t nv = (size_t)r->s.num_verts, nf = (size_t)r->s.num_faces;
+    r->x = malloc(sizeof(double) * (6 * nv + 12 * nf));
+    r->fv = malloc(sizeof(int32_t) * 4 * nf);
+    ccn_limit_mesh out = {.positions = r->x, .normals = r->x + 3 * nv,
+                          .corner_normals = r->x + 6 * nv, .face_verts = r->fv};
+    return r->x && r->fv && ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK;
+}
+
+/* Largest difference of a and b (positions relative to the cage's size, normals absolute);
+ * -1 when sizes or the output mesh differ. */
+static double compare(const result *a, const result *b, double size) {
+    if (memcmp(&a->s, &b->s, sizeof a->s)) return -1;
+    size_t nv = (size_t)a->s.num_verts, nf = (size_t)a->s.num_faces;
+    if (memcmp(a->fv, b->fv, sizeof(int32_t) * 4 * nf)) return -1;
+    double worst = 0;
+    for (size_t i = 0; i < 6 * nv + 12 * nf; i++) {
+        double d = fabs(a->x[i] - b->x[i]) / (i < 3 * nv ? size : 1.0);
+        if (!(d <= worst)) worst = isnan(d) ? INFINITY : d;
+    }
+    return worst;
+}
+
+static double cage_size(const ccn_cage *c) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, s = 0;
+    for (int32_t v = 0; v < c->num_verts; v++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], c->positions[3 * v + k]);
+            hi[k] = fmax(hi[k], c->positions[3 * v + k]);
+        }
+    for (int k = 0; k < 3; k++) s = fmax(s, hi[k] - lo[k]);
+    return s > 0 ? s : 1;
+}
+
+/* One cage through a chain of edits at one level: each plan made from the one before. */
+static void chain(const char *name, int random_knots, int random_creases, int levels, int *runs,
+                  double *worst_all) {
+    char path[256];
+    snprintf(path, sizeof path, "tests/data/%s.obj", name);
+    edit_cage c;
+    if (!load(path, random_knots, random_creases, &c)) { CHECK(0, "cannot read %s", path); return; }
+    ccn_cache *cache = NULL;
+    ccn_error err;
+    CHECK(ccn_cache_create(&cache, &err) == CCN_OK, "%s", err.message);
+    ccn_options o = {0};
+    o.levels = levels;
+    ccn_plan *prev = NULL;
+    CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &prev, &err) == CCN_OK, "%s: %s", name, err.message);
+    double size = cage_size(&c.cage), worst = 0;
+    for (int step = 0; step < 6 && prev; step++) {
+        int32_t e = (int32_t)(tl_rand01() * c.ne);
+        double mx = 0;
+        for (int32_t i = 0; i < c.ne; i++) mx = fmax(mx, c.knots[i]);
+        if (step == 0) c.knots[e] = 3.0 * mx;               /* a new largest interval */
+        else if (step == 1) c.knots[e] = 0.05 + 5 * tl_rand01(); /* one ring */
+        else if (step == 2) { /* nothing changed */ }
+        else if (step == 3) c.knots[e] = 0.05;               /* a tiny interval */
+        else c.knots[e] = 0.05 + 19.95 * tl_rand01();
+        ccn_plan *fresh = NULL, *next = NULL;
+        CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &fresh, &err) == CCN_OK, "%s", err.message);
+        CHECK(ccn_plan_recreate(prev, &c.cage, &o, cache, &next, &err) == CCN_OK, "%s", err.message);
+        ccn_plan_destroy(prev); /* the new plan must not need it */
+        prev = next;
+        if (!fresh || !next) { ccn_plan_destroy(fresh); break; }
+        result a, b;
+        int ok = evaluate(fresh, &a) && evaluate(next, &b);
+        CHECK(ok, "%s L%d step %d: evaluate failed", name, levels, step);
+        double d = ok ? compare(&a, &b, size) : -1;
+        CHECK(d >= 0 && d <= 1e-12, "%s L%d step %d: recreated plan differs from a new one by %g%s",
+              name, levels, step, d, d < 0 ? " (sizes or output mesh)" : "");
+        if (d > worst) worst = d;
+        (*runs)++;
+        free(a.x); free(a.fv); free(b.x); free(b.fv);
+        ccn_plan_destroy(fresh);
+    }
+    ccn_plan_destroy(prev);
+    ccn_cache_destroy(cache);
+    unload(&c);
+    if (worst > *worst_all) *worst_all = worst;
+}
+
+static void test_interval_edits(void) {
+    static const char *cages[] = {"cube", "torus", "lshape", "mixed_boundary", "fan5", "fan8",
+                                  "prism_pyramid", "suzanne", "jitter_sphere", "icosahedron",
+                                  "grid4", "bfan5", "pole12"};
+    int runs = 0;
+    double worst = 0;
+    for (size_t i = 0; i < sizeof cages / sizeof *cages; i++)
+        for (int L = 1; L <= 3; L++) {
+            chain(cages[i], 0, 0, L, &runs, &worst);                  /* uniform, then edits */
+            if (L <= 2) chain(cages[i], 1, i % 3 == 0, L, &runs, &worst); /* random, creases */
+        }
+    printf("  %d recreated plans equal new ones within %.1e\n", runs, worst);
+    CHECK(runs >= 150, "only %d plans compared", runs);
+}
+
+/* Another topology, other creases or other options: the previous plan is ignored (the result
+ * is byte-identical to a new plan's). */
+static void test_hint_ignored(void) {
+    edit_cage a, b;
+    if (!load("tests/data/torus.obj", 1, 0, &a) || !load("tests/data/cube.obj", 0, 0, &b)) {
+        CHECK(0, "cannot read the cages");
+        return;
+    }
+    ccn_error err;
+    ccn_options o2 = {0}, o3 = {0};
+    o2.levels = 2;
+    o3.levels = 3;
+    ccn_plan *cube = NULL, *torus2 = NULL;
+    CHECK(ccn_plan_create(&b.cage, &o2, &cube, &err) == CCN_OK, "%s", err.message);
+    CHECK(ccn_plan_create(&a.cage, &o2, &torus2, &err) == CCN_OK, "%s", err.message);
+    for (int k = 0; k < a.ne; k++) a.creases[k] = k % 7 == 0 ? 1.5 : 0;
+    const ccn_plan *hints[3] = {cube, torus2, torus2};
+    const char *what[3] = {"another topology", "other creases", "other options (levels)"};
+    for (int i = 0; i < 3; i++) {
+        a.cage.edge_creases = i == 1 ? a.creases : NULL;
+        const ccn_options *o = i == 2 ? &o3 : &o2;
+        ccn_plan *fresh = NULL, *next = NULL;
+        CHECK(ccn_plan_create(&a.cage, o, &fresh, &err) == CCN_OK, "%s", err.message);
+        CHECK(ccn_plan_recreate(hints[i], &a.cage, o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+        result x, y;
+        if (fresh && next && evaluate(fresh, &x) && evaluate(next, &y)) {
+            CHECK(compare(&x, &y, 1) == 0, "%s: the result differs from a new plan", what[i]);
+            free(x.x); free(x.fv); free(y.x); free(y.fv);
+        } else {
+            CHECK(0, "%s: no plan", what[i]);
+        }
+        ccn_plan_destroy(fresh);
+        ccn_plan_destroy(next);
+    }
+    ccn_plan *none = NULL;
+    CHECK(ccn_plan_recreate(NULL, &b.cage, &o2, NULL, &none, &err) == CCN_OK, "prev NULL: %s", err.message);
+    ccn_plan_destroy(none);
+    ccn_plan_destroy(cube);
+    ccn_plan_destroy(torus2);
+    unload(&a);
+    unload(&b);
+}
+
+int main(void) {
+    RUN(test_interval_edits);
+    RUN(test_hint_ignored);
+    return TEST_SUMMARY();
+}
