@@ -267,6 +267,63 @@ static void tabulate(ccn__level *c) {
     c->tab_full = 1;
 }
 
+/* ccn_plan_recreate: the weights of q, a level of the same topology (an earlier plan's), for
+ * every element whose weights read no interval that changed; the first ccn__level_points
+ * tabulates the others. An element's rule reads intervals of edges at its vertices only (the
+ * face's sides and the transverse ones beyond them, the edge's neighbours along its curve, the
+ * vertex's fan: rules/bspline.c, rules/nurss.c), so it is kept where none of its vertices ends
+ * a changed edge (compared in the caller's units, eknot * knot_scale). The normalisation may
+ * differ (m's intervals are q's times r): the weights that are intervals (te's transverse
+ * ones) scale with r, the NURSS fan weights (products of two sums of intervals) with r^2 and
+ * their normaliser with 1/r^2; the others are ratios. */
+void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q) {
+    const ccn_mesh *m = c->m, *qm = q->m;
+    if (!q->tab_full || !q->tf || c->tab_full || !qm || qm->nv != m->nv || qm->nf != m->nf ||
+        qm->ne != m->ne || qm->nh != m->nh || !m->esharp != !qm->esharp || !q->tvs != !m->esharp)
+        return;
+    uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    if (!ends || !tab_alloc(c)) { free(ends); return; }
+    double r = qm->knot_scale / m->knot_scale;
+    for (int32_t e = 0; e < m->ne; e++) {
+        double a = m->eknot[e] * m->knot_scale, b = qm->eknot[e] * qm->knot_scale;
+        if (!(fabs(a - b) <= 1e-14 * fmax(fabs(a), fabs(b))))
+            ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
+    }
+    uint8_t *fm = c->tmask, *em = fm + m->nf, *vm = em + m->ne;
+    const uint8_t *qf = q->tmask, *qe = qf + m->nf, *qv = qe + m->ne;
+    for (int32_t f = 0; f < m->nf; f++) {
+        int keep = qf[f];
+        for (int32_t h = m->fstart[f]; h < m->fstart[f + 1] && keep; h++) keep = !ends[m->hvert[h]];
+        if (!keep) continue;
+        c->tf[2 * (size_t)f] = q->tf[2 * (size_t)f];
+        c->tf[2 * (size_t)f + 1] = q->tf[2 * (size_t)f + 1];
+        fm[f] = 1;
+    }
+    for (int32_t e = 0; e < m->ne; e++) {
+        if (!qe[e] || ends[m->everts[2 * e]] || ends[m->everts[2 * e + 1]]) continue;
+        const double *a = q->te + 3 * (size_t)e;
+        double *o = c->te + 3 * (size_t)e;
+        o[0] = a[0]; o[1] = a[1] * r; o[2] = a[2] * r;
+        em[e] = 1;
+    }
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!qv[v] || ends[v]) continue;
+        vm[v] = 1;
+        if (m->vfan_start[v + 1] == m->vfan_start[v] || m->vboundary[v]) continue; /* no weights */
+        if (c->tvs) {
+            c->tvs[v] = q->tvs[v];
+            if (!q->tvs[v]) continue;
+        }
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            c->th[2 * (size_t)k] = q->th[2 * (size_t)k] * r * r;
+            c->th[2 * (size_t)k + 1] = q->th[2 * (size_t)k + 1] * r * r;
+        }
+        c->tv[2 * (size_t)v] = q->tv[2 * (size_t)v];
+        c->tv[2 * (size_t)v + 1] = q->tv[2 * (size_t)v + 1] / (r * r);
+    }
+    free(ends);
+}
+
 /* Only the listed elements' weights (ccn__level_points_lists: the face-varying probes compute a
  * part of each level, the same part every pass). */
 static void tabulate_lists(ccn__level *c, const int32_t *faces, int32_t nfaces, const int32_t *edges,

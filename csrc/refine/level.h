@@ -51,6 +51,9 @@ void ccn__level_points(ccn__level *c, double *out);
 void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t nverts,
                               double *out);
 void ccn__level_tabulate_subset(ccn__level *c, const int32_t *verts, int32_t nverts);
+/* The tables of q (the same topology, other intervals: an earlier plan's level, evaluated)
+ * for the elements whose rules read no changed interval (ccn_plan_recreate). */
+void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q);
 /* The next-level points of the listed faces, edges and vertices only (each once; every EV's
  * red points too). A point is right when the old points its rule reads are. */
 void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces,
