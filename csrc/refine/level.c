@@ -760,7 +760,13 @@ ccn_status ccn__level_topology_like(const ccn__level *c, const ccn_mesh *like, c
     child_candidates(m, cand);
     if ((st = new_intervals(m, r, cand, err))) goto done;
     if ((st = child_sharpness(c, r, err))) goto done;
-    ccn__mesh_update_info(r);
+    if (like) { /* the counts of the same topology and sharpness; the rings' are new */
+        ccn_mesh_info in = like->info;
+        in.num_rings = r->info.num_rings;
+        r->info = in;
+    } else {
+        ccn__mesh_update_info(r);
+    }
     r->info.num_ring_conflicts = m->info.num_ring_conflicts;
     r->info.num_ignored_edges = m->info.num_ignored_edges;
     r->info.num_ev_fallbacks = m->info.num_ev_fallbacks + c->fallbacks;

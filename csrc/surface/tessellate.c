@@ -315,14 +315,19 @@ static void fill_range(void *ctx, int32_t begin, int32_t end) {
         }
         j->len[o] = -1; /* failed: no scratch, or more than FAST_MAX entries */
         if (!s || !rc) continue;
-        int copied = j->moved && !j->moved[j->p->out_vL[o]] && earlier_row(j->p->hint, o, s);
-        if (copied && j->p->hint->st_w[o] < 0) { /* the earlier plan's shared set: named only */
-            memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
-            j->len[o] = s->n;
-            j->ref[o] = -3 - (-1 - j->p->hint->st_w[o]);
-            continue;
+        const ccn_plan *q = j->p->hint;
+        int keep = j->moved && !j->moved[j->p->out_vL[o]];
+        if (keep && q->st_w[o] < 0) { /* the earlier plan's shared set: named only */
+            int32_t from = q->st_start[o], n = q->st_start[o + 1] - from, nvL = j->mL->nv, ok = n <= FAST_MAX;
+            for (int32_t k = 0; k < n && ok; k++) ok = q->st_v[from + k] < nvL;
+            if (ok) {
+                memcpy(b->v + at, q->st_v + from, sizeof(int32_t) * (size_t)n);
+                j->len[o] = n;
+                j->ref[o] = -3 - (-1 - q->st_w[o]);
+                continue;
+            }
         }
-        if (!copied) ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
+        if (!keep || !earlier_row(q, o, s)) ccn__limit_stencil(j->mL, j->p->out_vL[o], j->pinned, s);
         if (s->n > FAST_MAX) continue;
         memcpy(b->v + at, s->v, sizeof(int32_t) * (size_t)s->n);
         j->len[o] = s->n;
