@@ -96,6 +96,40 @@ int main(int argc, char **argv) {
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,
            tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1, ru.ru_maxrss, tfirst,
            cache ? " (one ccn_cache)" : "");
+    /* an interval edit: one ring's interval changed (the cage's first edge, alternately 3 and
+     * 1.5 times its interval), the plan made again and evaluated (the add-on's rebuild), by a
+     * new plan and by ccn_plan_recreate from the plan before */
+    {
+        int32_t ne = cage.num_edges > 0 ? cage.num_edges : 1;
+        int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)ne);
+        double *ek = malloc(sizeof(double) * (size_t)ne);
+        if (cage.num_edges > 0) {
+            memcpy(ev, cage.edge_verts, sizeof(int32_t) * 2 * (size_t)ne);
+            for (int32_t i = 0; i < ne; i++) ek[i] = cage.edge_knots ? cage.edge_knots[i] : 1.0;
+        } else {
+            ev[0] = cage.face_verts[0]; ev[1] = cage.face_verts[1]; ek[0] = 1.0;
+        }
+        ccn_cage ec = cage;
+        ec.num_edges = ne; ec.edge_verts = ev; ec.edge_knots = ek;
+        double base = ek[0] > 0 ? ek[0] : 1.0, tnew = 1e30, trec = 1e30;
+        for (int way = 0; way < 2; way++)
+            for (int r = 0; r < 2 * reps + 1; r++) {
+                ek[0] = base * (r % 2 ? 3.0 : 1.5);
+                ccn_plan *q = NULL;
+                double t0 = now();
+                ccn_status st = way ? ccn_plan_recreate(plan, &ec, &o, cache, &q, &err)
+                                    : ccn_plan_create_cached(&ec, &o, cache, &q, &err);
+                if (st || ccn_plan_evaluate(q, NULL, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+                double t1 = now() - t0;
+                ccn_plan_destroy(plan);
+                plan = q;
+                if (r == 0) continue; /* the first: from the cage's own intervals */
+                if (way) trec = t1 < trec ? t1 : trec; else tnew = t1 < tnew ? t1 : tnew;
+            }
+        printf("ccn edit %s L%d: one ring's interval changed, plan + evaluate: new plan %.4f s, "
+               "recreated %.4f s\n", argv[1], levels, tnew, trec);
+        free(ev); free(ek);
+    }
     ccn_plan_destroy(plan);
     ccn_cache_destroy(cache);
     ccn_fvar_channel uv;
