@@ -279,13 +279,13 @@ ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts,
                                   ccn_plan **out, ccn_error *err);
 /* ccn_plan_create_cached after an edit of the cage `prev` was made for, typically its knot
  * intervals (an interval edit): where the cage's topology (faces, edges), creases and options
- * (but threads) equal prev's, the levels' and output mesh's topology are copied from prev and
- * so are the limit stencils of the output vertices whose nearby level-L intervals did not
- * change (equal within 1e-14 relative, in the caller's units); everything else is made anew.
- * The result equals ccn_plan_create_cached's within rounding (1e-15 relative; copied stencils
- * were computed under prev's interval normalisation); otherwise prev is ignored. prev is only
- * read and stays valid; it may be destroyed after the call. Face-varying channels are not
- * carried over: add them to the new plan. */
+ * (but threads) equal prev's, the levels' and output mesh's topology are copied from prev, and
+ * so are the limit stencils, rule weights and cap parameters (taus) that read no changed
+ * interval (compared in the caller's units); everything else is made anew. The output is
+ * byte-identical to ccn_plan_create_cached's (intervals are normalised by powers of two, so
+ * the copies are exact). Otherwise prev is ignored. prev is only read and stays valid; it may
+ * be destroyed after the call. Face-varying channels are not carried over: add them to the
+ * new plan. */
 ccn_status ccn_plan_recreate(const ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
                              ccn_cache *cache, ccn_plan **out, ccn_error *err);
 ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);

@@ -273,9 +273,10 @@ static void tabulate(ccn__level *c) {
  * face's sides and the transverse ones beyond them, the edge's neighbours along its curve, the
  * vertex's fan: rules/bspline.c, rules/nurss.c), so it is kept where none of its vertices ends
  * a changed edge (compared in the caller's units, eknot * knot_scale). The normalisation may
- * differ (m's intervals are q's times r): the weights that are intervals (te's transverse
- * ones) scale with r, the NURSS fan weights (products of two sums of intervals) with r^2 and
- * their normaliser with 1/r^2; the others are ratios. */
+ * differ (m's intervals are q's times r, a power of two: topology/knots.c): the weights that
+ * are intervals (te's transverse ones) scale with r, the NURSS fan weights (products of two
+ * sums of intervals) with r^2 and their normaliser with 1/r^2, exactly; the others are
+ * ratios, the same to the bit. */
 void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q) {
     const ccn_mesh *m = c->m, *qm = q->m;
     if (!q->tab_full || !q->tf || c->tab_full || !qm || qm->nv != m->nv || qm->nf != m->nf ||
@@ -286,7 +287,7 @@ void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q) {
     double r = qm->knot_scale / m->knot_scale;
     for (int32_t e = 0; e < m->ne; e++) {
         double a = m->eknot[e] * m->knot_scale, b = qm->eknot[e] * qm->knot_scale;
-        if (!(fabs(a - b) <= 1e-14 * fmax(fabs(a), fabs(b))))
+        if (a != b)
             ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
     }
     uint8_t *fm = c->tmask, *em = fm + m->nf, *vm = em + m->ne;
@@ -525,6 +526,7 @@ static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, cc
         memcpy(r->eknot, cand, sizeof(double) * (size_t)r->ne);
         double mx = 0.0;
         for (int32_t e = 0; e < r->ne; e++) mx = r->eknot[e] > mx ? r->eknot[e] : mx;
+        mx = ccn__pow2_at_least(mx > 0.0 ? mx : 1.0); /* exact, as at level 0 (topology/knots.c) */
         for (int32_t e = 0; e < r->ne; e++) r->eknot[e] /= mx;
         r->knot_scale = m->knot_scale * mx;
         r->info.num_rings = 2 * m->info.num_rings; /* each ring splits in two */

@@ -137,8 +137,25 @@ static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *
            ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, c->taus, zero, NULL, c->patches, e2) == CCN_OK;
 }
 
+/* ccn_plan_recreate: the earlier plan's cap at EV ev of level K, if it has taus and the same
+ * spoke intervals (in the caller's units; the taus depend on their ratios only, bi5.h [R11],
+ * which the power-of-two normalisation keeps to the bit), else NULL. hint_caps: the earlier
+ * cap per level-K vertex, or -1. */
+static const ccn__cap *same_spokes_cap(const ccn_plan *p, const int32_t *hint_caps, int32_t ev,
+                                       const ccn__cap *c) {
+    if (!hint_caps || hint_caps[ev] < 0) return NULL;
+    const ccn__cap *h = &p->hint->caps[hint_caps[ev]];
+    if (h->n != c->n || !h->taus) return NULL;
+    double s = p->lev[p->K]->knot_scale, hs = p->hint->lev[p->K]->knot_scale;
+    for (int32_t k = 0; k < c->n; k++) {
+        double a = c->knots[k] * s, b = h->knots[k] * hs;
+        if (a != b) return NULL;
+    }
+    return h;
+}
+
 /* Sets up the cap of EV ev at level K; returns 1 if it was added, 0 for a fallback. */
-static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
+static int cap_add(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn_error *err) {
     const ccn_mesh *m = p->lev[p->K];
     int32_t n = ccn__valence(m, ev);
     if (n > CCN_CAP_MAX_VALENCE) return 0;
@@ -174,7 +191,9 @@ static int cap_add(ccn_plan *p, int32_t ev, ccn_error *err) {
         }
         if (ok && nu) {
             c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
-            ok = c->taus && ccn__bi5_nu_taus(op, c->knots, c->taus, &e2) == CCN_OK;
+            const ccn__cap *h = c->taus ? same_spokes_cap(p, hint_caps, ev, c) : NULL;
+            if (h) memcpy(c->taus, h->taus, sizeof(double complex) * 36 * (size_t)n); /* the same taus */
+            else ok = c->taus && ccn__bi5_nu_taus(op, c->knots, c->taus, &e2) == CCN_OK;
         }
         /* Equal spoke intervals: the uniform operator on the level-K net, whose bicubic surround
          * is the limit itself. Any other intervals (kappa = 1 alternating and period 4 too, whose
@@ -229,10 +248,17 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     int32_t *stamp = malloc(sizeof(int32_t) * (size_t)m->nv), *q = malloc(sizeof(int32_t) * (size_t)m->nv);
     if (!p->caps || !stamp || !q) { free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
+    int32_t *hint_caps = NULL; /* ccn_plan_recreate: the earlier plan's caps by EV */
+    if (p->hint && p->hint->K == K && p->hint->ncap && p->hint->lev[K]->nv == m->nv &&
+        (hint_caps = malloc(sizeof(int32_t) * (size_t)m->nv))) {
+        for (int32_t v = 0; v < m->nv; v++) hint_caps[v] = -1;
+        for (int32_t c = 0; c < p->hint->ncap; c++) hint_caps[p->hint->caps[c].cnet[0]] = c;
+    }
     for (int32_t v = 0; v < m->nv; v++) {
         if (!cap_ev(m, v)) continue;
-        if (!cap_isolated(m, v, stamp, q) || !cap_add(p, v, err)) p->sizes.num_cap_fallbacks++;
+        if (!cap_isolated(m, v, stamp, q) || !cap_add(p, v, hint_caps, err)) p->sizes.num_cap_fallbacks++;
     }
+    free(hint_caps);
     free(stamp); free(q);
     p->sizes.num_caps = p->ncap;
     int32_t maxn = 0;

@@ -220,14 +220,17 @@ typedef struct {
  * edges at its fan's vertices (its own and the ones beyond each neighbour), so it may change
  * where a vertex of one of its faces ends a changed edge: those vertices get 1 in the
  * returned mask (NULL: out of memory, or nothing to compare). Intervals are compared in the
- * caller's units (eknot * knot_scale), as the normalisation may differ. */
+ * caller's units (eknot * knot_scale, exact: the scales are powers of two), as the
+ * normalisation may differ; a kept stencil is then the one this plan would make, its
+ * derivative weights in q's interval unit (a power of two apart), which gives the same unit
+ * normals. */
 static uint8_t *moved_vertices(const ccn_mesh *m, const ccn_mesh *q) {
     if (!q || q->ne != m->ne || q->nv != m->nv) return NULL;
     uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1), *moved = calloc((size_t)(m->nv ? m->nv : 1), 1);
     if (!ends || !moved) { free(ends); free(moved); return NULL; }
     for (int32_t e = 0; e < m->ne; e++) {
         double a = m->eknot[e] * m->knot_scale, b = q->eknot[e] * q->knot_scale;
-        if (!(fabs(a - b) <= 1e-14 * fmax(fabs(a), fabs(b))))
+        if (a != b)
             ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
     }
     for (int32_t v = 0; v < m->nv; v++) {

@@ -5,6 +5,7 @@
 
 #include "ccnurbs.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -21,7 +22,7 @@ struct ccn_mesh {
     int32_t *hedge;  /* nh: edge index */
     int32_t *hface;  /* nh: face index */
     int32_t *everts; /* 2 * ne */
-    double *eknot;   /* ne: ring interval, normalised so the largest is 1 */
+    double *eknot;   /* ne: ring interval, normalised by a power of two: the largest in (1/2, 1] */
     double knot_scale; /* eknot * knot_scale = interval in the caller's units */
     /* Vertex fans: the outgoing half-edges of vertex v in counter-clockwise order are
      * vfan[vfan_start[v] .. vfan_start[v+1]-1]. A boundary vertex's fan starts with the
@@ -73,6 +74,14 @@ static inline int ccn__edge_splits(const ccn_mesh *m, int32_t e) {
 }
 
 #define CCN_KNOT_MIN_RATIO 1e-6
+
+/* The smallest power of two >= x (x > 0, finite): the interval normalisation (topology/knots.c),
+ * by which dividing is exact. */
+static inline double ccn__pow2_at_least(double x) {
+    int e;
+    double f = frexp(x, &e); /* x = f 2^e, f in [1/2, 1) */
+    return ldexp(1.0, f == 0.5 ? e - 1 : e);
+}
 #define CCN_COORD_MAX 1e300 /* larger |coordinates| are rejected: results must stay finite */
 
 #endif

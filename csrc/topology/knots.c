@@ -4,8 +4,13 @@
  *
  * Resolution: the ring's interval is the mean of the positive finite values given on its
  * edges (1 if none); a ring whose given values differ is counted as a conflict. Intervals
- * are then normalised (largest = 1; the scale is kept in knot_scale) and clamped to
- * >= CCN_KNOT_MIN_RATIO (DESIGN §4.5), so every rule's denominators stay positive.
+ * are then normalised by the smallest power of two at least the largest (so the largest is in
+ * (1/2, 1]; the scale is kept in knot_scale) and clamped to >= CCN_KNOT_MIN_RATIO times the
+ * largest (DESIGN §4.5), so every rule's denominators stay positive. A power of two because
+ * dividing by it is exact: every rule is homogeneous in the intervals (ratios; an interval
+ * weight scales with them), so two cages whose intervals differ by a factor give the same
+ * weights to the bit, and a plan made after an edit that moves the largest interval can keep
+ * the earlier plan's weights, rescaled exactly (ccn_plan_recreate).
  */
 #include "topology/knots.h"
 
@@ -104,10 +109,11 @@ ccn_status ccn__resolve_rings(ccn_mesh *m, const double *val, const int32_t *sou
         if (!(sum[e] <= 1e300)) sum[e] = 1e300; /* overflow of the mean */
         if (sum[e] > vmax) vmax = sum[e];
     }
-    m->knot_scale = vmax > 0.0 ? vmax : 1.0;
+    m->knot_scale = ccn__pow2_at_least(vmax > 0.0 ? vmax : 1.0);
+    double lo_knot = CCN_KNOT_MIN_RATIO * ((vmax > 0.0 ? vmax : 1.0) / m->knot_scale);
     for (int32_t e = 0; e < m->ne; e++) {
         double x = sum[parent[e]] / m->knot_scale;
-        m->eknot[e] = x < CCN_KNOT_MIN_RATIO ? CCN_KNOT_MIN_RATIO : x;
+        m->eknot[e] = x < lo_knot ? lo_knot : x;
     }
     m->info.num_rings = rings;
     m->info.num_ring_conflicts = conflicts;

@@ -5,7 +5,7 @@
 #include "topology/halfedge.h"
 
 /* Resolves ring intervals from per-edge candidate values (<= 0 / non-finite = unset) and
- * normalises them (largest = 1, clamped to >= 1e-6). Writes m->eknot, m->knot_scale and the
+ * normalises them (by a power of two: largest in (1/2, 1]; clamped to >= 1e-6 of the largest). Writes m->eknot, m->knot_scale and the
  * ring counts in m->info. `source` (may be NULL) tags each edge's value with the identity of
  * where it came from; a ring's value is the mean over distinct sources (NULL: over edges). */
 ccn_status ccn__resolve_rings(ccn_mesh *m, const double *edge_values, const int32_t *source,
