@@ -139,7 +139,19 @@ for st in level1:6 cage:4; do
   run "$tmp/r3.txt" maxima --start "$s" --rings 3 --knots "$k" &&
     run "$tmp/rb.txt" maxima --start "$s" --rings "$r" --knots "$k"
   l3=$(grep '^level 5:' "$tmp/r3.txt"); lb=$(grep '^level 5:' "$tmp/rb.txt")
-  check "3-ring cage exact (start $s)" "[ -n '$l3' ] && [ '$l3' = '$lb' ]" "rings 3 vs $r: $l3"
+  # the same support and fallbacks; sum and maximum within rounding and their printed digits (12
+  # and 15: the two cages' arithmetic differs in the last bits, 1-2 ulps measured, so equal
+  # printed digits would be chance)
+  same=$(printf '%s\n%s\n' "$l3" "$lb" | awk '{
+      s = $0; sub(/^.*support /, "", s); sub(/ vertices.*/, "", s)
+      f = $0; sub(/^.*fallbacks /, "", f)
+      t = $0; sub(/^.*sum z /, "", t); sub(/,.*/, "", t)
+      z = $0; sub(/^.*max z /, "", z); sub(/,.*/, "", z)
+      S[NR] = s; F[NR] = f; T[NR] = t + 0; Z[NR] = z + 0 }
+    function near(a, b, tol) { return (a - b <= tol * (a < 0 ? -a : a) && b - a <= tol * (a < 0 ? -a : a)) }
+    END { print (NR == 2 && S[1] != "" && S[1] == S[2] && F[1] == F[2] && near(T[1], T[2], 1e-11) &&
+                 near(Z[1], Z[2], 1e-13)) ? 1 : 0 }')
+  check "3-ring cage exact (start $s)" "[ -n '$l3' ] && [ $same = 1 ]" "rings 3 vs $r: $l3; rings $r: ${lb#level 5: }"
 done
 
 # ---- (c) charmap, the per-vertex choice -----------------------------------------------------------
