@@ -229,9 +229,10 @@ class Plan:
     edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None and
     vertex_sharpness (V,) or None (OpenSubdiv sharpness: ccn_cage.edge_creases / vertex_creases).
     options: scheme/cap/boundary/crease_method (enum identifiers), levels.
-    previous: the open Plan this one replaces after an edit (ccn_plan_recreate: where topology,
-    creases and options are the same, e.g. an interval edit, its topology and unchanged
-    stencils are reused; otherwise it is ignored). It stays open: close it afterwards.
+    previous: the open Plan this one replaces after an edit, given up (ccn_plan_recreate: where
+    topology, creases and options are the same, e.g. an interval edit, its topology moves over
+    and its unchanged stencils are reused; otherwise it is only freed). It is closed by the
+    call, also when the call fails.
     """
 
     def __init__(self, positions, face_sizes, face_verts, edge_verts=None, edge_knots=None,
@@ -279,6 +280,7 @@ class Plan:
         err = ccn_error()
         prev = previous._handle if previous is not None else None
         if prev is not None:
+            previous._handle = None  # consumed by the call, whatever it returns
             st = lib.ccn_plan_recreate(prev, ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
                                        ctypes.byref(handle), ctypes.byref(err))
         else:

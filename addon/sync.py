@@ -107,8 +107,9 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
             raise native.CCNError("CCN_ERR_MEMORY", why)
         sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
         vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
-        # the old plan lends its topology and unchanged stencils to an interval edit's plan
-        # (ccn_plan_recreate; ignored by the library when topology, creases or options differ)
+        # the old plan gives its topology and unchanged stencils to an interval edit's plan
+        # (ccn_plan_recreate, which consumes it; only freed when topology, creases or options
+        # differ)
         plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
                            cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
                            levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp,

@@ -278,15 +278,16 @@ void ccn_cache_destroy(ccn_cache *cache);
 ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
                                   ccn_plan **out, ccn_error *err);
 /* ccn_plan_create_cached after an edit of the cage `prev` was made for, typically its knot
- * intervals (an interval edit): where the cage's topology (faces, edges), creases and options
- * (but threads) equal prev's, the levels' and output mesh's topology are copied from prev, and
- * so are the limit stencils, rule weights and cap parameters (taus) that read no changed
- * interval (compared in the caller's units); everything else is made anew. The output is
- * byte-identical to ccn_plan_create_cached's (intervals are normalised by powers of two, so
- * the copies are exact). Otherwise prev is ignored. prev is only read and stays valid; it may
- * be destroyed after the call. Face-varying channels are not carried over: add them to the
- * new plan. */
-ccn_status ccn_plan_recreate(const ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
+ * intervals (an interval edit), consuming prev: where the cage's topology (faces, edges),
+ * creases and options (but threads) equal prev's, the levels' and output mesh's topology move
+ * over from prev (no copy, no new memory), and the limit stencils, rule weights and cap
+ * parameters (taus) that read no changed interval (compared in the caller's units) are copied;
+ * everything else is made anew. The output is byte-identical to ccn_plan_create_cached's
+ * (intervals are normalised by powers of two, so the copies are exact). Otherwise prev is
+ * only freed. prev (may be NULL) is destroyed by the call whatever it returns: do not use or
+ * destroy it afterwards. Face-varying channels are not carried over: add them to the new
+ * plan. */
+ccn_status ccn_plan_recreate(ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
                              ccn_cache *cache, ccn_plan **out, ccn_error *err);
 ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs

@@ -721,14 +721,15 @@ ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *e
     return ccn__level_topology_like(c, NULL, out, err);
 }
 
-ccn_status ccn__level_topology_like(const ccn__level *c, const ccn_mesh *like, ccn_mesh **out,
+ccn_status ccn__level_topology_like(const ccn__level *c, ccn_mesh *like, ccn_mesh **out,
                                     ccn_error *err) {
     const ccn_mesh *m = c->m;
     int64_t nv2 = (int64_t)m->nf + m->ne + m->nv, nh2 = 4 * (int64_t)m->nh;
     int64_t ne2 = 2 * (int64_t)m->ne + m->nh;
     *out = NULL;
-    if (like && (like->nv != nv2 || like->nf != m->nh || like->nh != nh2 || like->ne != ne2))
-        like = NULL; /* not this level's child: build it */
+    if (like && (like->nv != nv2 || like->nf != m->nh || like->nh != nh2 || like->ne != ne2 ||
+                 !like->fstart))
+        like = NULL; /* not this level's child (or given up already): build it */
     if (nh2 > INT32_MAX / 8 || nv2 > INT32_MAX / 8 || ne2 > INT32_MAX / 8)
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1,
                          "refined mesh would have %lld face corners: too large", (long long)nh2);
@@ -740,18 +741,12 @@ ccn_status ccn__level_topology_like(const ccn__level *c, const ccn_mesh *like, c
                        "out of memory for a refined mesh of %lld face corners", (long long)nh2);
         goto done;
     }
-    if (like) { /* the same parent topology: the same child topology */
-        memcpy(r->fstart, like->fstart, sizeof(int32_t) * ((size_t)r->nf + 1));
-        memcpy(r->hvert, like->hvert, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->htwin, like->htwin, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->hedge, like->hedge, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->hface, like->hface, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->everts, like->everts, sizeof(int32_t) * 2 * (size_t)r->ne);
-        memcpy(r->vfan_start, like->vfan_start, sizeof(int32_t) * ((size_t)r->nv + 1));
-        memcpy(r->vfan, like->vfan, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->hfanpos, like->hfanpos, sizeof(int32_t) * (size_t)r->nh);
-        memcpy(r->vlast_edge, like->vlast_edge, sizeof(int32_t) * (size_t)r->nv);
-        memcpy(r->vboundary, like->vboundary, (size_t)r->nv);
+    if (like) { /* the same parent topology: the same child topology, moved over */
+#define CCN_TAKE(f) do { free(r->f); r->f = like->f; like->f = NULL; } while (0)
+        CCN_TAKE(fstart); CCN_TAKE(hvert); CCN_TAKE(htwin); CCN_TAKE(hedge); CCN_TAKE(hface);
+        CCN_TAKE(everts); CCN_TAKE(vfan_start); CCN_TAKE(vfan); CCN_TAKE(hfanpos);
+        CCN_TAKE(vlast_edge); CCN_TAKE(vboundary);
+#undef CCN_TAKE
     } else {
         refine_topology(m, r, c->threads);
         if (ccn__mesh_build_fans(r)) {

@@ -68,9 +68,11 @@ void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hv
                                 int32_t *chedge, int32_t *ceverts, int threads);
 /* Topology and intervals of the next level (positions uninitialised). */
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
-/* The same, with the child topology copied from `like`, the child of a mesh with c->m's
- * topology (an earlier plan's level; only the intervals, sharpness and counts are made). */
-ccn_status ccn__level_topology_like(const ccn__level *c, const ccn_mesh *like, ccn_mesh **out,
+/* The same, with the child topology taken from `like`, the child of a mesh with c->m's
+ * topology (an earlier plan's level, given up: its topology arrays move into *out and are
+ * NULL in like afterwards; its sizes, intervals and counts stay). Only the intervals,
+ * sharpness and counts are made. */
+ccn_status ccn__level_topology_like(const ccn__level *c, ccn_mesh *like, ccn_mesh **out,
                                     ccn_error *err);
 void ccn__level_free(ccn__level *c);
 

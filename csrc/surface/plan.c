@@ -144,20 +144,22 @@ static int same_plan_topology(const ccn_plan *q, const ccn_options *o, const ccn
 }
 
 static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
-                         const ccn_plan *prev, ccn_plan **out, ccn_error *err);
+                         ccn_plan *prev, ccn_plan **out, ccn_error *err);
 
 ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
                                   ccn_plan **out, ccn_error *err) {
     return create(cage, opts, cache, NULL, out, err);
 }
 
-ccn_status ccn_plan_recreate(const ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
+ccn_status ccn_plan_recreate(ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
                              ccn_cache *cache, ccn_plan **out, ccn_error *err) {
-    return create(cage, opts, cache, prev, out, err);
+    ccn_status st = create(cage, opts, cache, prev, out, err);
+    ccn_plan_destroy(prev); /* consumed: what the new plan took is NULL in it */
+    return st;
 }
 
 static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
-                         const ccn_plan *prev, ccn_plan **out, ccn_error *err) {
+                         ccn_plan *prev, ccn_plan **out, ccn_error *err) {
     ccn__ok(err);
     if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
     *out = NULL;

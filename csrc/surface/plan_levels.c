@@ -19,7 +19,7 @@ ccn_status ccn__plan_build_levels(ccn_plan *p, int32_t R, ccn_error *err) {
         p->prep[l].threads = p->threads;
         p->lev[l + 1] = NULL;
         p->R = l + 1; /* prep[l] is owned from here on */
-        const ccn_mesh *like = p->hint && p->hint->R > l ? p->hint->lev[l + 1] : NULL;
+        ccn_mesh *like = p->hint && p->hint->R > l ? p->hint->lev[l + 1] : NULL;
         st = ccn__level_topology_like(&p->prep[l], like, &p->lev[l + 1], err);
         if (st) { p->R = l; ccn__level_free(&p->prep[l]); return st; }
         if (like) ccn__level_tabulate_like(&p->prep[l], &p->hint->prep[l]);

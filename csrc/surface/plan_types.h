@@ -96,9 +96,10 @@ struct ccn_plan {
     ccn_cache *op_cache;     /* the caller's bi-5 operators (ccn_plan_create_cached), or NULL:
                                 then ops holds the plan's own */
     /* during ccn_plan_recreate only (NULL otherwise): the earlier plan, of the same cage
-     * topology, creases and options, whose level topology, output mesh and unchanged limit
-     * stencils are copied instead of made again */
-    const struct ccn_plan *hint;
+     * topology, creases and options, consumed by the call: its level topology and output mesh
+     * arrays are taken over (moved, not copied), its unchanged limit stencils, rule weights and
+     * cap taus copied; destroyed at the end */
+    struct ccn_plan *hint;
 };
 
 /* The weights of output o's stencil row (see ccn_plan.st_w); entry k of the row is index

@@ -10,36 +10,23 @@
 #include <math.h>
 #include <string.h>
 
-static int32_t *dup_i32(const int32_t *a, size_t n) {
-    int32_t *b = malloc(sizeof(int32_t) * (n ? n : 1));
-    if (b && n) memcpy(b, a, sizeof(int32_t) * n);
-    return b;
-}
-
-/* The earlier plan's output mesh (ccn_plan_recreate: the same level-L topology). */
-static ccn_status output_topology_like(ccn_plan *p, const ccn_plan *q, ccn_error *err) {
-    const ccn_mesh *mL = p->lev[p->L];
+/* The earlier plan's output mesh (ccn_plan_recreate: the same level-L topology), moved over. */
+static ccn_status output_topology_like(ccn_plan *p, ccn_plan *q) {
     p->nout_v = q->nout_v;
     p->nout_f = q->nout_f;
     p->nout_e = q->nout_e;
-    p->vmapL = dup_i32(q->vmapL, (size_t)mL->nv);
-    p->out_fv = dup_i32(q->out_fv, (size_t)mL->nh);
-    p->out_origin = dup_i32(q->out_origin, (size_t)mL->nf);
-    p->out_ce = dup_i32(q->out_ce, (size_t)mL->nh);
-    p->out_ev = dup_i32(q->out_ev, 2 * (size_t)q->nout_e);
-    p->out_vL = dup_i32(q->out_vL, (size_t)q->nout_v);
-    p->out_eorigin = dup_i32(q->out_eorigin, (size_t)mL->nh);
-    if (!p->vmapL || !p->out_fv || !p->out_origin || !p->out_ce || !p->out_ev || !p->out_vL ||
-        !p->out_eorigin)
-        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
+#define CCN_TAKE(f) do { p->f = q->f; q->f = NULL; } while (0)
+    CCN_TAKE(vmapL); CCN_TAKE(out_fv); CCN_TAKE(out_origin); CCN_TAKE(out_ce); CCN_TAKE(out_ev);
+    CCN_TAKE(out_vL); CCN_TAKE(out_eorigin);
+#undef CCN_TAKE
     return CCN_OK;
 }
 
 static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     if (p->hint && p->hint->L == p->L && p->hint->lev[p->L]->nv == mL->nv &&
-        p->hint->lev[p->L]->nh == mL->nh)
-        return output_topology_like(p, p->hint, err);
+        p->hint->lev[p->L]->nh == mL->nh && p->hint->vmapL)
+        return output_topology_like(p, p->hint);
     p->vmapL = malloc(sizeof(int32_t) * (size_t)mL->nv);
     p->out_fv = malloc(sizeof(int32_t) * (size_t)mL->nh);
     p->out_origin = malloc(sizeof(int32_t) * (size_t)(mL->nf ? mL->nf : 1));
@@ -488,7 +475,7 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     p->nnear = 0;
     if (moved) { /* the same topology and creases: the same regular outputs (not in near) */
         memset(j.fast, 1, nslot);
-        for (int32_t i = 0; i < p->hint->nnear; i++) j.fast[p->hint->vmapL[p->hint->near[i]]] = 0;
+        for (int32_t i = 0; i < p->hint->nnear; i++) j.fast[p->vmapL[p->hint->near[i]]] = 0;
     } else {
         ccn__parallel_for(p->threads, mL->nv, irr_range, &j);
         ccn__parallel_for(p->threads, nout, fast_range, &j);

@@ -121,7 +121,7 @@ int main(int argc, char **argv) {
                                     : ccn_plan_create_cached(&ec, &o, cache, &q, &err);
                 if (st || ccn_plan_evaluate(q, NULL, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
                 double t1 = now() - t0;
-                ccn_plan_destroy(plan);
+                if (!way) ccn_plan_destroy(plan); /* ccn_plan_recreate consumed it */
                 plan = q;
                 if (r == 0) continue; /* the first: from the cage's own intervals */
                 if (way) trec = t1 < trec ? t1 : trec; else tnew = t1 < tnew ? t1 : tnew;

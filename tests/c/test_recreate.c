@@ -156,8 +156,7 @@ static void chain(const char *name, int random_knots, int random_creases, int le
         ccn_plan *fresh = NULL, *next = NULL;
         CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &fresh, &err) == CCN_OK, "%s", err.message);
         CHECK(ccn_plan_recreate(prev, &c.cage, &o, cache, &next, &err) == CCN_OK, "%s", err.message);
-        ccn_plan_destroy(prev); /* the new plan must not need it */
-        prev = next;
+        prev = next; /* the old plan was consumed (destroyed) by the call */
         if (!fresh || !next) { ccn_plan_destroy(fresh); break; }
         result a, b;
         int ok = evaluate(fresh, &a) && evaluate(next, &b);
@@ -210,18 +209,17 @@ static void test_hint_ignored(void) {
     ccn_options o2 = {0}, o3 = {0};
     o2.levels = 2;
     o3.levels = 3;
-    ccn_plan *cube = NULL, *torus2 = NULL;
-    CHECK(ccn_plan_create(&b.cage, &o2, &cube, &err) == CCN_OK, "%s", err.message);
-    CHECK(ccn_plan_create(&a.cage, &o2, &torus2, &err) == CCN_OK, "%s", err.message);
-    for (int k = 0; k < a.ne; k++) a.creases[k] = k % 7 == 0 ? 1.5 : 0;
-    const ccn_plan *hints[3] = {cube, torus2, torus2};
     const char *what[3] = {"another topology", "other creases", "other options (levels)"};
     for (int i = 0; i < 3; i++) {
+        ccn_plan *hint = NULL; /* consumed by ccn_plan_recreate */
+        a.cage.edge_creases = NULL;
+        CHECK(ccn_plan_create(i == 0 ? &b.cage : &a.cage, &o2, &hint, &err) == CCN_OK, "%s", err.message);
+        if (i == 1) for (int k = 0; k < a.ne; k++) a.creases[k] = k % 7 == 0 ? 1.5 : 0;
         a.cage.edge_creases = i == 1 ? a.creases : NULL;
         const ccn_options *o = i == 2 ? &o3 : &o2;
         ccn_plan *fresh = NULL, *next = NULL;
         CHECK(ccn_plan_create(&a.cage, o, &fresh, &err) == CCN_OK, "%s", err.message);
-        CHECK(ccn_plan_recreate(hints[i], &a.cage, o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+        CHECK(ccn_plan_recreate(hint, &a.cage, o, NULL, &next, &err) == CCN_OK, "%s", err.message);
         result x, y;
         if (fresh && next && evaluate(fresh, &x) && evaluate(next, &y)) {
             double dn, d = compare(&x, &y, 1, &dn);
@@ -233,11 +231,15 @@ static void test_hint_ignored(void) {
         ccn_plan_destroy(fresh);
         ccn_plan_destroy(next);
     }
-    ccn_plan *none = NULL;
+    ccn_plan *none = NULL, *bad = NULL, *victim = NULL;
     CHECK(ccn_plan_recreate(NULL, &b.cage, &o2, NULL, &none, &err) == CCN_OK, "prev NULL: %s", err.message);
     ccn_plan_destroy(none);
-    ccn_plan_destroy(cube);
-    ccn_plan_destroy(torus2);
+    /* a failing call consumes prev too (ASan: no leak, no use after free) */
+    CHECK(ccn_plan_create(&b.cage, &o2, &victim, &err) == CCN_OK, "%s", err.message);
+    ccn_cage broken = b.cage;
+    broken.num_faces = 0;
+    CHECK(ccn_plan_recreate(victim, &broken, &o2, NULL, &bad, &err) != CCN_OK && !bad,
+          "a cage without faces must fail");
     unload(&a);
     unload(&b);
 }
