@@ -113,6 +113,13 @@ class TestModifier(AddonTestCase):
         self.assertIs(ccn.modifier.proxy(ob, 'VIEW').data, proxy_me)
         ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
         np.testing.assert_array_equal(loops_before, loops_after)
+        # more interval edits, each plan made from the one before (ccn_plan_recreate): a new
+        # largest interval, a small one, the largest back to 1: each equals `ccnurbs limit`
+        for e, v in ((5, 9.0), (3, 0.25), (0, 1.0)):
+            k[e] = v
+            me.attributes["knot_interval"].data.foreach_set("value", k)
+            me.update()
+            self.assertMatchesCLI(ob)
 
         # levels → new vertex count
         n2 = len(evaluated_positions(ob))
