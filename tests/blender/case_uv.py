@@ -317,6 +317,29 @@ class TestUVs(AddonTestCase):
         moved = corner_data(ob.evaluated_get(update()).data)[2]
         self.assertLess(np.abs(moved - after).max(), 1e-7)
 
+    def test_interval_edit_keeps_uvs(self):
+        """An interval edit (the plan made from the one before, its UV channels added again)
+        gives the UVs and positions of a modifier added to a copy with those intervals, and the
+        UVs follow the intervals (inside a UV chart they use the ring intervals)."""
+        ob = setup("cube")
+        add_modifier(ob, levels=2)
+        before = corner_data(ob.evaluated_get(update()).data)[2].copy()
+        me = ob.data
+        att = me.attributes.get("knot_interval") or me.attributes.new("knot_interval", 'FLOAT', 'EDGE')
+        k = np.ones(len(me.edges), np.float32)
+        k[0] = 3.0
+        att.data.foreach_set("value", k)
+        me.update()
+        edited = corner_data(ob.evaluated_get(update()).data)
+        self.assertGreater(np.abs(edited[2] - before).max(), 1e-4, "the interval did not reach the UVs")
+        twin = bpy.data.objects.new("Twin", me.copy())
+        twin.matrix_world = ob.matrix_world
+        bpy.context.collection.objects.link(twin)
+        add_modifier(twin, levels=2)
+        fresh = corner_data(twin.evaluated_get(update()).data)
+        self.assertLess(np.abs(edited[0] - fresh[0]).max(), 1e-6, "positions differ from a new modifier")
+        self.assertLess(np.abs(edited[2] - fresh[2]).max(), 1e-7, "UVs differ from a new modifier")
+
     def test_attributes_and_apply(self):
         """Point attributes interpolate like the positions (an affine function of the positions
         gives the same function of the limit positions), face attributes come from the cage
