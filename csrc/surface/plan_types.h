@@ -58,6 +58,7 @@ struct ccn_plan {
     int32_t *st_w;
     double *ws;
     int32_t nws;
+    int32_t st_nown;        /* entries of st_wp / st_wu / st_wv (the rows with their own weights) */
     /* sharp features: output vertices whose faces see more than one tangent plane (creases,
      * corners). Their sectors' tangent stencils (indices as st_v), CSR; each output face
      * corner names its sector (-1: the vertex normal). The vertex normal of such a vertex is

@@ -443,6 +443,117 @@ done:
     return st;
 }
 
+/* ccn_plan_recreate, the stencil table of the earlier plan q patched where intervals moved: the
+ * regular rows near a changed interval are made again (in threads) into scratch, and when every
+ * one of them and every irregular row (made by the caller into ib) has q's row length, q's
+ * table is taken over and those rows are written in place (own weights: over the old ones; a
+ * row that shared a weight set gets own weights, appended). The other rows are q's, which
+ * are exactly this plan's (see moved_vertices). Returns 1 when taken (the table is in b and
+ * p), 0 when not (nothing changed: the caller makes the table), -1 when out of memory. Not
+ * taken either when more than half the regular rows would end up with their own weights
+ * (shared sets are re-found only by a new table). */
+typedef struct {
+    const ccn_mesh *mL;
+    int pinned;
+    const int32_t *dl, *out_vL;
+    int32_t *dv, *dn;   /* per dirty row: FAST_MAX indices, the length */
+    double *dw;         /* per dirty row: 3 * FAST_MAX weights (wp, wu, wv) */
+} patch_job;
+
+static void patch_range(void *ctx, int32_t begin, int32_t end) {
+    const patch_job *j = ctx;
+    ccn__stencil *s = malloc(sizeof *s);
+    for (int32_t i = begin; i < end; i++) {
+        j->dn[i] = -1;
+        if (!s) continue;
+        ccn__limit_stencil(j->mL, j->out_vL[j->dl[i]], j->pinned, s);
+        if (s->n > FAST_MAX) continue;
+        j->dn[i] = s->n;
+        memcpy(j->dv + FAST_MAX * (size_t)i, s->v, sizeof(int32_t) * (size_t)s->n);
+        double *w = j->dw + 3 * FAST_MAX * (size_t)i;
+        memcpy(w, s->wp, sizeof(double) * (size_t)s->n);
+        memcpy(w + FAST_MAX, s->wu, sizeof(double) * (size_t)s->n);
+        memcpy(w + 2 * FAST_MAX, s->wv, sizeof(double) * (size_t)s->n);
+    }
+    free(s);
+}
+
+static int patch_stencils(ccn_plan *p, const stencil_job *j, csr_buf *b) {
+    ccn_plan *q = p->hint;
+    const ccn_mesh *mL = j->mL;
+    int32_t nout = p->nout_v, nd = 0, nfast = 0;
+    if (!q->st_start || !q->st_v || !q->st_w) return 0;
+    for (int32_t o = 0; o < nout; o++) {
+        int32_t n = q->st_start[o + 1] - q->st_start[o];
+        if (!j->fast[o]) { if (j->len[o] != n || q->st_w[o] < 0) return 0; continue; }
+        nfast++;
+        nd += j->moved[p->out_vL[o]];
+    }
+    int32_t *dl = malloc(sizeof(int32_t) * (size_t)(nd ? nd : 1));
+    int32_t *dv = malloc(sizeof(int32_t) * FAST_MAX * (size_t)(nd ? nd : 1));
+    int32_t *dn = malloc(sizeof(int32_t) * (size_t)(nd ? nd : 1));
+    double *dw = malloc(sizeof(double) * 3 * FAST_MAX * (size_t)(nd ? nd : 1));
+    int r = -1;
+    if (!dl || !dv || !dn || !dw) goto out;
+    nd = 0;
+    int64_t add = 0, own_rows = 0;
+    for (int32_t o = 0; o < nout; o++) {
+        if (!j->fast[o]) continue;
+        int dirty = j->moved[p->out_vL[o]];
+        if (dirty) dl[nd++] = o;
+        if (dirty && q->st_w[o] < 0) add += q->st_start[o + 1] - q->st_start[o];
+        own_rows += dirty || q->st_w[o] >= 0;
+    }
+    r = 0;
+    if (q->nws && 2 * own_rows > nfast) goto out; /* mostly own weights: let a new table share */
+    patch_job pj = {mL, j->pinned, dl, p->out_vL, dv, dn, dw};
+    ccn__parallel_for(p->threads, nd, patch_range, &pj);
+    for (int32_t i = 0; i < nd; i++)
+        if (dn[i] != q->st_start[dl[i] + 1] - q->st_start[dl[i]]) goto out; /* other length */
+    r = -1;
+    if (add) { /* room for the rows that leave their shared set */
+        size_t cap = (size_t)q->st_nown + (size_t)add;
+        double *a = realloc(q->st_wp, sizeof(double) * cap);
+        if (a) q->st_wp = a;
+        double *c = realloc(q->st_wu, sizeof(double) * cap);
+        if (c) q->st_wu = c;
+        double *d = realloc(q->st_wv, sizeof(double) * cap);
+        if (d) q->st_wv = d;
+        if (!a || !c || !d) goto out;
+    }
+    /* taken: q's table is this plan's from here on */
+    free(p->st_start);
+    free(p->st_w);
+    p->st_start = q->st_start; p->st_w = q->st_w; p->ws = q->ws; p->nws = q->nws;
+    b->v = q->st_v; b->wp = q->st_wp; b->wu = q->st_wu; b->wv = q->st_wv;
+    p->st_nown = q->st_nown;
+    q->st_start = q->st_w = q->st_v = NULL; q->ws = q->st_wp = q->st_wu = q->st_wv = NULL;
+    q->nws = 0;
+    b->n = p->st_start[nout];
+    for (int32_t o = 0; o < nout; o++) { /* the irregular rows, made by the caller */
+        if (j->fast[o]) continue;
+        int32_t at = p->st_start[o], w = p->st_w[o], from = j->istart[o], n = j->len[o];
+        memcpy(b->v + at, j->ib->v + from, sizeof(int32_t) * (size_t)n);
+        memcpy(b->wp + w, j->ib->wp + from, sizeof(double) * (size_t)n);
+        memcpy(b->wu + w, j->ib->wu + from, sizeof(double) * (size_t)n);
+        memcpy(b->wv + w, j->ib->wv + from, sizeof(double) * (size_t)n);
+    }
+    for (int32_t i = 0; i < nd; i++) { /* the regular rows near a changed interval */
+        int32_t o = dl[i], n = dn[i], at = p->st_start[o];
+        if (p->st_w[o] < 0) { p->st_w[o] = p->st_nown; p->st_nown += n; }
+        int32_t w = p->st_w[o];
+        const double *src = dw + 3 * FAST_MAX * (size_t)i;
+        memcpy(b->v + at, dv + FAST_MAX * (size_t)i, sizeof(int32_t) * (size_t)n);
+        memcpy(b->wp + w, src, sizeof(double) * (size_t)n);
+        memcpy(b->wu + w, src + FAST_MAX, sizeof(double) * (size_t)n);
+        memcpy(b->wv + w, src + 2 * FAST_MAX, sizeof(double) * (size_t)n);
+    }
+    r = 1;
+out:
+    free(dl); free(dv); free(dn); free(dw);
+    return r;
+}
+
 static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
@@ -500,6 +611,14 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
             goto done;
         }
     }
+    if (moved) { /* ccn_plan_recreate: the earlier table patched in place, where it fits */
+        int r = patch_stencils(p, &j, &b);
+        if (r < 0) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+            goto done;
+        }
+        if (r) goto sectors;
+    }
     /* FAST_MAX slots per regular one, the irregular ones' own size; made, then packed */
     slot[0] = 0;
     for (int32_t o = 0; o < nout; o++) {
@@ -552,6 +671,8 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
         if (c) b.wu = c;
         if (d) b.wv = d;
     }
+    p->st_nown = own;
+sectors:
     if (p->nsec) {
         p->sec_nrm = malloc(sizeof(double) * 3 * (size_t)p->nsec);
         if (!p->sec_nrm) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
