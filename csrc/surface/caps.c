@@ -5,6 +5,7 @@
 #include "surface/caps.h"
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "base/vec3.h"
 #include "bi5/bi5.h"
 #include "rules/bspline.h"
@@ -154,16 +155,25 @@ static const ccn__cap *same_spokes_cap(const ccn_plan *p, const int32_t *hint_ca
     return h;
 }
 
-/* Sets up the cap of EV ev at level K; returns 1 if it was added, 0 for a fallback. */
-static int cap_add(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn_error *err) {
+/* A cap being set up (ccn__caps_setup's three passes): its slot in p->caps, what is left. */
+typedef struct {
+    int32_t ev;
+    int ok, uni;       /* ok: so far; uni: equal spoke intervals */
+    int need_taus;     /* non-uniform spokes whose taus are still to be solved (pass 2) */
+} cap_todo;
+
+/* Pass 1 (serial): the cap of EV ev at level K in slot c: its net, ring, spoke intervals,
+ * limit weights, the kappa range, and its taus when the earlier plan has them. */
+static void cap_begin(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn__cap *c, cap_todo *t) {
     const ccn_mesh *m = p->lev[p->K];
     int32_t n = ccn__valence(m, ev);
-    if (n > CCN_CAP_MAX_VALENCE) return 0;
+    memset(c, 0, sizeof *c);
+    memset(t, 0, sizeof *t);
+    t->ev = ev;
+    if (n > CCN_CAP_MAX_VALENCE) return;
     ccn_error e2;
     const struct ccn__bi5 *op = cap_op(p, n, 0, &e2);
-    if (!op) return 0;
-    ccn__cap *c = &p->caps[p->ncap];
-    memset(c, 0, sizeof *c);
+    if (!op) return;
     c->n = n;
     c->op = op;
     c->cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));
@@ -171,9 +181,8 @@ static int cap_add(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn_error 
     c->l0 = malloc(sizeof(double) * 3 * (2 * (size_t)n + 1)); /* limit point, then tangents */
     c->knots = malloc(sizeof(double) * (size_t)n);
     c->patches = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(op));
-    double *zero = calloc(3 * (6 * (size_t)n + 1), sizeof(double));
     ccn__stencil *s = malloc(sizeof *s);
-    int ok = c->cnet && c->ring && c->l0 && c->knots && c->patches && zero && s;
+    int ok = c->cnet && c->ring && c->l0 && c->knots && c->patches && s;
     if (ok) {
         cap_cnet(m, ev, n, c->cnet);
         ccn__ev_ring(m, ev, c->ring);
@@ -189,28 +198,52 @@ static int cap_add(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn_error 
             uni &= fabs(c->knots[k] / c->knots[0] - 1.0) <= 1e-12;
             if (kap > krange * (1 + 1e-12) || kap * krange < 1 - 1e-12) ok = 0; /* measured range */
         }
+        t->uni = uni;
         if (ok && nu) {
             c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
             const ccn__cap *h = c->taus ? same_spokes_cap(p, hint_caps, ev, c) : NULL;
             if (h) memcpy(c->taus, h->taus, sizeof(double complex) * 36 * (size_t)n); /* the same taus */
-            else ok = c->taus && ccn__bi5_nu_taus(op, c->knots, c->taus, &e2) == CCN_OK;
+            else if (c->taus) t->need_taus = 1;
+            else ok = 0;
         }
+    }
+    free(s);
+    t->ok = ok;
+}
+
+/* Pass 2 (the plan's threads): the taus of the caps that need them (bi5.h [R11]); each solve
+ * reads its cap and the shared operator only. */
+typedef struct { ccn__cap *caps; cap_todo *todo; const int32_t *list; } taus_job;
+
+static void taus_range(void *ctx, int32_t begin, int32_t end) {
+    const taus_job *j = ctx;
+    for (int32_t k = begin; k < end; k++) {
+        int32_t i = j->list[k];
+        cap_todo *t = &j->todo[i];
+        ccn__cap *c = &j->caps[i];
+        ccn_error e2;
+        t->ok = ccn__bi5_nu_taus(c->op, c->knots, c->taus, &e2) == CCN_OK;
+    }
+}
+
+/* Pass 3 (serial, in EV order): the patches of the cap in slot c (its taus known); 1 if it is
+ * kept, 0 for a fallback (the slot freed). */
+static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
+    int ok = t->ok;
+    if (ok) {
+        ccn_error e2;
+        double *zero = calloc(3 * (6 * (size_t)c->n + 1), sizeof(double));
+        ok = zero != NULL;
         /* Equal spoke intervals: the uniform operator on the level-K net, whose bicubic surround
          * is the limit itself. Any other intervals (kappa = 1 alternating and period 4 too, whose
          * level-K surround is not the limit: issue 14 measured 5e-5 .. 6e-3 off): the exact
          * level-(K+1) surround and the exact centre normal (bi5.h [R13], [R14]). */
-        if (ok && uni) ok = ccn__bi5_apply_cached(op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
-        else if (ok) ok = cap_use_surround(p, c, ev, zero, &e2);
+        if (ok && t->uni) ok = ccn__bi5_apply_cached(c->op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
+        else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
+        free(zero);
     }
-    free(zero);
-    free(s);
-    if (!ok) {
-        ccn__cap_free(c);
-        return 0;
-    }
-    p->ncap++;
-    (void)err;
-    return 1;
+    if (!ok) ccn__cap_free(c);
+    return ok;
 }
 
 /* Chooses K, builds the caps. A cap at level K >= L (the output level) changes nothing: every
@@ -254,10 +287,30 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
         for (int32_t v = 0; v < m->nv; v++) hint_caps[v] = -1;
         for (int32_t c = 0; c < p->hint->ncap; c++) hint_caps[p->hint->caps[c].cnet[0]] = c;
     }
+    cap_todo *todo = malloc(sizeof(cap_todo) * (size_t)(nev ? nev : 1));
+    if (!todo) { free(hint_caps); free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
+    int32_t ncand = 0; /* pass 1: every cap EV in order, a slot each */
     for (int32_t v = 0; v < m->nv; v++) {
         if (!cap_ev(m, v)) continue;
-        if (!cap_isolated(m, v, stamp, q) || !cap_add(p, v, hint_caps, err)) p->sizes.num_cap_fallbacks++;
+        if (!cap_isolated(m, v, stamp, q)) { p->sizes.num_cap_fallbacks++; continue; }
+        cap_begin(p, v, hint_caps, &p->caps[ncand], &todo[ncand]);
+        ncand++;
     }
+    int32_t nsolve = 0; /* pass 2: the tau solves (each a few ms), spread over the threads */
+    int32_t *solve = malloc(sizeof(int32_t) * (size_t)(ncand ? ncand : 1));
+    for (int32_t i = 0; solve && i < ncand; i++)
+        if (todo[i].ok && todo[i].need_taus) solve[nsolve++] = i;
+    if (!solve) /* out of memory: those caps fall back */
+        for (int32_t i = 0; i < ncand; i++) todo[i].ok &= !todo[i].need_taus;
+    taus_job tj = {p->caps, todo, solve};
+    ccn__parallel_for(p->threads, nsolve, taus_range, &tj);
+    free(solve);
+    for (int32_t i = 0; i < ncand; i++) { /* pass 3: in EV order; the kept caps packed */
+        ccn__cap c = p->caps[i];
+        if (cap_finish(p, &c, &todo[i])) p->caps[p->ncap++] = c;
+        else p->sizes.num_cap_fallbacks++;
+    }
+    free(todo);
     free(hint_caps);
     free(stamp); free(q);
     p->sizes.num_caps = p->ncap;
