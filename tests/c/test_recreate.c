@@ -244,8 +244,42 @@ static void test_hint_ignored(void) {
     unload(&b);
 }
 
+/* The earlier plan had a UV channel and was never evaluated (no rule tables to copy): the
+ * recreated plan still equals a new one, holds no channel (ccn_plan_evaluate_fvar refuses
+ * channel 0), takes a new one, and nothing leaks (ASan). */
+static void test_channels_and_unevaluated(void) {
+    edit_cage c;
+    if (!load("tests/data/fvar_abab.obj", 1, 0, &c)) { CHECK(0, "cannot read fvar_abab.obj"); return; }
+    ccn_fvar_channel uv;
+    CHECK(ccn_obj_fvar(c.obj, &uv) == CCN_OK && uv.num_values > 0, "no UV map");
+    ccn_error err;
+    ccn_options o = {0};
+    o.levels = 2;
+    ccn_plan *prev = NULL, *next = NULL, *fresh = NULL;
+    int32_t ch = -1;
+    CHECK(ccn_plan_create(&c.cage, &o, &prev, &err) == CCN_OK, "%s", err.message);
+    CHECK(prev && ccn_plan_add_fvar(prev, &uv, &ch, &err) == CCN_OK, "%s", err.message);
+    c.knots[0] *= 2.5;
+    CHECK(ccn_plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+    CHECK(ccn_plan_create(&c.cage, &o, &fresh, &err) == CCN_OK, "%s", err.message);
+    if (next && fresh) {
+        result a = {0}, b = {0};
+        double dn = -1, d = evaluate(fresh, &a) && evaluate(next, &b) ? compare(&a, &b, 1, &dn) : -1;
+        CHECK(d == 0 && dn == 0, "unevaluated earlier plan: differs from a new plan (%g, %g)", d, dn);
+        free(a.x); free(a.fv); free(b.x); free(b.fv);
+        ccn_fvar_sizes fs;
+        CHECK(ccn_plan_fvar_sizes(next, 0, &fs) != CCN_OK, "the earlier plan's channel was carried over");
+        int32_t ch2 = -1;
+        CHECK(ccn_plan_add_fvar(next, &uv, &ch2, &err) == CCN_OK && ch2 == 0, "%s", err.message);
+    }
+    ccn_plan_destroy(next);
+    ccn_plan_destroy(fresh);
+    unload(&c);
+}
+
 int main(void) {
     RUN(test_interval_edits);
     RUN(test_hint_ignored);
+    RUN(test_channels_and_unevaluated);
     return TEST_SUMMARY();
 }
