@@ -282,14 +282,9 @@ void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q) {
     if (!q->tab_full || !q->tf || c->tab_full || !qm || qm->nv != m->nv || qm->nf != m->nf ||
         qm->ne != m->ne || qm->nh != m->nh || !m->esharp != !qm->esharp || !q->tvs != !m->esharp)
         return;
-    uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    uint8_t *ends = ccn__changed_interval_ends(m, qm);
     if (!ends || !tab_alloc(c)) { free(ends); return; }
     double r = qm->knot_scale / m->knot_scale;
-    for (int32_t e = 0; e < m->ne; e++) {
-        double a = m->eknot[e] * m->knot_scale, b = qm->eknot[e] * qm->knot_scale;
-        if (a != b)
-            ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
-    }
     uint8_t *fm = c->tmask, *em = fm + m->nf, *vm = em + m->ne;
     const uint8_t *qf = q->tmask, *qe = qf + m->nf, *qv = qe + m->ne;
     for (int32_t f = 0; f < m->nf; f++) {

@@ -5,6 +5,7 @@
 
 #include "base/parallel.h"
 #include "surface/limit.h"
+#include "topology/knots.h"
 
 #include <string.h>
 
@@ -18,14 +19,8 @@
  * derivative weights in q's interval unit (a power of two apart), which gives the same unit
  * normals. */
 uint8_t *ccn__moved_vertices(const ccn_mesh *m, const ccn_mesh *q) {
-    if (!q || q->ne != m->ne || q->nv != m->nv) return NULL;
-    uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1), *moved = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    uint8_t *ends = ccn__changed_interval_ends(m, q), *moved = calloc((size_t)(m->nv ? m->nv : 1), 1);
     if (!ends || !moved) { free(ends); free(moved); return NULL; }
-    for (int32_t e = 0; e < m->ne; e++) {
-        double a = m->eknot[e] * m->knot_scale, b = q->eknot[e] * q->knot_scale;
-        if (a != b)
-            ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
-    }
     for (int32_t v = 0; v < m->nv; v++) {
         if (!ends[v]) continue;
         for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
@@ -37,18 +32,26 @@ uint8_t *ccn__moved_vertices(const ccn_mesh *m, const ccn_mesh *q) {
     return moved;
 }
 
-/* Output o's row in the earlier plan q, if it is a regular one (level-L indices only, at most
- * CCN_FAST_MAX entries): 1 and s filled, else 0. */
-int ccn__earlier_row(const ccn_plan *q, int32_t o, ccn__stencil *s) {
+/* The length of output o's row in the earlier plan q if it is a regular one (level-L indices
+ * only, at most CCN_FAST_MAX entries), else -1. */
+int32_t ccn__earlier_regular(const ccn_plan *q, int32_t o) {
     int32_t b = q->st_start[o], n = q->st_start[o + 1] - b, nvL = q->lev[q->L]->nv;
-    if (n > CCN_FAST_MAX) return 0;
+    if (n > CCN_FAST_MAX) return -1;
+    for (int32_t k = 0; k < n; k++)
+        if (q->st_v[b + k] >= nvL) return -1;
+    return n;
+}
+
+/* Output o's row in the earlier plan q, if it is a regular one: 1 and s filled, else 0. */
+int ccn__earlier_row(const ccn_plan *q, int32_t o, ccn__stencil *s) {
+    int32_t b = q->st_start[o], n = ccn__earlier_regular(q, o);
+    if (n < 0) return 0;
     const double *wp, *wu, *wv;
     ccn__plan_row_weights(q, o, &wp, &wu, &wv);
-    for (int32_t k = 0; k < n; k++) {
-        if (q->st_v[b + k] >= nvL) return 0;
-        s->v[k] = q->st_v[b + k];
-        s->wp[k] = wp[k]; s->wu[k] = wu[k]; s->wv[k] = wv[k];
-    }
+    memcpy(s->v, q->st_v + b, sizeof(int32_t) * (size_t)n);
+    memcpy(s->wp, wp, sizeof(double) * (size_t)n);
+    memcpy(s->wu, wu, sizeof(double) * (size_t)n);
+    memcpy(s->wv, wv, sizeof(double) * (size_t)n);
     s->n = n;
     return 1;
 }

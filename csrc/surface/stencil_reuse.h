@@ -11,6 +11,8 @@
 /* Per level-L vertex of m, 1 where a regular stencil may read an interval that differs from
  * q's (q: the same level of the earlier plan); NULL when out of memory or not comparable. */
 uint8_t *ccn__moved_vertices(const ccn_mesh *m, const ccn_mesh *q);
+/* The length of output o's row in the earlier plan q if it is a regular one, else -1. */
+int32_t ccn__earlier_regular(const ccn_plan *q, int32_t o);
 /* Output o's regular row in the earlier plan q into s: 1, or 0 if it is not a regular row. */
 int ccn__earlier_row(const ccn_plan *q, int32_t o, ccn__stencil *s);
 

@@ -264,10 +264,9 @@ static void fill_range(void *ctx, int32_t begin, int32_t end) {
         const ccn_plan *q = j->p->hint;
         int keep = j->moved && !j->moved[j->p->out_vL[o]];
         if (keep && q->st_w[o] < 0) { /* the earlier plan's shared set: named only */
-            int32_t from = q->st_start[o], n = q->st_start[o + 1] - from, nvL = j->mL->nv, ok = n <= FAST_MAX;
-            for (int32_t k = 0; k < n && ok; k++) ok = q->st_v[from + k] < nvL;
-            if (ok) {
-                memcpy(b->v + at, q->st_v + from, sizeof(int32_t) * (size_t)n);
+            int32_t n = ccn__earlier_regular(q, o);
+            if (n >= 0) {
+                memcpy(b->v + at, q->st_v + q->st_start[o], sizeof(int32_t) * (size_t)n);
                 j->len[o] = n;
                 j->ref[o] = -3 - (-1 - q->st_w[o]);
                 continue;

@@ -79,6 +79,15 @@ static void ring_means(const ccn_mesh *m, const int32_t *parent, const double *v
     }
 }
 
+uint8_t *ccn__changed_interval_ends(const ccn_mesh *m, const ccn_mesh *q) {
+    if (!q || q->ne != m->ne || q->nv != m->nv) return NULL;
+    uint8_t *ends = calloc((size_t)(m->nv ? m->nv : 1), 1);
+    for (int32_t e = 0; ends && e < m->ne; e++)
+        if (m->eknot[e] * m->knot_scale != q->eknot[e] * q->knot_scale)
+            ends[m->everts[2 * e]] = ends[m->everts[2 * e + 1]] = 1;
+    return ends;
+}
+
 ccn_status ccn__resolve_rings(ccn_mesh *m, const double *val, const int32_t *source,
                               ccn_error *err) {
     size_t ne = (size_t)(m->ne ? m->ne : 1);
