@@ -1,7 +1,8 @@
 """ctypes binding to libccnurbs.so, shipped inside this package.
 
 Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) or, after
-an edit, ccn_plan_recreate (from the plan it replaces) / ccn_plan_sizes / ccn_plan_evaluate / ccn_plan_destroy, and its face-varying channels and
+an edit, ccn_plan_recreate (from the plan it replaces) / ccn_plan_sizes / ccn_plan_evaluate (the first
+evaluation after an edit: ccn_plan_evaluate_changed) / ccn_plan_destroy, and its face-varying channels and
 per-vertex data (ccn_plan_add_fvar / ccn_plan_fvar_sizes / ccn_plan_evaluate_fvar /
 ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
 buffers passed by pointer; a failing call raises CCNError carrying the library's message.
@@ -142,6 +143,8 @@ def _bind(lib):
     lib.ccn_plan_evaluate.argtypes = [P, c_double_p, ctypes.POINTER(ccn_limit_mesh),
                                       ctypes.POINTER(ccn_error)]
     lib.ccn_plan_evaluate.restype = ctypes.c_int
+    lib.ccn_plan_evaluate_changed.argtypes = lib.ccn_plan_evaluate.argtypes
+    lib.ccn_plan_evaluate_changed.restype = ctypes.c_int
     lib.ccn_plan_destroy.argtypes = [P]
     lib.ccn_plan_destroy.restype = None
     lib.ccn_plan_add_fvar.argtypes = [P, ctypes.POINTER(ccn_fvar_channel), c_int32_p,
@@ -243,6 +246,11 @@ class Plan:
         self._lib = lib
         self._handle = None
         self._buffers = None  # evaluate(topology=False)'s output arrays, reused
+        self._last = None  # the own arrays the last evaluate(topology=False) wrote, else None
+        # an interval edit's plan starts from the output of the plan it replaces: its first
+        # evaluate writes only what the edit changed (ccn_plan_evaluate_changed)
+        self._inherit = previous._last if previous is not None else None
+        self.changed_only = False  # the last evaluate was ccn_plan_evaluate_changed
         pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)
         fs = np.ascontiguousarray(face_sizes, dtype=np.int32).reshape(-1)
         fv = np.ascontiguousarray(face_verts, dtype=np.int32).reshape(-1)
@@ -306,10 +314,19 @@ class Plan:
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
         n, f = self.sizes["num_verts"], self.sizes["num_faces"]
-        if topology or self._buffers is None:
+        inherit, self._inherit = self._inherit, None
+        sharp = self.sizes.get("num_sharp_corners", 0) > 0
+        if inherit is not None and (sorted(inherit) != sorted(["positions", "normals"] + (
+                ["corner_normals"] if sharp else [])) or len(inherit["positions"]) != n):
+            inherit = None  # not this output's arrays
+        if inherit is not None:  # the earlier plan's output, kept where the edit changed nothing
+            out = dict(inherit)
+            if not topology:
+                self._buffers = dict(inherit)
+        elif topology or self._buffers is None:
             out = {"positions": np.empty((n, 3), np.float64),
                    "normals": np.empty((n, 3), np.float64)}
-            if self.sizes.get("num_sharp_corners", 0) > 0:
+            if sharp:
                 out["corner_normals"] = np.empty((4 * f, 3), np.float64)
             if not topology:  # position updates reuse these arrays (written before the next)
                 self._buffers = out
@@ -336,10 +353,14 @@ class Plan:
                 raise CCNError("CCN_ERR_ARGUMENT", "expected %d cage positions, got %d"
                                % (self.sizes["num_cage_verts"], pos.size // 3))
         err = ccn_error()
-        st = self._lib.ccn_plan_evaluate(self._handle, _ptr(pos, ctypes.c_double),
-                                         ctypes.byref(lm), ctypes.byref(err))
+        self._last = None
+        self.changed_only = inherit is not None
+        fn = self._lib.ccn_plan_evaluate_changed if inherit is not None else self._lib.ccn_plan_evaluate
+        st = fn(self._handle, _ptr(pos, ctypes.c_double), ctypes.byref(lm), ctypes.byref(err))
         if st != 0:
             _raise(st, err)
+        if not topology:  # the plan's own arrays (a caller keeps topology=True results)
+            self._last = {k: out[k] for k in ("positions", "normals", "corner_normals") if k in out}
         return out
 
     def add_fvar(self, values, indices, linear="PRESERVE_CORNERS"):

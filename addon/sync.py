@@ -29,7 +29,8 @@ from . import cage as cagemod
 # ccn_cage.edge_creases / vertex_creases when the cage's Use Creases is on (the default).
 
 stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "skipped": 0, "errors": 0,
-         "internal_errors": 0, "render_frames": 0}
+         "internal_errors": 0, "render_frames": 0, "changed_only": 0}
+# changed_only: interval edits whose plan wrote only the outputs the edit changed
 _plans = {}      # (object name, kind) -> (topology key, native.Plan)
 _status = {}     # (object name, kind) -> Status
 _key_memo = {}   # (object name, kind) -> the last topology keys, their inputs (cage.py), and
@@ -194,6 +195,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             pass  # forced: the proxy is already right
         elif same_topology:
             proxies.write_positions(me, plan.evaluate(cage.positions, topology=False), exact)
+            stats["changed_only"] += plan.changed_only
             # a new plan (an interval edit) changes the limit UVs and attributes too
             _write_extras(me, plan, cage, uv_chans, ekey, me.get(proxies.PLAN_PROP) != topo)
             stats["position_updates"] += 1

@@ -322,7 +322,7 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
 }
 
 /* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h). */
-static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out) {
+static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) {
     const ccn_mesh *mK = p->lev[p->K];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     for (int32_t i = 0; i < p->nrf; i++)
@@ -334,12 +334,13 @@ static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out) {
         double x[3], du[3], dv[3];
         ccn__bezier_eval(b, 3, p->bv_uv[2 * i], p->bv_uv[2 * i + 1], x, du, dv);
         int32_t o = p->bv_out[i];
+        if (written) written[o] = 1;
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
         if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
     }
 }
 
-ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
+ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written, ccn_error *err) {
     if (p->ncap == 0) return CCN_OK;
     const double *P = p->lev[p->K]->pos;
     for (int32_t c = 0; c < p->ncap; c++) {
@@ -375,9 +376,10 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) 
         double x[3], du[3], dv[3];
         ccn__bi5_eval(cp->op, cp->patches, p->hv_sector[i], p->hv_uv[2 * i], p->hv_uv[2 * i + 1], x, du, dv);
         int32_t o = p->hv_out[i];
+        if (written) written[o] = 1;
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
         if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
     }
-    eval_ring_faces(p, out);
+    eval_ring_faces(p, out, written);
     return CCN_OK;
 }

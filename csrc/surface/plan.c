@@ -15,6 +15,7 @@
 #include "base/vec3.h"
 #include "bi5/bi5.h"
 #include "surface/caps.h"
+#include "surface/edit_region.h"
 #include "surface/plan_fvar.h"
 #include "surface/plan_levels.h"
 #include "surface/tessellate.h"
@@ -46,6 +47,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     for (int32_t c = 0; c < p->nfv; c++) ccn__fvchan_free(p->fv[c]);
     free(p->fv); free(p->vd_buf);
     ccn__ev_cache_destroy(p->ev_cache);
+    ccn__edit_region_free(p->region);
     free(p);
 }
 
@@ -210,9 +212,11 @@ static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cach
     if (st) goto fail;
     if ((st = ccn__caps_setup(p, err))) goto fail;
     if ((st = ccn__plan_build_levels(p, p->R > p->L ? p->R : p->L, err))) goto fail;
+    if (p->hint) ccn__edit_region_begin(p); /* none when out of memory: evaluate all */
     if ((st = setup_level_s(p, err))) goto fail;
     if ((st = ccn__tess_output(p, err))) goto fail;
     if (p->ncap && (st = ccn__tess_holes(p, err))) goto fail;
+    ccn__edit_region_rows(p);
     fill_sizes(p);
     p->hint = NULL;
     *out = p;
@@ -233,7 +237,7 @@ ccn_status ccn_plan_sizes(const ccn_plan *p, ccn_sizes *s) {
 
 #define SPOINT(i) ((i) < nvL ? PL + 3 * (size_t)(i) : PS + 3 * ((size_t)(i) - nvL))
 
-typedef struct { const ccn_plan *p; ccn_limit_mesh *out; } stencil_job;
+typedef struct { const ccn_plan *p; ccn_limit_mesh *out; const int32_t *rows; } stencil_job; /* rows: NULL = all */
 
 static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     const stencil_job *j = ctx;
@@ -241,7 +245,8 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     ccn_limit_mesh *out = j->out;
     const double *PL = p->lev[p->L]->pos, *PS = p->posS;
     int32_t nvL = p->lev[p->L]->nv;
-    for (int32_t o = begin; o < end; o++) {
+    for (int32_t i = begin; i < end; i++) {
+        int32_t o = j->rows ? j->rows[i] : i;
         const double *wp, *wu, *wv;
         ccn__plan_row_weights(p, o, &wp, &wu, &wv);
         const int32_t *idx = p->st_v + p->st_start[o];
@@ -279,9 +284,9 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     }
 }
 
-static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out) {
-    stencil_job j = {p, out};
-    ccn__parallel_for(p->threads, p->nout_v, stencil_range, &j);
+static void eval_stencils(const ccn_plan *p, ccn_limit_mesh *out, const int32_t *rows, int32_t nrows) {
+    stencil_job j = {p, out, rows};
+    ccn__parallel_for(p->threads, rows ? nrows : p->nout_v, stencil_range, &j);
 }
 
 /* Sharp features: each sector's normal, the vertex normal = their normalised sum. */
@@ -316,13 +321,21 @@ static void eval_corner_normals(const ccn_plan *p, ccn_limit_mesh *out) {
         }
 }
 
-ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh *out,
-                             ccn_error *err) {
+/* Both evaluations; changed: out holds the last evaluation of the plan p was recreated from
+ * (ccn_plan_evaluate_changed). */
+static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh *out, int changed,
+                           ccn_error *err) {
     ccn__ok(err);
     if (!p || !out || !out->positions)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "plan, out or out->positions is NULL");
     if (out->corner_normals && !out->normals)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "corner_normals needs normals too");
+    struct ccn__edit_region *r = changed ? p->region : NULL;
+    if (!changed && p->region) { /* the earlier plan's points are this plan's now: evaluate all */
+        ccn__edit_region_free(p->region);
+        p->region = NULL;
+    }
+    p->evaluated = 0;
     if (positions) {
         ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
         if (st) return st;
@@ -334,23 +347,56 @@ ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mes
     double *centre = p->centre, scale;
     ccn__normalize(p->lev[0], centre, &scale);
     p->scale = scale;
-    for (int32_t l = 0; l < p->R; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
+    p->region = NULL; /* used once, by this call */
+    if (r && (memcmp(r->pos0, p->lev[0]->pos, sizeof(double) * 3 * (size_t)p->lev[0]->nv) ||
+              memcmp(r->centre, centre, sizeof r->centre) || r->scale != scale)) {
+        ccn__edit_region_free(r); /* the cage moved too: everything changes */
+        r = NULL;
+    }
+    for (int32_t l = 0; l < p->R; l++) {
+        if (r)
+            ccn__level_points_lists(&p->prep[l], r->lists[l].f, r->lists[l].nf, r->lists[l].e,
+                                    r->lists[l].ne, r->lists[l].v, r->lists[l].nv, p->lev[l + 1]->pos);
+        else
+            ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
+    }
     if (p->has_sub) {
         ccn__level_tabulate_subset(&p->sub, p->near, p->nnear);
         ccn__level_points_subset(&p->sub, p->near, p->nnear, p->posS);
     }
-    eval_stencils(p, out);
+    uint8_t *written = NULL;
+    if (r) {
+        written = r->written;
+        memset(written, 0, (size_t)p->nout_v);
+        for (int32_t i = 0; i < r->nrows; i++) written[r->rows[i]] = 1;
+        eval_stencils(p, out, r->rows, r->nrows);
+    } else {
+        eval_stencils(p, out, NULL, 0);
+    }
     if (out->normals && p->nsec) eval_sectors(p, out);
-    ccn_status st = ccn__caps_evaluate(p, out, err);
-    if (st) return st;
+    ccn_status st = ccn__caps_evaluate(p, out, written, err);
+    if (st) { ccn__edit_region_free(r); return st; }
     if (out->corner_normals) eval_corner_normals(p, out);
     for (int32_t o = 0; o < p->nout_v; o++)
-        for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
+        if (!written || written[o])
+            for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];
+    ccn__edit_region_free(r);
     if (out->face_verts) memcpy(out->face_verts, p->out_fv, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->face_origin) memcpy(out->face_origin, p->out_origin, sizeof(int32_t) * (size_t)p->nout_f);
     if (out->corner_edge_origin)
         memcpy(out->corner_edge_origin, p->out_eorigin, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->edge_verts) memcpy(out->edge_verts, p->out_ev, sizeof(int32_t) * 2 * (size_t)p->nout_e);
     if (out->corner_edges) memcpy(out->corner_edges, p->out_ce, sizeof(int32_t) * 4 * (size_t)p->nout_f);
+    p->evaluated = 1;
     return CCN_OK;
+}
+
+ccn_status ccn_plan_evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh *out,
+                             ccn_error *err) {
+    return evaluate(p, positions, out, 0, err);
+}
+
+ccn_status ccn_plan_evaluate_changed(ccn_plan *p, const double *positions, ccn_limit_mesh *out,
+                                     ccn_error *err) {
+    return evaluate(p, positions, out, 1, err);
 }

@@ -8,6 +8,7 @@
 
 struct ccn__bi5;
 struct ccn__fvchan; /* a face-varying channel (surface/plan_fvar.c) */
+struct ccn__edit_region; /* what an interval edit changes (surface/edit_region.c) */
 
 /* One extraordinary vertex filled by the guided bi-5 cap (K&P 2018). */
 typedef struct {
@@ -101,6 +102,12 @@ struct ccn_plan {
      * arrays are taken over (moved, not copied), its unchanged limit stencils, rule weights and
      * cap taus copied; destroyed at the end */
     struct ccn_plan *hint;
+    /* 1 after a successful ccn_plan_evaluate: the levels' points are those of lev[0]->pos
+     * (normalised by centre, scale) */
+    int evaluated;
+    /* made by ccn_plan_recreate from an evaluated earlier plan, used and dropped by the next
+     * evaluation: the earlier plan's level points (moved into lev[]) and what the edit changed */
+    struct ccn__edit_region *region;
 };
 
 /* The weights of output o's stencil row (see ccn_plan.st_w); entry k of the row is index

@@ -5,6 +5,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "surface/edit_region.h"
 #include "surface/limit.h"
 #include "surface/stencil_reuse.h"
 
@@ -455,6 +456,8 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
             goto done;
         }
     }
+    if (moved && p->region && (p->region->redo = malloc(nslot))) /* the rows made again */
+        for (int32_t o = 0; o < nout; o++) p->region->redo[o] = !j.fast[o] || moved[p->out_vL[o]];
     if (moved) { /* ccn_plan_recreate: the earlier table patched in place, where it fits */
         ccn__reuse_rows in = {j.fast, moved, len, istart, ib.v, ib.wp, ib.wu, ib.wv, pinned};
         ccn__reuse_table t = {NULL, NULL, NULL, NULL, 0};

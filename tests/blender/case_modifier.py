@@ -114,12 +114,16 @@ class TestModifier(AddonTestCase):
         ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
         np.testing.assert_array_equal(loops_before, loops_after)
         # more interval edits, each plan made from the one before (ccn_plan_recreate): a new
-        # largest interval, a small one, the largest back to 1: each equals `ccnurbs limit`
+        # largest interval, a small one, the largest back to 1: each equals `ccnurbs limit`,
+        # and each wrote only what it changed into the outputs of the plan before
+        # (ccn_plan_evaluate_changed: the previous edit's outputs are the plan's own arrays)
+        st = dict(ccn.sync.stats)
         for e, v in ((5, 9.0), (3, 0.25), (0, 1.0)):
             k[e] = v
             me.attributes["knot_interval"].data.foreach_set("value", k)
             me.update()
             self.assertMatchesCLI(ob)
+        self.assertEqual(ccn.sync.stats["changed_only"] - st["changed_only"], 3)
 
         # levels → new vertex count
         n2 = len(evaluated_positions(ob))

@@ -89,16 +89,23 @@ static void unload(edit_cage *c) {
 
 typedef struct { ccn_sizes s; double *x; int32_t *fv; } result;
 
-static int evaluate(ccn_plan *p, result *r) {
+/* r: p's output (positions: NULL for the cage's). from: NULL, or the earlier plan's last
+ * output, which r starts as, evaluated by ccn_plan_evaluate_changed. */
+static int evaluate_at(ccn_plan *p, const double *positions, const result *from, result *r) {
     ccn_error err;
     ccn_plan_sizes(p, &r->s);
     size_t nv = (size_t)r->s.num_verts, nf = (size_t)r->s.num_faces;
     r->x = malloc(sizeof(double) * (6 * nv + 12 * nf));
     r->fv = malloc(sizeof(int32_t) * 4 * nf);
+    if (!r->x || !r->fv) return 0;
+    if (from) memcpy(r->x, from->x, sizeof(double) * (6 * nv + 12 * nf));
     ccn_limit_mesh out = {.positions = r->x, .normals = r->x + 3 * nv,
                           .corner_normals = r->x + 6 * nv, .face_verts = r->fv};
-    return r->x && r->fv && ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK;
+    return (from ? ccn_plan_evaluate_changed(p, positions, &out, &err)
+                 : ccn_plan_evaluate(p, positions, &out, &err)) == CCN_OK;
 }
+
+static int evaluate(ccn_plan *p, result *r) { return evaluate_at(p, NULL, NULL, r); }
 
 /* Largest difference of a and b: positions relative to the cage's size (returned), normals
  * and corner normals (unit vectors, in *nrm); -1 when sizes or the output mesh differ. */
@@ -143,6 +150,13 @@ static void chain(const char *name, int random_knots, int random_creases, int le
     ccn_plan *prev = NULL;
     CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &prev, &err) == CCN_OK, "%s: %s", name, err.message);
     double size = cage_size(&c.cage), worst[2] = {0, 0};
+    /* the cage's positions, and at step 5 moved (then ccn_plan_evaluate_changed has nothing
+     * to keep and evaluates everything) */
+    double *moved = malloc(sizeof(double) * 3 * (size_t)c.cage.num_verts);
+    memcpy(moved, c.cage.positions, sizeof(double) * 3 * (size_t)c.cage.num_verts);
+    moved[0] += 0.125 * size;
+    result last = {0};
+    CHECK(!prev || evaluate(prev, &last), "%s L%d: evaluate failed", name, levels);
     for (int step = 0; step < 6 && prev; step++) {
         int32_t e = (int32_t)(tl_rand01() * c.ne);
         double mx = 0;
@@ -158,8 +172,15 @@ static void chain(const char *name, int random_knots, int random_creases, int le
         CHECK(ccn_plan_recreate(prev, &c.cage, &o, cache, &next, &err) == CCN_OK, "%s", err.message);
         prev = next; /* the old plan was consumed (destroyed) by the call */
         if (!fresh || !next) { ccn_plan_destroy(fresh); break; }
-        result a, b;
-        int ok = evaluate(fresh, &a) && evaluate(next, &b);
+        result a, b, k;
+        const double *at = step == 5 ? moved : NULL;
+        /* the recreated plan's first evaluation keeps what the edit did not change of the
+         * earlier plan's last output (ccn_plan_evaluate_changed); a second one computes all */
+        /* (on odd steps the earlier plan's last output is its changed one: chains of them) */
+        int full = step % 2 == 0 || step == 5;
+        int ok = evaluate_at(fresh, at, NULL, &a) && evaluate_at(next, at, &last, &k);
+        if (full) ok = ok && evaluate_at(next, at, NULL, &b);
+        else b = k;
         CHECK(ok, "%s L%d step %d: evaluate failed", name, levels, step);
         double dn = -1, d = ok ? compare(&a, &b, size, &dn) : -1;
         CHECK(d == 0 && dn == 0,
@@ -167,10 +188,19 @@ static void chain(const char *name, int random_knots, int random_creases, int le
               "normals%s", name, levels, step, d, dn, d < 0 ? " (sizes or output mesh)" : "");
         if (d > worst[0]) worst[0] = d;
         if (dn > worst[1]) worst[1] = dn;
+        double kn = -1, kd = ok ? compare(&a, &k, size, &kn) : -1;
+        CHECK(kd == 0 && kn == 0,
+              "%s L%d step %d: ccn_plan_evaluate_changed differs from a new plan by %g in "
+              "positions, %g in normals%s", name, levels, step, kd, kn, kd < 0 ? " (sizes or output mesh)" : "");
+        if (kd > worst[0]) worst[0] = kd;
+        if (kn > worst[1]) worst[1] = kn;
         (*runs)++;
-        free(a.x); free(a.fv); free(b.x); free(b.fv);
+        free(a.x); free(a.fv); free(last.x); free(last.fv);
+        if (full) { free(k.x); free(k.fv); }
+        last = b;
         ccn_plan_destroy(fresh);
     }
+    free(last.x); free(last.fv); free(moved);
     ccn_plan_destroy(prev);
     ccn_cache_destroy(cache);
     unload(&c);
