@@ -579,7 +579,7 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
         if (!ccn__is_ev(m, v) || ccn__valence(m, v) < 3) continue; /* valence 2: NURSS / CC rules */
         if (m->esharp && (ccn__sharp_count(m, v) > 0 || m->vsharp[v] > 0.0f)) continue; /* creased */
         if (m->info.level == 0 && !ev_ready_at_level0(m, v)) continue; /* NURSS step */
-        if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; continue; }
+        if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; c->nbig++; continue; }
         c->ev_list[c->nev++] = v;
     }
     return build_ev_matrices(c, err);
@@ -600,6 +600,12 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
 ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                                  int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
                                  ccn_error *err) {
+    return ccn__level_prepare_like(c, m, scheme, pinned, crease_method, ev_poly, cache, NULL, err);
+}
+
+ccn_status ccn__level_prepare_like(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                                   int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                                   ccn__level *like, ccn_error *err) {
     memset(c, 0, sizeof *c);
     c->ev_poly = ev_poly;
     c->ev_cache = cache;
@@ -616,9 +622,26 @@ ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, i
         ccn__level_free(c);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (refinement)");
     }
-    for (int32_t e = 0; e < m->ne; e++) c->erep[e] = -1;
-    for (int32_t h = m->nh - 1; h >= 0; h--) c->erep[m->hedge[h]] = h;
-    ccn_status st = collect_evs(c, err);
+    if (like && (!like->m || like->m->nv != m->nv || like->m->ne != m->ne || like->m->nh != m->nh ||
+                 like->red != c->red || !like->erep))
+        like = NULL;
+    if (like) { /* the same topology: the same representatives */
+        free(c->erep);
+        c->erep = like->erep;
+        like->erep = NULL;
+    } else {
+        for (int32_t e = 0; e < m->ne; e++) c->erep[e] = -1;
+        for (int32_t h = m->nh - 1; h >= 0; h--) c->erep[m->hedge[h]] = h;
+    }
+    ccn_status st;
+    if (like && c->red && m->info.level >= 1) { /* EVs from level 1 on: topology and sharpness */
+        memcpy(c->ev_list, like->ev_list, sizeof(int32_t) * (size_t)like->nev);
+        c->nev = like->nev;
+        c->fallbacks = c->nbig = like->nbig;
+        st = build_ev_matrices(c, err);
+    } else {
+        st = collect_evs(c, err);
+    }
     if (st) ccn__level_free(c);
     return st;
 }

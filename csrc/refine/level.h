@@ -21,6 +21,7 @@ typedef struct {
     size_t *Moff;
     double *H;           /* scratch: 3*ne curve edge points */
     int32_t fallbacks;
+    int32_t nbig;        /* EVs above CCN_EV_MATRIX_MAX_VALENCE (NURSS rules; in fallbacks) */
     /* Face-varying channels (refine/fvar.c), else NULL: vertex v's rule (smooth, crease or
      * corner, and the fractional weight where it changes) follows the sharpness of vertex
      * partner[v] >= 0 (OpenSubdiv's dependent sharpness), its crease along its own edges. */
@@ -44,6 +45,13 @@ ccn_status ccn__level_prepare(ccn__level *c, const ccn_mesh *m, int scheme, int 
 ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
                                  int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
                                  ccn_error *err);
+/* ccn__level_prepare_ev for a level of the same topology and sharpness as like's (an earlier
+ * plan's, ccn_plan_recreate; may be NULL): its edge representatives are taken over (moved: NULL
+ * in like) and, from level 1 on, its EV list copied (both topology only); the EV matrices are
+ * made anew (they read the intervals). */
+ccn_status ccn__level_prepare_like(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
+                                   int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
+                                   ccn__level *like, ccn_error *err);
 /* Points of the next level from c->m->pos into out (3*(nf+ne+nv)). */
 void ccn__level_points(ccn__level *c, double *out);
 /* Next-level points around the listed vertices only (see refine/level.c); with the tables of

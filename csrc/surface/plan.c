@@ -79,8 +79,9 @@ static ccn_status setup_level_s(ccn_plan *p, ccn_error *err) {
     if (p->R > p->L) { p->posS = p->lev[p->L + 1]->pos; return CCN_OK; }
     const ccn_mesh *m = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
-    ccn_status st = ccn__level_prepare_ev(&p->sub, m, p->opts.scheme, pinned, p->opts.crease_method,
-                                          p->opts.ev_polyhedron, p->ev_cache, err);
+    ccn__level *same = p->hint && p->hint->has_sub ? &p->hint->sub : NULL; /* its topology */
+    ccn_status st = ccn__level_prepare_like(&p->sub, m, p->opts.scheme, pinned, p->opts.crease_method,
+                                            p->opts.ev_polyhedron, p->ev_cache, same, err);
     if (st) return st;
     p->has_sub = 1;
     p->sub.threads = 1; /* a few points only */

@@ -12,9 +12,10 @@ ccn_status ccn__plan_build_levels(ccn_plan *p, int32_t R, ccn_error *err) {
     if (!lev || !prep) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
     for (int32_t l = p->R; l < R; l++) {
-        ccn_status st = ccn__level_prepare_ev(&p->prep[l], p->lev[l], p->opts.scheme, pinned,
-                                              p->opts.crease_method, p->opts.ev_polyhedron,
-                                              p->ev_cache, err);
+        ccn__level *same = p->hint && p->hint->R > l ? &p->hint->prep[l] : NULL;
+        ccn_status st = ccn__level_prepare_like(&p->prep[l], p->lev[l], p->opts.scheme, pinned,
+                                                p->opts.crease_method, p->opts.ev_polyhedron,
+                                                p->ev_cache, same, err);
         if (st) return st;
         p->prep[l].threads = p->threads;
         p->lev[l + 1] = NULL;

@@ -5,7 +5,8 @@
  * sizes consistent, every position and normal finite (normals of unit length), indices in
  * range, topology outputs identical between calls; ccn_plan_patches: degree 3 or 5, finite
  * control points, cage face in range; a face-varying channel and per-vertex data from the
- * input (fvar_stage). Output buffers are allocated at exactly
+ * input (fvar_stage); an interval edit through ccn_plan_recreate and ccn_plan_evaluate_changed,
+ * byte-identical to a new plan (edit_stage). Output buffers are allocated at exactly
  * the sizes ccn_plan_sizes gives, so ASan catches any write past them.
  * Input: byte 0 flags (as fuzz_mesh.c), the cage, then scheme, cap, levels, corners,
  * threads bytes, then positions for the second evaluation. Built only once the library
@@ -124,6 +125,54 @@ static void fvar_stage(ccn_plan *plan, const ccn_cage *c, const ccn_sizes *z, rd
         }
     }
     free(vd); free(vo); free(idx); free(vals);
+}
+
+/* 5: an interval edit (one edge's interval from the input): the plan recreated from this one
+ * (ccn_plan_recreate) and evaluated by ccn_plan_evaluate_changed into this plan's last output
+ * gives the same status as a new plan of the edited cage and, when both succeed, the same
+ * bytes (positions, normals). *plan is consumed; the recreated plan (or NULL) replaces it. */
+static void edit_stage(ccn_plan **plan, const ccn_cage *c, const ccn_options *o, const ccn_sizes *z,
+                       int strict, rd *r) {
+    if (c->num_edges <= 0 || !c->edge_verts) return;
+    size_t nv3 = 3 * (size_t)z->num_verts;
+    double *a = malloc(sizeof(double) * 2 * nv3), *b = malloc(sizeof(double) * 2 * nv3);
+    double *kn = malloc(sizeof(double) * (size_t)c->num_edges);
+    FZ_CHECK(a && b && kn, "harness out of memory");
+    ccn_limit_mesh la = {.positions = a, .normals = a + nv3}, lb = {.positions = b, .normals = b + nv3};
+    ccn_error e;
+    fz_err_init(&e);
+    ccn_status s0 = ccn_plan_evaluate(*plan, NULL, &la, &e); /* the last output before the edit */
+    for (int32_t i = 0; i < c->num_edges; i++) kn[i] = c->edge_knots ? c->edge_knots[i] : 1.0;
+    uint8_t eb = next(r), vb = next(r);
+    kn[eb % c->num_edges] = vb < 8 ? fz_special(vb) : (double)vb / 16.0;
+    ccn_cage c2 = *c;
+    c2.edge_knots = kn;
+    ccn_plan *fresh = NULL, *next_plan = NULL;
+    fz_err_init(&e);
+    ccn_status sf = ccn_plan_create(&c2, o, &fresh, &e);
+    fz_check_status(sf, &e, "ccn_plan_create(edited)");
+    fz_err_init(&e);
+    ccn_status sr = ccn_plan_recreate(*plan, &c2, o, NULL, &next_plan, &e);
+    *plan = next_plan;
+    fz_check_status(sr, &e, "ccn_plan_recreate");
+    FZ_CHECK(sr == sf || sr == CCN_ERR_MEMORY || sf == CCN_ERR_MEMORY,
+             "recreate gave %d, a new plan %d", (int)sr, (int)sf);
+    FZ_CHECK((sr == CCN_OK) == (next_plan != NULL), "recreate %d with plan %p", (int)sr, (void *)next_plan);
+    if (sr == CCN_OK && sf == CCN_OK && s0 == CCN_OK) {
+        ccn_sizes z2;
+        FZ_CHECK(ccn_plan_sizes(next_plan, &z2) == CCN_OK && z2.num_verts == z->num_verts, "sizes changed");
+        fz_err_init(&e);
+        ccn_status e1 = ccn_plan_evaluate(fresh, NULL, &lb, &e);
+        fz_err_init(&e);
+        ccn_status e2 = ccn_plan_evaluate_changed(next_plan, NULL, &la, &e);
+        fz_check_status(e2, &e, "ccn_plan_evaluate_changed");
+        FZ_CHECK(e1 == e2 || e1 == CCN_ERR_MEMORY || e2 == CCN_ERR_MEMORY, "evaluate %d, changed %d", (int)e1, (int)e2);
+        if (e1 == CCN_OK && e2 == CCN_OK && strict)
+            FZ_CHECK(memcmp(a, b, sizeof(double) * 2 * nv3) == 0,
+                     "ccn_plan_evaluate_changed differs from a new plan's evaluation");
+    }
+    ccn_plan_destroy(fresh);
+    free(a); free(b); free(kn);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -274,6 +323,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FZ_CHECK(st == CCN_ERR_ARGUMENT, "NULL out gave %d", (int)st);
 
     fvar_stage(plan, &c, &z, &r);
+    edit_stage(&plan, &c, &o, &z, strict, &r);
     free(p2); free(pos1); free(pos); free(nrm); free(fv); free(fo); free(fv2); free(fo2);
     ccn_plan_destroy(plan);
     return 0;
