@@ -69,7 +69,7 @@ void ccn__bi5_jet_weights(int32_t corner1, double Wj[9]) {
             Wj[k * 3 + a] = ccn__bi5_binom(k, a) / ccn__bi5_binom(5, a) * ((corner1 && (a & 1)) ? -1.0 : 1.0);
 }
 
-static void bern5_with_deriv(double t, double B[6], double D[6]) {
+void ccn__bi5_bern5_with_deriv(double t, double B[6], double D[6]) {
     for (int32_t k = 0; k < 6; k++) {
         B[k] = ccn__bi5_bern(5, k, t);
         D[k] = 5.0 * (ccn__bi5_bern(4, k - 1, t) - ccn__bi5_bern(4, k, t));
@@ -79,8 +79,14 @@ static void bern5_with_deriv(double t, double B[6], double D[6]) {
 void ccn__bi5_patch_eval(const double *P, int32_t m, double u, double v, double *pos,
                          double *du, double *dv) {
     double Bu[6], Du[6], Bv[6], Dv[6];
-    bern5_with_deriv(u, Bu, Du);
-    bern5_with_deriv(v, Bv, Dv);
+    ccn__bi5_bern5_with_deriv(u, Bu, Du);
+    ccn__bi5_bern5_with_deriv(v, Bv, Dv);
+    ccn__bi5_patch_eval_tab(P, m, Bu, Du, Bv, Dv, pos, du, dv);
+}
+
+void ccn__bi5_patch_eval_tab(const double *P, int32_t m, const double Bu[6], const double Du[6],
+                             const double Bv[6], const double Dv[6], double *pos, double *du,
+                             double *dv) {
     for (int32_t c = 0; c < m; c++) {
         double p = 0, pu = 0, pv = 0;
         for (int32_t i = 0; i < 6; i++)

@@ -19,5 +19,11 @@ void ccn__bi5_jet_weights(int32_t corner1, double Wj[9]);
 /* Evaluates a bi-5 patch with m-column coefficients (36 x m) and its first derivatives. */
 void ccn__bi5_patch_eval(const double *P, int32_t m, double u, double v, double *pos,
                          double *du, double *dv);
+/* The degree-5 Bernstein values B and derivatives D at t (ccn__bi5_patch_eval's), and
+ * ccn__bi5_patch_eval from such tables at u (Bu, Du) and v (Bv, Dv): the same numbers. */
+void ccn__bi5_bern5_with_deriv(double t, double B[6], double D[6]);
+void ccn__bi5_patch_eval_tab(const double *P, int32_t m, const double Bu[6], const double Du[6],
+                             const double Bv[6], const double Dv[6], double *pos, double *du,
+                             double *dv);
 
 #endif

@@ -325,13 +325,15 @@ ccn_status ccn__bi5_tau(int32_t n, const double complex chi[16], double complex 
     return tau_solve(&P, tau, err);
 }
 
-/* Smallest Jacobian Im(conj(tau_u) tau_v) of the planar bi-5 map tau on a 21 x 21 grid. */
-static double tau_min_jacobian(const double complex tau[36]) {
+/* Smallest Jacobian Im(conj(tau_u) tau_v) of the planar bi-5 map tau on a 21 x 21 grid; B, D:
+ * the Bernstein values and derivatives at the grid's 21 parameters (ccn__bi5_bern5_with_deriv
+ * at k / 20), the same for every sector. */
+static double tau_min_jacobian(const double complex tau[36], double B[21][6], double D[21][6]) {
     double P[72], du[2], dv[2], jmin = INFINITY;
     for (int32_t k = 0; k < 36; k++) P[2 * k] = creal(tau[k]), P[2 * k + 1] = cimag(tau[k]);
     for (int32_t a = 0; a <= 20; a++)
         for (int32_t c = 0; c <= 20; c++) {
-            ccn__bi5_patch_eval(P, 2, a / 20.0, c / 20.0, NULL, du, dv);
+            ccn__bi5_patch_eval_tab(P, 2, B[a], D[a], B[c], D[c], NULL, du, dv);
             jmin = fmin(jmin, du[0] * dv[1] - du[1] * dv[0]);
         }
     return jmin;
@@ -352,8 +354,10 @@ ccn_status ccn__bi5_tau_nu(int32_t n, const double complex chi[16], const double
     /* Extreme spoke ratios (e.g. kappa = 10 next to kappa = 0.1) fold the minimum-energy
      * tau, and the cap with it (a reversed normal at the centre): refuse, the caller falls
      * back to the exact refined limit. kappa <= 3 keeps J >= 0.33 (measured). */
+    double B[21][6], D[21][6];
+    for (int32_t a = 0; a <= 20; a++) ccn__bi5_bern5_with_deriv(a / 20.0, B[a], D[a]);
     for (int32_t s = 0; !st && s < n; s++)
-        if (!(tau_min_jacobian(tau + 36 * (size_t)s) > 0))
+        if (!(tau_min_jacobian(tau + 36 * (size_t)s, B, D) > 0))
             st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, s,
                            "bi5: the cap parameterization folds in sector %d for these spoke ratios "
                            "(kappa %g)", (int)s, kap[s]);

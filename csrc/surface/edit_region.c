@@ -32,12 +32,15 @@ void ccn__edit_region_free(struct ccn__edit_region *r) {
     free(r);
 }
 
-/* Marks in y the corners of the faces around each listed vertex (n of them in list). */
-static void mark_around(const ccn_mesh *m, const int32_t *list, int32_t n, uint8_t *y) {
+/* Marks in y the corners of the faces around each listed vertex (n of them in list), each face
+ * once: fm marks the faces done (and is left marking the faces around the list). */
+static void mark_around(const ccn_mesh *m, const int32_t *list, int32_t n, uint8_t *fm, uint8_t *y) {
     for (int32_t i = 0; i < n; i++) {
         int32_t v = list[i];
         for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
             int32_t f = m->hface[m->vfan[k]];
+            if (fm[f]) continue;
+            fm[f] = 1;
             for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) y[m->hvert[h]] = 1;
         }
     }
@@ -60,17 +63,17 @@ static int level_lists(const ccn_mesh *m, const ccn_mesh *q, const uint8_t *D, c
                        uint8_t **child) {
     uint8_t *x = ccn__changed_interval_ends(m, q);
     int64_t nc = (int64_t)m->nf + m->ne + m->nv;
-    uint8_t *c = calloc((size_t)nc + 1, 1);
+    uint8_t *c = calloc((size_t)nc + 1, 1), *fm = calloc((size_t)m->nf + 1, 1);
     int32_t *list = alloc_list(m->nv);
-    int ok = x && c && list;
+    int ok = x && c && fm && list;
     if (ok) {
         if (D) for (int32_t v = 0; v < m->nv; v++) x[v] |= D[v];
         uint8_t *z = c + m->nf + m->ne; /* Z: X and two face rings around it */
         memcpy(z, x, (size_t)m->nv);
         int32_t n = listed(x, m->nv, list);
-        mark_around(m, list, n, z);      /* one ring */
+        mark_around(m, list, n, fm, z);  /* one ring */
         n = listed(z, m->nv, list);
-        mark_around(m, list, n, z);      /* two */
+        mark_around(m, list, n, c, z);   /* two (c: the faces around the first ring) */
         n = listed(z, m->nv, list);
         for (int32_t i = 0; i < n; i++) { /* the faces and edges touching Z */
             int32_t v = list[i];
@@ -89,6 +92,7 @@ static int level_lists(const ccn_mesh *m, const ccn_mesh *q, const uint8_t *D, c
         }
     }
     free(x);
+    free(fm);
     free(list);
     if (!ok) { free(c); c = NULL; }
     *child = c;
@@ -146,19 +150,19 @@ int ccn__edit_region_rows(ccn_plan *p) {
     r->rows = alloc_list(nout);
     r->written = calloc((size_t)(nout ? nout : 1), 1);
     int32_t *list = alloc_list(nvL);
-    uint8_t *near = calloc((size_t)nvL + 1, 1);
-    if (!r->rows || !r->written || !list || !near) {
-        free(list); free(near);
+    uint8_t *near = calloc((size_t)nvL + 1, 1), *fm = calloc((size_t)mL->nf + 1, 1);
+    if (!r->rows || !r->written || !list || !near || !fm) {
+        free(list); free(near); free(fm);
         ccn__edit_region_free(r);
         p->region = NULL;
         return -1;
     }
     /* a regular row (not redo) reads its vertex's 1-ring at level L only: it reads a changed
      * point when a changed point lies on a face around its vertex */
-    mark_around(mL, list, listed(r->dirtyL, nvL, list), near);
+    mark_around(mL, list, listed(r->dirtyL, nvL, list), fm, near);
     for (int32_t o = 0; o < nout; o++)
         if (r->redo[o] || near[p->out_vL[o]]) r->rows[n++] = o;
-    free(list); free(near);
+    free(list); free(near); free(fm);
     r->nrows = n;
     return 0;
 }
