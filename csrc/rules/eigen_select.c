@@ -30,6 +30,8 @@ struct ccn__ev_cache {
 
 ccn__ev_cache *ccn__ev_cache_create(void) { return calloc(1, sizeof(ccn__ev_cache)); }
 
+size_t ccn__ev_cache_count(const ccn__ev_cache *c) { return c ? c->count : 0; }
+
 void ccn__ev_cache_destroy(ccn__ev_cache *c) {
     if (!c) return;
     free(c->e); free(c->table); free(c->pool);

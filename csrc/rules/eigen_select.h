@@ -23,6 +23,8 @@ typedef struct ccn__ev_cache ccn__ev_cache;
 
 ccn__ev_cache *ccn__ev_cache_create(void);
 void ccn__ev_cache_destroy(ccn__ev_cache *c);
+/* Entries held (each a verified choice for one interval tuple). */
+size_t ccn__ev_cache_count(const ccn__ev_cache *c);
 
 typedef struct {
     int32_t poly;     /* the chosen candidate (CCN_POLY_PAPER.. CCN_POLY_COUNT) */

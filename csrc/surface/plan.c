@@ -25,6 +25,7 @@
 #include <string.h>
 
 #define CCN_MAX_LEVELS 10
+#define CCN_EV_CACHE_CARRY 65536 /* a recreated plan keeps the earlier one's EV choices up to this many */
 
 void ccn_plan_destroy(ccn_plan *p) {
     if (!p) return;
@@ -203,6 +204,13 @@ static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cach
                            (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE);
     if (st) goto fail;
     if (prev && prev->R >= 1 && same_plan_topology(prev, &o, cage_mesh)) p->hint = prev;
+    if (prev && prev->ev_cache && ccn__ev_cache_count(prev->ev_cache) <= CCN_EV_CACHE_CARRY) {
+        /* the eigen polyhedron choices it verified: a function of the spoke intervals only
+         * (rules/eigen_select.c), so the EVs the edit left alone are not verified again */
+        ccn__ev_cache *t = p->ev_cache;
+        p->ev_cache = prev->ev_cache;
+        prev->ev_cache = t;
+    }
     p->L = o.levels < 1 && has_non_quads(cage_mesh) ? 1 : o.levels;
     int64_t corners = cage_mesh->nh; /* fail before any work if the output cannot be indexed */
     for (int32_t l = 0; l < p->L + 1 && !st; l++)

@@ -301,7 +301,7 @@ class TestSaveCost(AddonTestCase):
         V = np.array([(x, y, 0.0) for y in range(n + 1) for x in range(n + 1)], float)
         F = [(y * (n + 1) + x, y * (n + 1) + x + 1, (y + 1) * (n + 1) + x + 1,
               (y + 1) * (n + 1) + x) for y in range(n) for x in range(n)]
-        times, sizes = {}, {}  # kind -> (save_pre..save_post, the operator call)
+        times, sizes, raws = {}, {}, {}  # kind -> (save_pre..save_post, the operator call)
         for kind in ("SUBSURF", "CCNURBS"):
             reset_scene()
             ob = load_cage("Big", V=V, F=F, K={})
@@ -338,6 +338,10 @@ class TestSaveCost(AddonTestCase):
                 bpy.app.handlers.save_post.remove(post)
             times[kind] = min(best)
             sizes[kind] = os.path.getsize(path)
+            if bpy.app.version >= (5, 0, 0):  # saves compressed: also the uncompressed size
+                raw = os.path.join(TMP, "save50k_raw_" + kind + ".blend")
+                bpy.ops.wm.save_as_mainfile(filepath=raw, copy=True, compress=False)
+                raws[kind] = os.path.getsize(raw)
             if kind == "CCNURBS":
                 self.assertEqual(len(evaluated_positions(ob)), (4 * n + 1) ** 2)
         ratio = times["CCNURBS"][0] / times["SUBSURF"][0]
@@ -348,7 +352,16 @@ class TestSaveCost(AddonTestCase):
               % (times["SUBSURF"][0], times["CCNURBS"][0], ratio, times["SUBSURF"][1],
                  times["CCNURBS"][1], ratio_next, times["SUBSURF"][2], times["CCNURBS"][2],
                  times["CCNURBS"][2] / times["SUBSURF"][2], sizes["SUBSURF"], sizes["CCNURBS"]))
-        self.assertLessEqual(sizes["CCNURBS"], 1.2 * sizes["SUBSURF"], "the file holds more")
+        if raws:
+            # Blender 5.0's compressed size varies between runs with the same content (this
+            # cage: Subsurf 1.23-1.43 MB, CCNURBS 1.32-1.51 MB, measured in session 28), as in
+            # test_apply_file_size_like_subsurf: the content is asserted uncompressed
+            print("measure save50k uncompressed: Subsurf %d bytes, CCNURBS %d bytes (%.4f)"
+                  % (raws["SUBSURF"], raws["CCNURBS"], raws["CCNURBS"] / raws["SUBSURF"]))
+            self.assertLessEqual(raws["CCNURBS"], 1.2 * raws["SUBSURF"], "the file holds more")
+            self.assertLessEqual(sizes["CCNURBS"], 1.5 * sizes["SUBSURF"], "the file holds more")
+        else:
+            self.assertLessEqual(sizes["CCNURBS"], 1.2 * sizes["SUBSURF"], "the file holds more")
         # the write itself, generous margin against millisecond noise (target 1.2x)
         self.assertLessEqual(times["CCNURBS"][0], 3.0 * times["SUBSURF"][0] + 0.05,
                              "saving is far slower than with Subsurf (target 1.2x)")
