@@ -228,9 +228,24 @@ static void irr_range(void *ctx, int32_t begin, int32_t end) {
         j->irr[v] = ccn__limit_kind(j->mL, v, j->pinned) != CCN_LIMIT_REGULAR;
 }
 
-static void fast_range(void *ctx, int32_t begin, int32_t end) {
+/* j->irr widened to ccn__near_irregular's test: the corners of every face around an irregular
+ * vertex (few of them) join it, in place; near: scratch, nv bytes. */
+static void widen_irregular(stencil_job *j, uint8_t *near) {
+    const ccn_mesh *m = j->mL;
+    memcpy(near, j->irr, (size_t)m->nv);
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (!j->irr[v]) continue;
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) near[m->hvert[h]] = 1;
+        }
+    }
+    memcpy(j->irr, near, (size_t)m->nv);
+}
+
+static void fast_range(void *ctx, int32_t begin, int32_t end) { /* after widen_irregular */
     stencil_job *j = ctx;
-    for (int32_t o = begin; o < end; o++) j->fast[o] = !ccn__near_irregular(j->mL, j->p->out_vL[o], j->irr);
+    for (int32_t o = begin; o < end; o++) j->fast[o] = !j->irr[j->p->out_vL[o]];
 }
 
 /* The last distinct weights a range made (most regular outputs repeat one of them). */
@@ -434,6 +449,13 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
         for (int32_t i = 0; i < p->hint->nnear; i++) j.fast[p->vmapL[p->hint->near[i]]] = 0;
     } else {
         ccn__parallel_for(p->threads, mL->nv, irr_range, &j);
+        uint8_t *near = malloc((size_t)(mL->nv ? mL->nv : 1));
+        if (!near) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (stencils)");
+            goto done;
+        }
+        widen_irregular(&j, near);
+        free(near);
         ccn__parallel_for(p->threads, nout, fast_range, &j);
     }
     /* the irregular ones, in output order */
