@@ -20,6 +20,7 @@
 #include "surface/edit_region.h"
 
 #include "topology/knots.h"
+#include "topology/mesh.h"
 
 #include <string.h>
 
@@ -30,20 +31,6 @@ void ccn__edit_region_free(struct ccn__edit_region *r) {
     }
     free(r->lists); free(r->pos0); free(r->dirtyL); free(r->redo); free(r->rows); free(r->written);
     free(r);
-}
-
-/* Marks in y the corners of the faces around each listed vertex (n of them in list), each face
- * once: fm marks the faces done (and is left marking the faces around the list). */
-static void mark_around(const ccn_mesh *m, const int32_t *list, int32_t n, uint8_t *fm, uint8_t *y) {
-    for (int32_t i = 0; i < n; i++) {
-        int32_t v = list[i];
-        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-            int32_t f = m->hface[m->vfan[k]];
-            if (fm[f]) continue;
-            fm[f] = 1;
-            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) y[m->hvert[h]] = 1;
-        }
-    }
 }
 
 /* The set entries of mask (n) into list (n entries room): their count. */
@@ -71,9 +58,9 @@ static int level_lists(const ccn_mesh *m, const ccn_mesh *q, const uint8_t *D, c
         uint8_t *z = c + m->nf + m->ne; /* Z: X and two face rings around it */
         memcpy(z, x, (size_t)m->nv);
         int32_t n = listed(x, m->nv, list);
-        mark_around(m, list, n, fm, z);  /* one ring */
+        ccn__mesh_mark_face_ring(m, list, n, fm, z);  /* one ring */
         n = listed(z, m->nv, list);
-        mark_around(m, list, n, c, z);   /* two (c: the faces around the first ring) */
+        ccn__mesh_mark_face_ring(m, list, n, c, z);   /* two (c: the faces around the first ring) */
         n = listed(z, m->nv, list);
         for (int32_t i = 0; i < n; i++) { /* the faces and edges touching Z */
             int32_t v = list[i];
@@ -159,7 +146,7 @@ int ccn__edit_region_rows(ccn_plan *p) {
     }
     /* a regular row (not redo) reads its vertex's 1-ring at level L only: it reads a changed
      * point when a changed point lies on a face around its vertex */
-    mark_around(mL, list, listed(r->dirtyL, nvL, list), fm, near);
+    ccn__mesh_mark_face_ring(mL, list, listed(r->dirtyL, nvL, list), fm, near);
     for (int32_t o = 0; o < nout; o++)
         if (r->redo[o] || near[p->out_vL[o]]) r->rows[n++] = o;
     free(list); free(near); free(fm);

@@ -6,6 +6,7 @@
 #include "base/parallel.h"
 #include "surface/limit.h"
 #include "topology/knots.h"
+#include "topology/mesh.h"
 
 #include <string.h>
 
@@ -21,13 +22,8 @@
 uint8_t *ccn__moved_vertices(const ccn_mesh *m, const ccn_mesh *q) {
     uint8_t *ends = ccn__changed_interval_ends(m, q), *moved = calloc((size_t)(m->nv ? m->nv : 1), 1);
     if (!ends || !moved) { free(ends); free(moved); return NULL; }
-    for (int32_t v = 0; v < m->nv; v++) {
-        if (!ends[v]) continue;
-        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-            int32_t f = m->hface[m->vfan[k]];
-            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) moved[m->hvert[h]] = 1;
-        }
-    }
+    for (int32_t v = 0; v < m->nv; v++)
+        if (ends[v]) ccn__mesh_mark_face_ring(m, &v, 1, NULL, moved);
     free(ends);
     return moved;
 }

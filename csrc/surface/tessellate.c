@@ -8,6 +8,7 @@
 #include "surface/edit_region.h"
 #include "surface/limit.h"
 #include "surface/stencil_reuse.h"
+#include "topology/mesh.h"
 
 #include <math.h>
 #include <string.h>
@@ -233,13 +234,8 @@ static void irr_range(void *ctx, int32_t begin, int32_t end) {
 static void widen_irregular(stencil_job *j, uint8_t *near) {
     const ccn_mesh *m = j->mL;
     memcpy(near, j->irr, (size_t)m->nv);
-    for (int32_t v = 0; v < m->nv; v++) {
-        if (!j->irr[v]) continue;
-        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
-            int32_t f = m->hface[m->vfan[k]];
-            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) near[m->hvert[h]] = 1;
-        }
-    }
+    for (int32_t v = 0; v < m->nv; v++)
+        if (j->irr[v]) ccn__mesh_mark_face_ring(m, &v, 1, NULL, near);
     memcpy(j->irr, near, (size_t)m->nv);
 }
 

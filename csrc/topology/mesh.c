@@ -119,6 +119,19 @@ int32_t ccn__mesh_build_fans(ccn_mesh *m) {
     return 0;
 }
 
+void ccn__mesh_mark_face_ring(const ccn_mesh *m, const int32_t *list, int32_t n, uint8_t *fm,
+                              uint8_t *y) {
+    for (int32_t i = 0; i < n; i++) {
+        int32_t v = list[i];
+        for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
+            int32_t f = m->hface[m->vfan[k]];
+            if (fm && fm[f]) continue;
+            if (fm) fm[f] = 1;
+            for (int32_t h = m->fstart[f]; h < m->fstart[f + 1]; h++) y[m->hvert[h]] = 1;
+        }
+    }
+}
+
 void ccn__mesh_update_info(ccn_mesh *m) {
     ccn_mesh_info *in = &m->info;
     in->num_verts = m->nv; in->num_faces = m->nf; in->num_edges = m->ne;

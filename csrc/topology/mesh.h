@@ -10,6 +10,10 @@ ccn_mesh *ccn__mesh_alloc(int32_t nv, int32_t nf, int32_t nh, int32_t ne);
  * success, or the index + 1 of a vertex whose faces form more than one fan (non-manifold). */
 int32_t ccn__mesh_build_fans(ccn_mesh *m);
 void ccn__mesh_update_info(ccn_mesh *m);
+/* y[u] = 1 for every corner u of the faces around the n listed vertices; fm (may be NULL):
+ * faces already visited, skipped and set (each face once). */
+void ccn__mesh_mark_face_ring(const ccn_mesh *m, const int32_t *list, int32_t n, uint8_t *fm,
+                              uint8_t *y);
 /* Allocates esharp and vsharp (all 0); 0 on success. */
 int ccn__mesh_alloc_sharpness(ccn_mesh *m);
 /* Frees esharp and vsharp if every value is 0 (the crease-free rules then apply). */
