@@ -198,9 +198,11 @@ typedef struct {
 
 /* M ((2n+1) x (2n+1), row-major; rows F_0..F_{n-1}, E_0..E_{n-1}, V) for valence n >= 3
  * and spoke intervals d[0..n-1] > 0. info may be NULL. Scheme EIGEN: the per-vertex choice of
- * the eigen polyhedron (README "Eigen rules"): the paper's if max/min d <= 5, else the first
- * candidate that passes the single-maximum (level 5) and characteristic-map checks (a few ms
- * per candidate), else the paper's with info->outside_g1 = 1. */
+ * the eigen polyhedron (README "Eigen rules"): the paper's if max/min d <= 4, else a blend of
+ * the candidates weighted by continuous margins of the single-maximum (level 5) and
+ * characteristic-map checks (a few ms per candidate verified), so M is continuous in d;
+ * info->polyhedron is the candidate of the largest weight, info->outside_g1 = 1 when half the
+ * weight or more is on a paper's polyhedron that fails the checks. */
 ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
                          ccn_ev_info *info, ccn_error *err);
 
@@ -229,7 +231,7 @@ typedef struct {
     int32_t num_sharp_vertices;
     int32_t num_sharp_corners;/* output vertices whose faces see more than one tangent plane
                                  (creases, corners): corner_normals differ from normals */
-    int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 5) */
+    int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 4) */
     int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
     int32_t num_caps_deferred;/* cap EVs (bi-5) with no cap built because the output level is not
                                  above the cap level (they would change no output sample); the

@@ -8,7 +8,8 @@
  *    its 1-ring (§6.1); if M cannot be built the EV falls back to NURSS (counted). From level
  *    1 on this holds for every EV; at level 0 only for an EV that is already what the NURSS
  *    step would make it (quad 1-ring, no other EV on its faces, e_i = d_i); the others get
- *    the NURSS step first (DESIGN §4.3);
+ *    the NURSS step first (DESIGN §4.3), and where only e_i = d_i is missing the two are
+ *    blended by how far e_i is from d_i, so the surface does not jump there;
  *  - scheme CATMULL_CLARK: all intervals are 1, which makes every rule above Catmull-Clark.
  *  - boundaries: the boundary is a cubic B-spline curve of the boundary polygon; valence-2
  *    corners are smooth, or fixed with CCN_CORNERS_PINNED.
@@ -30,6 +31,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "refine/children.h"
 #include "rules/bspline.h"
 #include "rules/crease.h"
 #include "rules/nurss.h"
@@ -398,6 +400,42 @@ static int32_t ring_point(const ccn_mesh *m, int32_t v, int32_t n, int32_t j) {
     return j < n ? m->hvert[ccn__next(m, nh)] : m->hvert[nh];
 }
 
+/* The point the NURSS step gives red row r of EV v (kind which), table-free and from the
+ * current face points: what a level-0 EV with ev_w < 1 blends M's point with. Computed here
+ * rather than taken from the pass that ran before, because a partial pass (the lists of an
+ * interval edit, the subset) need not have made it; the spokes' curve points are made in H
+ * and H is restored, so the rest of the level reads what its own pass wrote. */
+static void nurss_step_point(const ccn__level *c, int32_t v, int32_t n, int which, int32_t r,
+                             const double *fp, double g[3]) {
+    const ccn_mesh *m = c->m;
+    int32_t h = m->vfan[m->vfan_start[v] + (r % n)];
+    if (which == 0) {
+        ccn__quad_face_point(m, m->hface[h], c->pinned, g);
+        return;
+    }
+    double stack[3 * 64], *keep = n <= 64 ? stack : malloc(sizeof(double) * 3 * (size_t)n);
+    int32_t saved = keep ? n : 0; /* (out of memory: H keeps the NURSS step's curve points) */
+    for (int32_t k = 0; k < saved; k++) {
+        int32_t e = ccn__fan_edge(m, v, k);
+        memcpy(keep + 3 * k, c->H + 3 * (size_t)e, sizeof(double) * 3);
+    }
+    for (int32_t k = 0; k < n; k++) {
+        int32_t e = ccn__fan_edge(m, v, k);
+        ccn__curve_edge_point(m, c->erep[e], c->pinned, c->H + 3 * (size_t)e);
+    }
+    if (which == 1) {
+        int32_t e = m->hedge[h];
+        ccn__edge_point(m, c->erep[e], c->H, fp, g);
+    } else {
+        ccn__nurss_vertex_point(m, v, c->H, fp, g);
+    }
+    for (int32_t k = 0; k < saved; k++) {
+        int32_t e = ccn__fan_edge(m, v, k);
+        memcpy(c->H + 3 * (size_t)e, keep + 3 * k, sizeof(double) * 3);
+    }
+    if (keep != stack) free(keep);
+}
+
 /* Overwrites the red points of kind `which` (0 faces, 1 spokes, 2 vertex). */
 static void apply_red(const ccn__level *c, int which, double *fp, double *ep, double *vp) {
     const ccn_mesh *m = c->m;
@@ -416,122 +454,15 @@ static void apply_red(const ccn__level *c, int which, double *fp, double *ep, do
             double *out = which == 0 ? fp + 3 * (size_t)m->hface[h]
                         : which == 1 ? ep + 3 * (size_t)m->hedge[h]
                                      : vp + 3 * (size_t)v;
+            double w = c->ev_w[i];
+            if (w < 1) { /* blended with the NURSS step's point */
+                double g[3];
+                nurss_step_point(c, v, n, which, r, fp, g);
+                for (int k = 0; k < 3; k++) acc[k] = w * acc[k] + (1 - w) * g[k];
+            }
             memcpy(out, acc, sizeof acc);
         }
     }
-}
-
-/* ---- topology of the refined mesh -------------------------------------------------- */
-
-/* Child edge of e at its end v: 2e from everts[2e], 2e + 1 from the other end. */
-static int32_t child_edge(const int32_t *everts, int32_t e, int32_t v) {
-    return everts[2 * e] == v ? 2 * e : 2 * e + 1;
-}
-
-typedef struct {
-    const ccn_mesh *m; int32_t ne; const int32_t *hvert, *hedge, *everts;
-    int32_t *chvert, *chedge, *ceverts;
-} numbering_job;
-
-static void numbering_edge_range(void *ctx, int32_t b, int32_t end) {
-    const numbering_job *j = ctx;
-    int32_t nf = j->m->nf, ne = j->ne;
-    for (int32_t e = b; e < end; e++) {
-        int32_t ep = nf + e;
-        j->ceverts[4 * e + 0] = nf + ne + j->everts[2 * e];
-        j->ceverts[4 * e + 1] = ep;
-        j->ceverts[4 * e + 2] = ep;
-        j->ceverts[4 * e + 3] = nf + ne + j->everts[2 * e + 1];
-    }
-}
-
-static void numbering_face_range(void *ctx, int32_t b, int32_t end) {
-    const numbering_job *j = ctx;
-    const ccn_mesh *m = j->m;
-    const int32_t *hvert = j->hvert, *hedge = j->hedge, *everts = j->everts;
-    int32_t nf = m->nf, ne = j->ne, *chvert = j->chvert, *chedge = j->chedge, *ceverts = j->ceverts;
-    for (int32_t f = b; f < end; f++) {
-        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
-        for (int32_t k = 0; k < n; k++) {
-            int32_t h = s + k, hp = s + (k + n - 1) % n;
-            int32_t v = hvert[h], q = 4 * h, inner = 2 * ne + h;
-            chvert[q + 0] = nf + ne + v;
-            chvert[q + 1] = nf + hedge[h];
-            chvert[q + 2] = f;
-            chvert[q + 3] = nf + hedge[hp];
-            chedge[q + 0] = child_edge(everts, hedge[h], v);
-            chedge[q + 1] = inner;
-            chedge[q + 2] = 2 * ne + hp;
-            chedge[q + 3] = child_edge(everts, hedge[hp], v);
-            ceverts[2 * inner] = f;
-            ceverts[2 * inner + 1] = nf + hedge[h];
-        }
-    }
-}
-
-void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
-                                const int32_t *hedge, const int32_t *everts, int32_t *chvert,
-                                int32_t *chedge, int32_t *ceverts, int threads) {
-    numbering_job j = {m, ne, hvert, hedge, everts, chvert, chedge, ceverts};
-    ccn__parallel_for(threads, ne, numbering_edge_range, &j);
-    ccn__parallel_for(threads, m->nf, numbering_face_range, &j);
-}
-
-static void refine_topology(const ccn_mesh *m, ccn_mesh *r, int threads) {
-    int32_t nf = m->nf, ne = m->ne;
-    ccn__level_child_numbering(m, ne, m->hvert, m->hedge, m->everts, r->hvert, r->hedge, r->everts, threads);
-    for (int32_t f = 0; f < nf; f++) {
-        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
-        for (int32_t j = 0; j < n; j++) {
-            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n, q = 4 * h;
-            int32_t t = m->htwin[h], tp = m->htwin[hp];
-            r->htwin[q + 0] = t >= 0 ? 4 * ccn__next(m, t) + 3 : -1;
-            r->htwin[q + 1] = 4 * hn + 2;
-            r->htwin[q + 2] = 4 * hp + 1;
-            r->htwin[q + 3] = tp >= 0 ? 4 * tp : -1;
-            for (int k = 0; k < 4; k++) r->hface[q + k] = h;
-        }
-    }
-    for (int32_t q = 0; q <= r->nf; q++) r->fstart[q] = 4 * q;
-}
-
-/* The child edges' candidate intervals: the two halves of each edge, and for the edge from
- * face point to edge point of half-edge h (NURSS Fig. 10) half the mean of the two sides
- * adjacent to edge h (for a quad with consistent rings: half the parallel ring's interval). */
-static void child_candidates(const ccn_mesh *m, double *cand) {
-    int32_t ne = m->ne;
-    for (int32_t e = 0; e < ne; e++) cand[2 * e] = cand[2 * e + 1] = 0.5 * m->eknot[e];
-    for (int32_t f = 0; f < m->nf; f++) {
-        int32_t s = m->fstart[f], n = ccn__fsize(m, f);
-        for (int32_t j = 0; j < n; j++) {
-            int32_t h = s + j, hp = s + (j + n - 1) % n, hn = s + (j + 1) % n;
-            cand[2 * ne + h] = 0.25 * (m->eknot[m->hedge[hp]] + m->eknot[m->hedge[hn]]);
-        }
-    }
-}
-
-static int all_quads(const ccn_mesh *m) {
-    for (int32_t f = 0; f < m->nf; f++)
-        if (ccn__fsize(m, f) != 4) return 0;
-    return 1;
-}
-
-static ccn_status new_intervals(const ccn_mesh *m, ccn_mesh *r, double *cand, ccn_error *err) {
-    if (all_quads(m)) { /* rings stay consistent: every interval halves */
-        memcpy(r->eknot, cand, sizeof(double) * (size_t)r->ne);
-        double mx = 0.0;
-        for (int32_t e = 0; e < r->ne; e++) mx = r->eknot[e] > mx ? r->eknot[e] : mx;
-        mx = ccn__pow2_at_least(mx > 0.0 ? mx : 1.0); /* exact, as at level 0 (topology/knots.c) */
-        for (int32_t e = 0; e < r->ne; e++) r->eknot[e] /= mx;
-        r->knot_scale = m->knot_scale * mx;
-        r->info.num_rings = 2 * m->info.num_rings; /* each ring splits in two */
-        return CCN_OK;
-    }
-    for (int32_t e = 0; e < r->ne; e++) cand[e] *= m->knot_scale;
-    int32_t conflicts = m->info.num_ring_conflicts;
-    ccn_status st = ccn__resolve_rings(r, cand, NULL, err);
-    r->info.num_ring_conflicts = conflicts;
-    return st;
 }
 
 /* ---- one level ---------------------------------------------------------------------- */
@@ -540,16 +471,16 @@ static int regular_interior(const ccn_mesh *m, int32_t v) {
     return !m->vboundary[v] && ccn__valence(m, v) == 4;
 }
 
-static int same_interval(double a, double b) {
-    return fabs(a - b) <= 1e-12 * fmax(a, b);
-}
-
 /* Level 0: may EV v take M already (Li 2016 §6.1), instead of the NURSS step that exists to
  * split non-quads, separate EVs and make e_i = d_i? Only when all of that already holds: every
  * face of v is a quad, every other corner of those faces is an interior valence-4 vertex (so no
  * other EV or n-gon shares a face with v), and each spoke continues beyond its end E_i with the
- * spoke's own interval (e_i = d_i, Fig. 3/5 — what M assumes). See README "Design notes". */
-static int ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
+ * spoke's own interval (e_i = d_i, Fig. 3/5 — what M assumes). See README "Design notes".
+ * Returns the weight of M against the NURSS step: 1 when e_i = d_i, falling smoothly to 0 as
+ * max_i |log(e_i / d_i)| grows to CCN__LEVEL0_BAND (so the surface does not jump when an
+ * interval beyond a spoke moves off the spoke's own), 0 when the topology is not ready. */
+static double ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
+    double mismatch = 0;
     if (m->esharp) /* no crease anywhere on v's faces */
         for (int32_t k = m->vfan_start[v]; k < m->vfan_start[v + 1]; k++) {
             int32_t f = m->hface[m->vfan[k]];
@@ -566,9 +497,10 @@ static int ev_ready_at_level0(const ccn_mesh *m, int32_t v) {
         int32_t t = m->htwin[h]; /* E_i -> v: the edge beyond E_i is opposite in E_i's fan */
         int32_t e = m->vfan_start[m->hvert[t]];
         int32_t beyond = m->hedge[m->vfan[e + (m->hfanpos[t] + 2) % 4]];
-        if (!same_interval(m->eknot[m->hedge[h]], m->eknot[beyond])) return 0;
+        mismatch = fmax(mismatch, fabs(log(m->eknot[m->hedge[h]] / m->eknot[beyond])));
     }
-    return 1;
+    double x = 1 - mismatch / CCN__LEVEL0_BAND;
+    return x <= 0 ? 0 : x >= 1 ? 1 : x * x * (3 - 2 * x);
 }
 
 static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
@@ -578,8 +510,10 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
     for (int32_t v = 0; v < m->nv; v++) {
         if (!ccn__is_ev(m, v) || ccn__valence(m, v) < 3) continue; /* valence 2: NURSS / CC rules */
         if (m->esharp && (ccn__sharp_count(m, v) > 0 || m->vsharp[v] > 0.0f)) continue; /* creased */
-        if (m->info.level == 0 && !ev_ready_at_level0(m, v)) continue; /* NURSS step */
+        double w = m->info.level == 0 ? ev_ready_at_level0(m, v) : 1.0;
+        if (!(w > 0)) continue; /* NURSS step */
         if (ccn__valence(m, v) > CCN_EV_MATRIX_MAX_VALENCE) { c->fallbacks++; c->nbig++; continue; }
+        c->ev_w[c->nev] = w;
         c->ev_list[c->nev++] = v;
     }
     return build_ev_matrices(c, err);
@@ -588,7 +522,7 @@ static ccn_status collect_evs(ccn__level *c, ccn_error *err) {
 void ccn__level_free(ccn__level *c) {
     if (!c) return;
     free(c->tf); free(c->te); free(c->tv); free(c->th); free(c->tvs); free(c->tmask);
-    free(c->H); free(c->erep); free(c->ev_list); free(c->Moff); free(c->M);
+    free(c->H); free(c->erep); free(c->ev_list); free(c->ev_w); free(c->Moff); free(c->M);
     memset(c, 0, sizeof *c);
 }
 
@@ -617,8 +551,9 @@ ccn_status ccn__level_prepare_like(ccn__level *c, const ccn_mesh *m, int scheme,
     c->H = malloc(sizeof(double) * 3 * (size_t)(m->ne ? m->ne : 1));
     c->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
     c->ev_list = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    c->ev_w = malloc(sizeof(double) * (size_t)(m->nv ? m->nv : 1));
     c->Moff = malloc(sizeof(size_t) * (size_t)(m->nv ? m->nv : 1));
-    if (!c->H || !c->erep || !c->ev_list || !c->Moff) {
+    if (!c->H || !c->erep || !c->ev_list || !c->ev_w || !c->Moff) {
         ccn__level_free(c);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (refinement)");
     }
@@ -636,6 +571,7 @@ ccn_status ccn__level_prepare_like(ccn__level *c, const ccn_mesh *m, int scheme,
     ccn_status st;
     if (like && c->red && m->info.level >= 1) { /* EVs from level 1 on: topology and sharpness */
         memcpy(c->ev_list, like->ev_list, sizeof(int32_t) * (size_t)like->nev);
+        memcpy(c->ev_w, like->ev_w, sizeof(double) * (size_t)like->nev);
         c->nev = like->nev;
         c->fallbacks = c->nbig = like->nbig;
         st = build_ev_matrices(c, err);
@@ -766,14 +702,14 @@ ccn_status ccn__level_topology_like(const ccn__level *c, ccn_mesh *like, ccn_mes
         CCN_TAKE(vlast_edge); CCN_TAKE(vboundary);
 #undef CCN_TAKE
     } else {
-        refine_topology(m, r, c->threads);
+        ccn__children_topology(m, r, c->threads);
         if (ccn__mesh_build_fans(r)) {
             st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "refined topology is invalid");
             goto done;
         }
     }
-    child_candidates(m, cand);
-    if ((st = new_intervals(m, r, cand, err))) goto done;
+    ccn__children_candidates(m, cand);
+    if ((st = ccn__children_intervals(m, r, cand, err))) goto done;
     if ((st = child_sharpness(c, r, err))) goto done;
     if (like) { /* the counts of the same topology and sharpness; the rings' are new */
         ccn_mesh_info in = like->info;

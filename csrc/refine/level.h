@@ -9,6 +9,8 @@
 #include <stddef.h>
 
 #define CCN_EV_MATRIX_MAX_VALENCE 1024 /* above: NURSS rules (memory grows as valence^2) */
+/* Level 0: M is blended with the NURSS step as max |log(e_i / d_i)| goes from 0 to this. */
+#define CCN__LEVEL0_BAND 0.5
 
 typedef struct {
     const ccn_mesh *m;   /* the level's topology, intervals and (input) positions */
@@ -17,6 +19,8 @@ typedef struct {
     int threads;         /* for ccn__level_points (set by the owner; default 1) */
     int32_t *erep;       /* a half-edge per edge */
     int32_t nev, *ev_list;
+    double *ev_w;        /* per listed EV: the weight of its M against the rules' own points
+                            (1 but at level 0, where e_i nears d_i: refine/level.c) */
     double *M;           /* concatenated EV matrices ((2n+1)^2 each) */
     size_t *Moff;
     double *H;           /* scratch: 3*ne curve edge points */
@@ -67,13 +71,6 @@ void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q);
 void ccn__level_points_lists(ccn__level *c, const int32_t *faces, int32_t nfaces,
                              const int32_t *edges, int32_t nedges, const int32_t *verts,
                              int32_t nverts, double *out);
-/* The next level's numbering (refine/level.c) for any numbering of m's corners by vertices
- * hvert and edges hedge (m->nh each; everts: their ne edges' ends), such as a face-varying
- * channel's values: child corner 4h + k's vertex and edge (4 * m->nh each) and the 2 ne + nh
- * child edges' ends. The child faces and corners are m's child's. On up to `threads`. */
-void ccn__level_child_numbering(const ccn_mesh *m, int32_t ne, const int32_t *hvert,
-                                const int32_t *hedge, const int32_t *everts, int32_t *chvert,
-                                int32_t *chedge, int32_t *ceverts, int threads);
 /* Topology and intervals of the next level (positions uninitialised). */
 ccn_status ccn__level_topology(const ccn__level *c, ccn_mesh **out, ccn_error *err);
 /* The same, with the child topology taken from `like`, the child of a mesh with c->m's

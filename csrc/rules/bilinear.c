@@ -38,7 +38,7 @@ static double square_dist(double a1, double a2) {
  * s = br * orientation sign of the quad (SPEC 2.4: the printed form is the CCW case).
  * Returns 0, or 1 if D < 0 (no real root). */
 static int floater_branch(const quad *q, const double x[2], double br, double *a1,
-                          double *a2) {
+                          double *a2, double *dratio) {
     double v[4][2], S[4], T[4], D, Dscale, orient, r, e13[2], e24[2];
     int k;
     for (k = 0; k < 4; k++) {
@@ -51,6 +51,7 @@ static int floater_branch(const quad *q, const double x[2], double br, double *a
     }
     D = T[0] * T[0] + T[1] * T[1] + 2 * S[0] * S[2] + 2 * S[1] * S[3];
     Dscale = T[0] * T[0] + T[1] * T[1] + 2 * fabs(S[0] * S[2]) + 2 * fabs(S[1] * S[3]);
+    *dratio = Dscale > 0 ? D / Dscale : 0.0;
     if (D < 0) {
         if (D < -1e-12 * Dscale) return 1;
         D = 0; /* a double root perturbed by rounding */
@@ -118,6 +119,12 @@ static void consider(double a1, double a2, double res, double tol, double *b1, d
 }
 
 int ccn__bilinear_inverse(const double corners[8], const double x[2], double *a1, double *a2) {
+    double dratio;
+    return ccn__bilinear_inverse_d(corners, x, a1, a2, &dratio);
+}
+
+int ccn__bilinear_inverse_d(const double corners[8], const double x[2], double *a1, double *a2,
+                            double *dratio) {
     static const double starts[5][2] = {{0.5, 0.5}, {0.25, 0.25}, {0.75, 0.75},
                                         {0.25, 0.75}, {0.75, 0.25}};
     quad Q;
@@ -125,6 +132,7 @@ int ccn__bilinear_inverse(const double corners[8], const double x[2], double *a1
                     bres = INFINITY;
     int k, br;
     *a1 = *a2 = NAN;
+    *dratio = -1;
     if (!isfinite(x[0]) || !isfinite(x[1])) return 2;
     for (k = 0; k < 4; k++) {
         Q.p[k][0] = corners[2 * k];
@@ -140,7 +148,7 @@ int ccn__bilinear_inverse(const double corners[8], const double x[2], double *a1
     /* Closed form, both branches of sqrt(D), each polished by a few Newton steps. */
     for (br = 1; br >= -1; br -= 2) {
         double u, w, res;
-        if (floater_branch(&Q, x, (double)br, &u, &w)) continue;
+        if (floater_branch(&Q, x, (double)br, &u, &w, dratio)) continue;
         if (!isfinite(u) || !isfinite(w)) continue;
         res = bl_residual(&Q, x, u, w);
         if (res > polish) res = newton_run(&Q, x, &u, &w, polish);

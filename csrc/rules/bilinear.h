@@ -16,4 +16,10 @@
  * are set to NaN. */
 int ccn__bilinear_inverse(const double corners[8], const double x[2], double *a1, double *a2);
 
+/* The same, also giving D / Dscale of Floater's discriminant (in [-1, 1]; the two roots meet
+ * at 0 and leave the real plane below it), a continuous measure of how far the solve is from
+ * having no real root. */
+int ccn__bilinear_inverse_d(const double corners[8], const double x[2], double *a1, double *a2,
+                            double *dratio);
+
 #endif

@@ -198,7 +198,7 @@ static void build_nurss(int32_t n, const double *d, double *g, double *f, double
 
 typedef struct {
     int32_t n;
-    const ccn__poly_design *des; /* the polyhedron's design (rules/eigen_shape.h) */
+    const ccn__poly_blend *blend; /* the polyhedron: a blend of designs (rules/eigen_shape.h) */
     const double *d;          /* normalised intervals */
     double *c, *s;            /* cos, sin of 2 pi i / n (eq (25)) */
     double *sc, *ss;          /* the spokes' directions (= c, s but for the angle designs) */
@@ -206,14 +206,18 @@ typedef struct {
     double *ex, *ey, *fx, *fy; /* eigen polyhedron E_i^0, F_i^0 (eqs (26), (13)) */
     double *g, *f, *m;        /* vertex-rule weights (27) */
     double *a1, *a2;          /* face-rule parameters alpha_{i,1}, alpha_{i,2} (30) */
+    double *tl, *tc, *ts, *ll, *ph; /* one design's lengths and directions; the blend's log l, angle */
     double lambda, T0[2];
+    double margin;            /* the construction's distance from failing (build_eigen) */
 } eigen_work;
 
 /* Section 5 (SPEC 2.2): d_i^+- = sum over j = i..i+n-1 (j = i included) of d_j max(+-cos, 0),
  * l_i = (d_i + d_i^+ + d_i^-)/3, E_i = l_i (cos, sin)(2 pi i/n) (26), F_i = gamma (E_i +
- * E_{i+1}) (13). Another candidate design (w->des, rules/eigen_shape.h) replaces the lengths
- * l_i and, for the angle designs, the spoke directions; d_i^+ (the vertex rule's f_i) is the
- * paper's in every case. Returns -1 if the candidate could not be built. */
+ * E_{i+1}) (13). Another candidate design (rules/eigen_shape.h) replaces the lengths l_i and,
+ * for the angle designs, the spoke directions; d_i^+ (the vertex rule's f_i) is the paper's in
+ * every case. A blend of designs takes the weighted geometric mean of their lengths and the
+ * weighted mean of their spoke angles (equal angles stay exact when no design moves them, so
+ * n = 4 and equal intervals keep their exact rules). Returns -1 if a design could not be built. */
 static int eigen_polyhedron(eigen_work *w) {
     int32_t n = w->n, i, k;
     double gamma = ccn__ev_gamma(n);
@@ -230,7 +234,32 @@ static int eigen_polyhedron(eigen_work *w) {
         w->sc[i] = w->c[i];
         w->ss[i] = w->s[i];
     }
-    if (ccn__poly_apply(w->des, n, w->d, w->ex, w->sc, w->ss)) return -1;
+    const ccn__poly_blend *b = w->blend;
+    if (b->count == 1) {
+        if (ccn__poly_apply(ccn__poly_design_of(b->poly[0]), n, w->d, w->ex, w->sc, w->ss)) return -1;
+    } else {
+        int angles = 0;
+        for (i = 0; i < n; i++) w->ll[i] = w->ph[i] = 0;
+        for (int32_t c = 0; c < b->count; c++) {
+            const ccn__poly_design *des = ccn__poly_design_of(b->poly[c]);
+            for (i = 0; i < n; i++) w->tl[i] = w->ex[i], w->tc[i] = w->c[i], w->ts[i] = w->s[i];
+            if (ccn__poly_apply(des, n, w->d, w->tl, w->tc, w->ts)) return -1;
+            angles |= des->a != 0;
+            double prev = 0;
+            for (i = 0; i < n; i++) {
+                w->ll[i] += b->w[c] * log(w->tl[i]);
+                /* the angle of spoke i, increasing from 0 (each step in (0, 2 pi)) */
+                double a = i ? atan2(w->ts[i], w->tc[i]) : 0.0;
+                while (i && a <= prev) a += 2 * CCN__PI;
+                w->ph[i] += b->w[c] * a;
+                prev = a;
+            }
+        }
+        for (i = 0; i < n; i++) {
+            w->ex[i] = exp(w->ll[i]);
+            if (angles) w->sc[i] = cos(w->ph[i]), w->ss[i] = sin(w->ph[i]);
+        }
+    }
     for (i = 0; i < n; i++) {
         double l = w->ex[i];
         w->ex[i] = l * w->sc[i];
@@ -271,6 +300,17 @@ static void eigen_vertex(eigen_work *w, double *M) {
 
 static int param_ok(double a) { return a >= CCN__EV_PARAM_LO && a <= CCN__EV_PARAM_HI; }
 
+/* The construction's margin (eigen_work.margin): the smallest of the face and edge parameters'
+ * distance from the limits [CCN__EV_PARAM_LO, CCN__EV_PARAM_HI] over CCN__EV_PARAM_BAND and of
+ * the bilinear discriminants D / Dscale over CCN__EV_D_BAND; >= 1 is clear of failing, <= 0
+ * fails. run_scheme blends towards the NURSS rules over (0, 1), so the rules do not jump where
+ * the construction stops working. */
+static void note_margin(eigen_work *w, double a, double b, double dratio) {
+    double slack = fmin(fmin(a - CCN__EV_PARAM_LO, CCN__EV_PARAM_HI - a),
+                        fmin(b - CCN__EV_PARAM_LO, CCN__EV_PARAM_HI - b));
+    w->margin = fmin(w->margin, fmin(slack / CCN__EV_PARAM_BAND, dratio / CCN__EV_D_BAND));
+}
+
 /* Face rule (29)-(30): F_i^1 = V^1 + lambda F_i^0 written as the bilinear combination of
  * (V, E_i, F_i, E_{i+1}); (alpha_{i,1}, alpha_{i,2}) by the inverse bilinear map. */
 static int eigen_faces(eigen_work *w, double *M, char *why, size_t whylen) {
@@ -279,8 +319,8 @@ static int eigen_faces(eigen_work *w, double *M, char *why, size_t whylen) {
         int32_t j = wrap(i + 1, n);
         double p[8] = {0, 0, w->ex[i], w->ey[i], w->fx[i], w->fy[i], w->ex[j], w->ey[j]};
         double x[2] = {w->T0[0] + w->lambda * w->fx[i], w->T0[1] + w->lambda * w->fy[i]};
-        double u, v, *rf = row_of(M, n, col_f(i, n));
-        int rc = ccn__bilinear_inverse(p, x, &u, &v);
+        double u, v, dr, *rf = row_of(M, n, col_f(i, n));
+        int rc = ccn__bilinear_inverse_d(p, x, &u, &v, &dr);
         if (rc) {
             snprintf(why, whylen, "face rule (30) of face %d: %s", (int)i,
                      rc == 1 ? "no real bilinear solution (D < 0)" : "degenerate face quad");
@@ -291,6 +331,7 @@ static int eigen_faces(eigen_work *w, double *M, char *why, size_t whylen) {
                      (int)i, u, v, CCN__EV_PARAM_LO, CCN__EV_PARAM_HI);
             return 1;
         }
+        note_margin(w, u, v, dr);
         w->a1[i] = u;
         w->a2[i] = v;
         rf[col_v(n)] = (1 - u) * (1 - v);
@@ -309,7 +350,7 @@ static int eigen_edges(eigen_work *w, double *M, char *why, size_t whylen) {
     int32_t n = w->n, i;
     for (i = 0; i < n; i++) {
         int32_t im = wrap(i - 1, n), ip = wrap(i + 1, n);
-        double a = w->a1[im], b = w->a2[i], q[8], x[2], b1, b2, *re;
+        double a = w->a1[im], b = w->a2[i], q[8], x[2], b1, b2, dr, *re;
         int rc, k;
         double E[2] = {w->ex[i], w->ey[i]};
         for (k = 0; k < 2; k++) {
@@ -321,7 +362,7 @@ static int eigen_edges(eigen_work *w, double *M, char *why, size_t whylen) {
             q[6 + k] = 0.5 * ((1 - a) * E[k] + a * Fm + E[k]); /* Q3 */
             x[k] = w->T0[k] + w->lambda * E[k];
         }
-        rc = ccn__bilinear_inverse(q, x, &b1, &b2);
+        rc = ccn__bilinear_inverse_d(q, x, &b1, &b2, &dr);
         if (rc) {
             snprintf(why, whylen, "edge rule (38) of spoke %d: %s", (int)i,
                      rc == 1 ? "no real bilinear solution (D < 0)" : "degenerate edge quad");
@@ -332,6 +373,7 @@ static int eigen_edges(eigen_work *w, double *M, char *why, size_t whylen) {
                      (int)i, b1, b2, CCN__EV_PARAM_LO, CCN__EV_PARAM_HI);
             return 1;
         }
+        note_margin(w, b1, b2, dr);
         re = row_of(M, n, col_e(i, n));
         re[col_v(n)] = (1 - b2) * ((1 - b1) * (1 - a) / 2 + b1 * (1 - b) / 2 + 0.5);
         re[col_e(im, n)] = (1 - b2) * (1 - b1) * a / 2;
@@ -373,6 +415,7 @@ static int build_eigen(eigen_work *w, double *M, double *residual, char *why, si
     int32_t n = w->n;
     zero_matrix(M, n);
     w->lambda = ccn__ev_lambda(n);
+    w->margin = INFINITY;
     if (eigen_polyhedron(w)) {
         snprintf(why, whylen, "the candidate polyhedron could not be built");
         return 1;
@@ -418,7 +461,7 @@ static double cc_residual(const double *M, int32_t n, double *scratch) {
 
 /* ---- public entry ---------------------------------------------------------------------- */
 
-#define SCRATCH_PER_N 15
+#define SCRATCH_PER_N 20
 
 ccn_status ccn__ev_validate(int32_t n, const double *d, ccn_scheme scheme, const double *M,
                            ccn_error *err) {
@@ -456,27 +499,38 @@ double ccn__ev_normalise(int32_t n, const double *d, double *out) {
     return mx;
 }
 
-/* Points the eigen work arrays into scratch (14 n doubles). */
-static void work_init(eigen_work *w, int32_t n, const double *d, const ccn__poly_design *des,
+/* Points the eigen work arrays into scratch (19 n doubles). */
+static void work_init(eigen_work *w, int32_t n, const double *d, const ccn__poly_blend *blend,
                       double *scratch) {
-    double **arrays[14];
+    double **arrays[19];
     int k;
     memset(w, 0, sizeof *w);
     w->n = n;
-    w->des = des;
+    w->blend = blend;
     w->d = d;
     arrays[0] = &w->c, arrays[1] = &w->s, arrays[2] = &w->dp, arrays[3] = &w->ex;
     arrays[4] = &w->ey, arrays[5] = &w->fx, arrays[6] = &w->fy, arrays[7] = &w->g;
     arrays[8] = &w->f, arrays[9] = &w->m, arrays[10] = &w->a1, arrays[11] = &w->a2;
     arrays[12] = &w->sc, arrays[13] = &w->ss;
-    for (k = 0; k < 14; k++) *arrays[k] = scratch + (size_t)k * (size_t)n;
+    arrays[14] = &w->tl, arrays[15] = &w->tc, arrays[16] = &w->ts, arrays[17] = &w->ll;
+    arrays[18] = &w->ph;
+    for (k = 0; k < 19; k++) *arrays[k] = scratch + (size_t)k * (size_t)n;
 }
 
-/* Fills M and info for a validated call; buf holds SCRATCH_PER_N * n doubles. */
+static double smoothstep01(double x) {
+    if (!(x > 0)) return 0.0;
+    if (x >= 1) return 1.0;
+    return x * x * (3 - 2 * x);
+}
+
+/* Fills M and info for a validated call; buf holds SCRATCH_PER_N * n doubles. The eigen M of
+ * a construction within CCN__EV_PARAM_BAND / CCN__EV_D_BAND of failing is blended with the
+ * NURSS M by smoothstep(margin), and a failed one is the NURSS M: so M is a continuous
+ * function of the intervals up to and across the eigen rules' range. */
 static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme,
-                             const ccn__poly_design *des, int32_t poly, double *M,
-                             ccn_ev_info *info, double *P, ccn_error *err, double *buf) {
-    double *nd = buf, *rest = buf + n, dmax, residual = 0;
+                             const ccn__poly_blend *blend, double *M, ccn_ev_info *info,
+                             double *P, double *margin, ccn_error *err, double *buf) {
+    double *nd = buf, *rest = buf + n, dmax, residual = 0, keep = 0;
     char why[200];
     eigen_work w;
     info->lambda = ccn__ev_lambda(n);
@@ -487,23 +541,46 @@ static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme,
     }
     dmax = ccn__ev_normalise(n, d, nd);
     if (scheme == CCN_SCHEME_EIGEN) {
-        work_init(&w, n, nd, des, rest);
+        work_init(&w, n, nd, blend, rest);
         if (!build_eigen(&w, M, &residual, why, sizeof why)) {
+            keep = margin ? 1.0 : smoothstep01(w.margin);
+            if (margin) *margin = w.margin;
             info->T0[0] = w.T0[0] * dmax;
             info->T0[1] = w.T0[1] * dmax;
             info->residual = residual;
-            info->polyhedron = poly;
-            for (int32_t i = 0; P && i < n; i++) {
-                P[2 * col_f(i, n)] = w.fx[i], P[2 * col_f(i, n) + 1] = w.fy[i];
-                P[2 * col_e(i, n)] = w.ex[i], P[2 * col_e(i, n) + 1] = w.ey[i];
+            int32_t best = 0;
+            for (int32_t c = 1; c < blend->count; c++)
+                if (blend->w[c] > blend->w[best]) best = c;
+            info->polyhedron = blend->poly[best];
+            if (keep == 1.0) {
+                for (int32_t i = 0; P && i < n; i++) {
+                    P[2 * col_f(i, n)] = w.fx[i], P[2 * col_f(i, n) + 1] = w.fy[i];
+                    P[2 * col_e(i, n)] = w.ex[i], P[2 * col_e(i, n) + 1] = w.ey[i];
+                }
+                if (P) P[2 * col_v(n)] = P[2 * col_v(n) + 1] = 0;
+                return CCN_OK;
             }
-            if (P) P[2 * col_v(n)] = P[2 * col_v(n) + 1] = 0;
-            return CCN_OK;
+            snprintf(why, sizeof why, "within %.3g of failing", w.margin);
         }
         info->fallback = 1;
-        set_error(err, CCN_OK, "eigen rules failed (%s); NURSS rules used", why);
+        set_error(err, CCN_OK, "eigen rules %s; NURSS rules %s", why, keep > 0 ? "blended in" : "used");
+    }
+    size_t sz = 2 * (size_t)n + 1;
+    double *E = NULL;
+    if (keep > 0) { /* the eigen M, to blend with */
+        E = malloc(sizeof(double) * sz * sz);
+        if (!E) {
+            set_error(err, CCN_ERR_MEMORY, "ev matrix: out of memory for valence %d", (int)n);
+            return CCN_ERR_MEMORY;
+        }
+        memcpy(E, M, sizeof(double) * sz * sz);
     }
     build_nurss(n, nd, rest, rest + n, rest + 2 * (size_t)n, M);
+    if (E) {
+        for (size_t k = 0; k < sz * sz; k++) M[k] = keep * E[k] + (1 - keep) * M[k];
+        free(E);
+    } else
+        info->T0[0] = info->T0[1] = info->residual = 0, info->polyhedron = 0;
     if (!all_finite(M, n)) {
         set_error(err, CCN_ERR_INTERNAL, "ev matrix: NURSS rules gave a non-finite entry");
         return CCN_ERR_INTERNAL;
@@ -511,13 +588,20 @@ static ccn_status run_scheme(int32_t n, const double *d, ccn_scheme scheme,
     return CCN_OK;
 }
 
-ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_scheme scheme,
-                                 const ccn__poly_design *des, int32_t poly, double *M,
-                                 ccn_ev_info *info, double *P, ccn_error *err) {
+ccn_status ccn__ev_matrix_blend(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                                const ccn__poly_blend *blend, double *M, ccn_ev_info *info,
+                                double *P, double *margin, ccn_error *err) {
     double stack[SCRATCH_PER_N * CCN__EV_STACK_VALENCE], *buf = stack;
     ccn_ev_info local;
     ccn_status st = ccn__ev_validate(n, spoke_knots, scheme, M, err);
     if (st != CCN_OK) return st;
+    for (int32_t c = 0; c < blend->count; c++)
+        if (!ccn__poly_design_of(blend->poly[c])) {
+            if (info) memset(info, 0, sizeof *info);
+            set_error(err, CCN_ERR_ARGUMENT, "ev matrix: polyhedron %d outside [1, %d]",
+                      (int)blend->poly[c], CCN__POLY_COUNT);
+            return CCN_ERR_ARGUMENT;
+        }
     if (n > CCN__EV_STACK_VALENCE) {
         buf = malloc(sizeof(double) * SCRATCH_PER_N * (size_t)n);
         if (!buf) {
@@ -528,7 +612,8 @@ ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_schem
     if (!info) info = &local;
     memset(info, 0, sizeof *info);
     set_error(err, CCN_OK, "%s", "");
-    st = run_scheme(n, spoke_knots, scheme, des, poly, M, info, P, err, buf);
+    if (margin) *margin = -1;
+    st = run_scheme(n, spoke_knots, scheme, blend, M, info, P, margin, err, buf);
     if (buf != stack) free(buf);
     return st;
 }
@@ -536,12 +621,6 @@ ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_schem
 ccn_status ccn__ev_matrix_poly(int32_t n, const double *spoke_knots, ccn_scheme scheme,
                                int32_t poly, double *M, ccn_ev_info *info, double *P,
                                ccn_error *err) {
-    const ccn__poly_design *des = ccn__poly_design_of(poly);
-    if (!des) {
-        if (info) memset(info, 0, sizeof *info);
-        set_error(err, CCN_ERR_ARGUMENT, "ev matrix: polyhedron %d outside [1, %d]", (int)poly,
-                  CCN__POLY_COUNT);
-        return CCN_ERR_ARGUMENT;
-    }
-    return ccn__ev_matrix_design(n, spoke_knots, scheme, des, poly, M, info, P, err);
+    ccn__poly_blend one = {1, {poly}, {1.0}};
+    return ccn__ev_matrix_blend(n, spoke_knots, scheme, &one, M, info, P, NULL, err);
 }

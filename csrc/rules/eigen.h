@@ -24,6 +24,10 @@
 #define CCN__EV_PARAM_LO (-0.5)
 #define CCN__EV_PARAM_HI 1.5
 #define CCN__EV_MAX_RESIDUAL 1e-8
+/* Bands over which M is blended from the eigen rules to the NURSS rules as the construction
+ * nears those limits (parameter slack; discriminant D / Dscale): M stays continuous. */
+#define CCN__EV_PARAM_BAND 0.25
+#define CCN__EV_D_BAND 0.02
 
 /* cos(2 pi k / n) and sin(2 pi k / n), with exact 0, +-1 at the quarter points (so n = 4
  * reproduces the tensor rules exactly) and symmetric rounding elsewhere. n >= 1. */
@@ -49,9 +53,13 @@ ccn_status ccn__ev_validate(int32_t n, const double *d, ccn_scheme scheme, const
 ccn_status ccn__ev_matrix_poly(int32_t n, const double *spoke_knots, ccn_scheme scheme,
                                int32_t poly, double *M, ccn_ev_info *info, double *P,
                                ccn_error *err);
-/* The same for any design (research and tests); info->polyhedron = poly. */
-ccn_status ccn__ev_matrix_design(int32_t n, const double *spoke_knots, ccn_scheme scheme,
-                                 const ccn__poly_design *des, int32_t poly, double *M,
-                                 ccn_ev_info *info, double *P, ccn_error *err);
+/* The same for a blend of candidates (rules/eigen_shape.h); info->polyhedron = the candidate
+ * of the largest weight. margin NULL: the library's M (near the construction's limits blended
+ * with the NURSS M, see eigen.c run_scheme). margin given: the pure eigen M (or the NURSS M when
+ * the construction fails, margin -1) and the construction's margin (>= 1 clear, <= 0 fails),
+ * for the verification (rules/eigen_select.c). */
+ccn_status ccn__ev_matrix_blend(int32_t n, const double *spoke_knots, ccn_scheme scheme,
+                                const ccn__poly_blend *blend, double *M, ccn_ev_info *info,
+                                double *P, double *margin, ccn_error *err);
 
 #endif

@@ -207,6 +207,126 @@ int ccn__fan_blend_stats(int32_t n, const double *d, const double *M, int levels
     return 0;
 }
 
+/* The margin of the single-maximum property, continuous in the z values (so in M and d).
+ * Each vertex u gets f_u = (max_nb z - z_u) / max_nb |z - z_u| in [-1, 1] (neighbours: the
+ * vertices sharing a face), negative exactly when u is a strict local maximum; a vertex low in
+ * the tail counts less: f_u is raised to 1 as z_u falls from 2e-3 to 1e-3 of the top (a
+ * ramp, so no cut-off jumps). Two maxima need two strict maxima that are not neighbours, so
+ * the margin is
+ *     q = min over pairs {u, v} of vertices that share no face of max(f_u, f_v),
+ * negative exactly when a second maximum stands apart from the first. The pairs are a fixed
+ * set and each f_u is continuous, so q is continuous: when the top moves to a neighbour, or two
+ * vertices beside the top rise level with it, q passes through 0 instead of jumping. Computed
+ * from the smallest f in order: the first vertex with a non-neighbour before it. */
+#define FAN_TAIL_LO 1e-3
+#define FAN_TAIL_HI 2e-3
+
+typedef struct {
+    double f;
+    int64_t slot;
+} fan_rank;
+
+/* The neighbours (sharing a face) of slot k = (s, i, j); returns their count (<= 2n). Inside a
+ * sector (i >= 2, j >= 1) they are stored in the sector's own block; elsewhere slot() maps
+ * them across the spokes. */
+static int neighbours(const fgrid *g, int64_t k, int32_t s, int32_t i, int32_t j, int64_t *nb) {
+    int m = 0;
+    if (!k) {
+        for (int32_t t = 0; t < g->n; t++) nb[m++] = slot(g, t, 1, 0), nb[m++] = slot(g, t, 1, 1);
+        return m;
+    }
+    if (i >= 2 && j >= 1 && i < g->R && j < g->R) {
+        for (int a = -1; a <= 1; a++)
+            for (int b = -1; b <= 1; b++)
+                if (a || b) nb[m++] = k + (int64_t)a * (g->R + 1) + b;
+        return m;
+    }
+    for (int a = -1; a <= 1; a++)
+        for (int b = -1; b <= 1; b++) {
+            int64_t q = a || b ? slot(g, s, i + a, j + b) : -1;
+            if (q >= 0) nb[m++] = q; /* not u itself, nor the quadrant that does not exist */
+        }
+    return m;
+}
+
+static void slot_coords(const fgrid *g, int64_t k, int32_t *s, int32_t *i, int32_t *j) {
+    *s = *i = *j = 0;
+    if (!k) return;
+    int64_t r = k - 1, per = (int64_t)g->R * (g->R + 1);
+    *s = (int32_t)(r / per);
+    r %= per;
+    *i = (int32_t)(r / (g->R + 1)) + 1;
+    *j = (int32_t)(r % (g->R + 1));
+}
+
+int ccn__fan_maxima_margin(int32_t n, const double *d, const double *M, int levels, double *q,
+                           int32_t *maxima) {
+    fgrid g, h;
+    if (grid_alloc(&g, n, 3, 1, d)) return -1;
+    g.v[0] = 1.0;
+    for (int l = 0; l < levels; l++) {
+        int rc = refine(&g, &h, M);
+        free(g.v);
+        if (rc) return -1;
+        g = h;
+    }
+    size_t np = grid_points(n, g.R);
+    fan_rank *rk = malloc(sizeof *rk * (size_t)(2 * n + 10));
+    int64_t *nb = malloc(sizeof(int64_t) * (size_t)(2 * n + 8));
+    if (!rk || !nb) { free(rk); free(nb); free(g.v); return -1; }
+    double zt = 0;
+    int finite = 1;
+    for (size_t k = 0; k < np; k++) {
+        if (!isfinite(g.v[k])) finite = 0;
+        else zt = fmax(zt, g.v[k]);
+    }
+    /* the K smallest f, sorted (K > any neighbourhood, so a vertex apart is among them) */
+    size_t m = 0, K = (size_t)(2 * n + 10);
+    int32_t count = 0;
+    for (size_t k = 0; k < np && finite && zt > 0; k++) {
+        int32_t s, i, j;
+        slot_coords(&g, (int64_t)k, &s, &i, &j);
+        if (k && (i >= g.R || j >= g.R)) continue; /* the outer ring: its neighbours are not all here */
+        double z = g.v[k], up = -INFINITY, spread = 0;
+        int c = neighbours(&g, (int64_t)k, s, i, j, nb);
+        for (int t = 0; t < c; t++) {
+            double y = g.v[nb[t]] - z;
+            up = y > up ? y : up;
+            spread = fabs(y) > spread ? fabs(y) : spread;
+        }
+        double f = spread > 0 ? up / spread : 0.0;
+        count += z > FAN_ZMIN && f < 0;
+        double hgt = z / zt;
+        if (hgt <= FAN_TAIL_LO) continue; /* f raised to 1: never below a counted one */
+        if (hgt < FAN_TAIL_HI) f = fmax(f, (FAN_TAIL_HI - hgt) / (FAN_TAIL_HI - FAN_TAIL_LO));
+        if (m == K && !(f < rk[K - 1].f)) continue;
+        size_t at_ = m < K ? m++ : K - 1;
+        while (at_ > 0 && f < rk[at_ - 1].f) { rk[at_] = rk[at_ - 1]; at_--; }
+        rk[at_] = (fan_rank){f, (int64_t)k};
+    }
+    double margin = 1.0;
+    if (finite && zt > 0) {
+        for (size_t a = 1; a < m && rk[a].f < margin; a++) {
+            int32_t s, i, j;
+            slot_coords(&g, rk[a].slot, &s, &i, &j);
+            int c = neighbours(&g, rk[a].slot, s, i, j, nb), apart = 0;
+            if ((size_t)c < a) apart = 1; /* more earlier vertices than neighbours */
+            for (size_t e = 0; e < a && !apart; e++) {
+                int adj = 0;
+                for (int t = 0; t < c && !adj; t++) adj = nb[t] == rk[e].slot;
+                apart = !adj;
+            }
+            if (apart) margin = rk[a].f;
+        }
+    }
+    free(rk);
+    free(nb);
+    free(g.v);
+    *q = finite ? margin : -1.0;
+    *maxima = finite ? count : 1000;
+    return 0;
+}
+
 /* ---- characteristic map ------------------------------------------------------------------ */
 
 /* 1 simple, mu2 = mu3 = lambda (real, double), |mu4| < lambda: the experiment's criteria. */
@@ -241,7 +361,7 @@ static int spectrum_ok(int32_t n, const double *M, double lambda) {
 /* The eigenvector of lambda on the 3-ring: 1-ring = P + T0/(lambda - 1) (an eigenvector of M),
  * rings 2, 3 by power iteration (refine, keep the 3-ring, divide by lambda). */
 static int charnet(int32_t n, const double *d, const double *M, const double *P, const double T0[2],
-                   double lambda, fgrid *g, int *converged) {
+                   double lambda, fgrid *g, int *converged, int iterations) {
     if (grid_alloc(g, n, 3, 2, d)) return -1;
     double c[2] = {T0[0] / (lambda - 1), T0[1] / (lambda - 1)}, scale = 0;
     for (int32_t r = 0; r <= 2 * n; r++) {
@@ -252,7 +372,7 @@ static int charnet(int32_t n, const double *d, const double *M, const double *P,
         }
     }
     *converged = 0;
-    for (int it = 0; it < 500 && !*converged; it++) {
+    for (int it = 0; it < iterations && !*converged; it++) {
         fgrid h;
         if (refine(g, &h, M)) return -1;
         double change = 0;
@@ -462,7 +582,7 @@ int ccn__fan_charmap(int32_t n, const double *d, const double *M, const double *
     if (!sp) return 0;
     fgrid g, h;
     int converged;
-    if (charnet(n, d, M, P, T0, lambda, &g, &converged)) { free(g.v); return -1; }
+    if (charnet(n, d, M, P, T0, lambda, &g, &converged, 500)) { free(g.v); return -1; }
     r->spectrum = converged;
     int rc = 0;
     for (int l = 0; l < 2 && r->spectrum && !rc; l++) { /* rings 3 -> 5 -> 9 */
@@ -471,6 +591,103 @@ int ccn__fan_charmap(int32_t n, const double *d, const double *M, const double *
         g = h;
     }
     if (!rc && r->spectrum) rc = surface_test(&g, 2, r);
+    free(g.v);
+    return rc;
+}
+
+/* ---- continuous margins of the characteristic-map test --------------------------------- */
+
+/* Spectrum: with 1 and the double lambda (which M has by construction) set aside, the
+ * largest modulus left over lambda, ratio in [0, inf). Returns -1 when out of memory. */
+static int spectrum_ratio(int32_t n, const double *M, double lambda, double *ratio) {
+    int32_t N = 2 * n + 1;
+    double *A = malloc(sizeof(double) * ((size_t)N * N + 2 * (size_t)N));
+    if (!A) return -1;
+    double *wr = A + (size_t)N * N, *wi = wr + N;
+    memcpy(A, M, sizeof(double) * (size_t)N * N);
+    *ratio = INFINITY;
+    if (LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'N', 'N', N, A, N, wr, wi, NULL, 1, NULL, 1) == 0) {
+        int32_t skip[3] = {-1, -1, -1};
+        for (int k = 0; k < 3; k++) { /* the eigenvalue nearest 1, then the two nearest lambda */
+            double target = k ? lambda : 1.0, best = INFINITY;
+            for (int32_t i = 0; i < N; i++) {
+                if (i == skip[0] || i == skip[1]) continue;
+                double dist = hypot(wr[i] - target, wi[i]);
+                if (dist < best) best = dist, skip[k] = i;
+            }
+        }
+        double mu = 0;
+        for (int32_t i = 0; i < N; i++)
+            if (i != skip[0] && i != skip[1] && i != skip[2]) mu = fmax(mu, hypot(wr[i], wi[i]));
+        *ratio = mu / lambda;
+    }
+    free(A);
+    return 0;
+}
+
+/* The smallest Bernstein coefficient of det J (times the orientation) after `depth` uniform
+ * splits, over the largest coefficient of the patch: a lower bound of min det J / max, and a
+ * continuous function of the net (the adaptive test above decides, this one measures). */
+static double jacobian_margin(double J[6][6], int sg, int depth, double scale) {
+    if (depth == 0) {
+        double mn = INFINITY;
+        for (int a = 0; a < 6; a++)
+            for (int b = 0; b < 6; b++) mn = fmin(mn, sg * J[a][b]);
+        return mn / scale;
+    }
+    double U0[6][6], U1[6][6], Q[4][6][6], m = INFINITY;
+    bern_split(J, 0, U0, U1);
+    bern_split(U0, 1, Q[0], Q[1]);
+    bern_split(U1, 1, Q[2], Q[3]);
+    for (int k = 0; k < 4; k++) m = fmin(m, jacobian_margin(Q[k], sg, depth - 1, scale));
+    return m;
+}
+
+#define FAN_REG_DEPTH 2
+
+int ccn__fan_charmap_margin(int32_t n, const double *d, const double *M, const double *P,
+                            const double T0[2], double lambda, ccn__charmap_margin *r) {
+    r->spectrum = r->regular = -1;
+    r->injective = 0;
+    double ratio;
+    if (spectrum_ratio(n, M, lambda, &ratio)) return -1;
+    r->spectrum = 1 - ratio - FAN_SPECTRUM_MIN;
+    if (!(r->spectrum > 0)) return 0;
+    fgrid g, h;
+    int converged, rc = 0;
+    /* iterations enough for |mu4| / lambda up to 1 - FAN_SPECTRUM_MIN */
+    int its = (int)ceil(log(1e-15) / log(1 - FAN_SPECTRUM_MIN));
+    if (charnet(n, d, M, P, T0, lambda, &g, &converged, its)) { free(g.v); return -1; }
+    if (!converged) r->spectrum = -1;
+    for (int l = 0; l < 2 && converged && !rc; l++) { /* rings 3 -> 5 -> 9 */
+        rc = refine(&g, &h, M);
+        free(g.v);
+        g = h;
+    }
+    if (!rc && converged) {
+        int orient = 0;
+        double margin = INFINITY;
+        const int32_t R = 2;
+        for (int32_t s = 0; s < n; s++)
+            for (int32_t i = 0; i < 2 * R; i++)
+                for (int32_t j = 0; j < 2 * R; j++) {
+                    if (i < R && j < R) continue;
+                    double B[4][4][2], J[6][6], scale = 0;
+                    face_patch(&g, s, i, j, B);
+                    jacobian_bezier(B, J);
+                    if (!orient) orient = J[0][0] > 0 ? 1 : J[0][0] < 0 ? -1 : 0;
+                    for (int a = 0; a < 6; a++)
+                        for (int b = 0; b < 6; b++) scale = fmax(scale, fabs(J[a][b]));
+                    margin = orient && scale > 0 ? fmin(margin, jacobian_margin(J, orient, FAN_REG_DEPTH, scale)) : -1;
+                }
+        r->regular = isfinite(margin) ? margin : -1;
+        if (r->regular > 0) {
+            ccn__charmap_result cr;
+            memset(&cr, 0, sizeof cr);
+            rc = surface_test(&g, R, &cr);
+            r->injective = cr.injective;
+        }
+    }
     free(g.v);
     return rc;
 }

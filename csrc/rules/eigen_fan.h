@@ -36,4 +36,28 @@ typedef struct {
 int ccn__fan_charmap(int32_t n, const double *d, const double *M, const double *P,
                      const double T0[2], double lambda, ccn__charmap_result *r);
 
+/* The same tests as continuous margins (the per-vertex choice blends candidates by them, so
+ * the surface moves continuously with the intervals; rules/eigen_select.c):
+ *   maxima: ccn__fan_maxima_margin's q in [-1, 1], negative when a second face-local maximum
+ *           stands clear of the top (see eigen_fan.c); maxima = the count as ccn__fan_maxima.
+ *   spectrum: 1 - FAN_SPECTRUM_MIN - |mu4| / lambda, |mu4| the largest eigenvalue modulus
+ *           of M besides 1 and the double lambda; <= 0 fails (lambda not subdominant by that
+ *           gap: the power iteration of the characteristic net would need too many steps);
+ *   regular: min over the patches of rings 2..4 of the smallest Bernstein coefficient of
+ *           det J after three uniform splits over the patch's largest, times the orientation:
+ *           > 0 proves regularity; -1 when not computed;
+ *   injective: the discrete test of ccn__fan_charmap, made only when regular > 0 (with a
+ *           regular map it can change only where a ring curve passes the centre). */
+typedef struct {
+    double spectrum, regular;
+    int injective;
+} ccn__charmap_margin;
+
+#define FAN_SPECTRUM_MIN 0.01
+
+int ccn__fan_maxima_margin(int32_t n, const double *d, const double *M, int levels, double *q,
+                           int32_t *maxima);
+int ccn__fan_charmap_margin(int32_t n, const double *d, const double *M, const double *P,
+                            const double T0[2], double lambda, ccn__charmap_margin *r);
+
 #endif

@@ -119,34 +119,64 @@ static void canonical(int32_t n, const double *d, double *out) {
 
 /* ---- verification and choice --------------------------------------------------------------- */
 
-int ccn__ev_verify(int32_t n, const double *nd, int32_t poly) {
+static double smoothstep01(double x) {
+    if (!(x > 0)) return 0.0;
+    if (x >= 1) return 1.0;
+    return x * x * (3 - 2 * x);
+}
+
+double ccn__ev_margin(int32_t n, const double *nd, int32_t poly) {
     size_t sz = 2 * (size_t)n + 1;
     double *M = malloc(sizeof(double) * (sz * sz + 2 * sz));
-    if (!M) return -1;
-    double *P = M + sz * sz;
+    if (!M) return NAN;
+    double *P = M + sz * sz, q;
     ccn_ev_info info;
-    int ok = ccn__ev_matrix_poly(n, nd, CCN_SCHEME_EIGEN, poly, M, &info, P, NULL) == CCN_OK &&
-             !info.fallback;
-    int rc = 0;
-    if (ok) {
-        int32_t maxima = ccn__fan_maxima(n, nd, M, CCN__EV_SELECT_LEVELS);
-        if (maxima < 0) rc = -1;
-        ok = maxima == 1;
+    ccn__poly_blend one = {1, {poly}, {1.0}};
+    if (ccn__ev_matrix_blend(n, nd, CCN_SCHEME_EIGEN, &one, M, &info, P, &q, NULL) != CCN_OK) q = -1;
+    if (q > 0) {
+        double qm;
+        int32_t maxima;
+        if (ccn__fan_maxima_margin(n, nd, M, CCN__EV_SELECT_LEVELS, &qm, &maxima)) q = NAN;
+        else q = fmin(q, qm / CCN__EV_MAXIMA_BAND);
     }
-    if (ok && !rc) {
-        ccn__charmap_result cr;
-        if (ccn__fan_charmap(n, nd, M, P, info.T0, info.lambda, &cr)) rc = -1;
-        ok = cr.spectrum && cr.regular && cr.injective;
+    if (q > 0) {
+        ccn__charmap_margin cm;
+        if (ccn__fan_charmap_margin(n, nd, M, P, info.T0, info.lambda, &cm)) q = NAN;
+        else {
+            q = fmin(q, fmin(cm.spectrum / CCN__EV_SPECTRUM_BAND, cm.regular / CCN__EV_REGULAR_BAND));
+            if (!cm.injective) q = fmin(q, -1.0);
+        }
     }
     free(M);
-    return rc ? -1 : ok;
+    return q;
+}
+
+int ccn__ev_verify(int32_t n, const double *nd, int32_t poly) {
+    double q = ccn__ev_margin(n, nd, poly);
+    return isnan(q) ? -1 : q > 0;
+}
+
+/* Weight of the paper's polyhedron accepted without checks: 1 up to a spoke ratio of
+ * CCN__EV_TRUST_RATIO, 0 from CCN__EV_VERIFY_RATIO, smooth in log(ratio) between. */
+static double trust_weight(double ratio) {
+    return smoothstep01(log(CCN__EV_VERIFY_RATIO / ratio) / log(CCN__EV_VERIFY_RATIO / CCN__EV_TRUST_RATIO));
+}
+
+static void blend_add(ccn__poly_blend *b, int32_t poly, double w) {
+    for (int32_t c = 0; c < b->count; c++)
+        if (b->poly[c] == poly) { b->w[c] += w; return; }
+    b->poly[b->count] = poly;
+    b->w[b->count++] = w;
 }
 
 ccn_status ccn__ev_select(int32_t n, const double *nd, ccn__ev_cache *cache, ccn__ev_choice *out) {
     double mn = nd[0], mx = nd[0];
     for (int32_t i = 1; i < n; i++) mn = fmin(mn, nd[i]), mx = fmax(mx, nd[i]);
-    *out = (ccn__ev_choice){CCN__POLY_PAPER, 0, 0, 0};
-    if (n == 4 || n > CCN__EV_SELECT_MAX_VALENCE || mx <= CCN__EV_TRUST_RATIO * mn) return CCN_OK;
+    memset(out, 0, sizeof *out);
+    out->poly = CCN__POLY_PAPER;
+    out->blend = (ccn__poly_blend){1, {CCN__POLY_PAPER}, {1.0}};
+    double trust = trust_weight(mx / mn);
+    if (n == 4 || n > CCN__EV_SELECT_MAX_VALENCE || trust >= 1) return CCN_OK;
     double key[CCN__EV_SELECT_MAX_VALENCE];
     canonical(n, nd, key);
     const ccn__ev_choice *hit = cache_find(cache, n, key);
@@ -155,17 +185,28 @@ ccn_status ccn__ev_select(int32_t n, const double *nd, ccn__ev_cache *cache, ccn
         out->cached = 1;
         return CCN_OK;
     }
-    out->outside = 1;
-    for (int32_t poly = 1; poly <= CCN__POLY_COUNT; poly++) {
-        int v = ccn__ev_verify(n, key, poly);
-        if (v < 0) return CCN_ERR_MEMORY;
+    /* "The first candidate that passes", made continuous: candidate k takes the weight
+     * s_k prod_{j<k} (1 - s_j), s = smoothstep of its margin (1 when it passes clearly, 0 when
+     * it fails), the paper's s at least the trust weight; what no candidate takes stays on the
+     * paper's polyhedron. Every margin is continuous in the intervals, so the weights are. */
+    ccn__poly_blend b = {0, {0}, {0}};
+    double rest = 1.0;
+    for (int32_t poly = 1; poly <= CCN__POLY_COUNT && rest > 0; poly++) {
+        double q = ccn__ev_margin(n, key, poly);
+        if (isnan(q)) return CCN_ERR_MEMORY;
         out->verified++;
-        if (v) {
-            out->poly = poly;
-            out->outside = 0;
-            break;
-        }
+        double sk = smoothstep01(q);
+        if (poly == CCN__POLY_PAPER) sk = fmax(sk, trust);
+        if (rest * sk > 0) blend_add(&b, poly, rest * sk);
+        rest *= 1 - sk;
     }
+    if (rest > 0) blend_add(&b, CCN__POLY_PAPER, rest);
+    out->outside = rest >= 0.5;
+    out->blend = b;
+    int32_t best = 0;
+    for (int32_t c = 1; c < b.count; c++)
+        if (b.w[c] > b.w[best]) best = c;
+    out->poly = b.poly[best];
     if (cache && cache_add(cache, n, key, out)) return CCN_ERR_MEMORY;
     return CCN_OK;
 }
@@ -188,7 +229,10 @@ ccn_status ccn__ev_matrix_cached(int32_t n, const double *spoke_knots, ccn_schem
         }
         return CCN_ERR_ARGUMENT;
     }
-    ccn__ev_choice ch = {polyhedron ? polyhedron : CCN__POLY_PAPER, 0, 0, 0};
+    ccn__ev_choice ch;
+    memset(&ch, 0, sizeof ch);
+    ch.poly = polyhedron ? polyhedron : CCN__POLY_PAPER;
+    ch.blend = (ccn__poly_blend){1, {ch.poly}, {1.0}};
     if (scheme == CCN_SCHEME_EIGEN && polyhedron == CCN_POLY_SELECT &&
         ccn__ev_validate(n, spoke_knots, scheme, M, err) == CCN_OK && n <= CCN__EV_SELECT_MAX_VALENCE) {
         double nd[CCN__EV_SELECT_MAX_VALENCE];
@@ -204,7 +248,7 @@ ccn_status ccn__ev_matrix_cached(int32_t n, const double *spoke_knots, ccn_schem
             return CCN_ERR_MEMORY;
         }
     }
-    ccn_status st = ccn__ev_matrix_poly(n, spoke_knots, scheme, ch.poly, M, info, NULL, err);
+    ccn_status st = ccn__ev_matrix_blend(n, spoke_knots, scheme, &ch.blend, M, info, NULL, NULL, err);
     if (st == CCN_OK && scheme == CCN_SCHEME_EIGEN) {
         info->verified = ch.verified;
         info->outside_g1 = ch.outside;

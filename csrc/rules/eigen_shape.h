@@ -44,6 +44,16 @@ typedef struct {
     int angle_fn; /* research: 0 w_s = (d_s d_{s+1})^a, 1 (d_s + d_{s+1})^a, 2 min^a, 3 max^a */
 } ccn__poly_design;
 
+/* A weighted blend of candidates (the per-vertex choice, rules/eigen_select.c): the spoke
+ * lengths are the weighted geometric mean of the candidates' lengths, the spoke angles the
+ * weighted mean of theirs (each candidate's angles increase from 0 at spoke 0). Weights > 0,
+ * summing to 1; count 1 is that candidate exactly. */
+typedef struct {
+    int32_t count;
+    int32_t poly[CCN__POLY_COUNT];
+    double w[CCN__POLY_COUNT];
+} ccn__poly_blend;
+
 /* The design of candidate poly (1..CCN__POLY_COUNT), NULL for any other number. */
 const ccn__poly_design *ccn__poly_design_of(int32_t poly);
 

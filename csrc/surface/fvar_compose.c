@@ -36,6 +36,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "refine/children.h"
 #include "refine/fvar.h"
 #include "rules/crease.h"
 #include "surface/fvar_bilinear.h"
@@ -338,7 +339,7 @@ static void origin_range(void *ctx, int32_t b, int32_t end) {
 }
 
 /* Every output written down: of levels 1..L only the numbering of the value vertices is needed
- * (refine/level.c's, through ccn__level_child_numbering from level 0's value vertices and
+ * (refine/level.c's, through ccn__children_numbering from level 0's value vertices and
  * edges), each level-L value vertex's first fan corner as the value mesh would have it (its
  * outgoing boundary corner, else its first corner: topology/mesh.c) for origin(), and the
  * count of values kept sharp (vertex points keep their value's flag; under BOUNDARIES the
@@ -364,7 +365,7 @@ static ccn_status numbered(const ccn_plan *p, builder *c, ccn_error *err) {
         if (!hv2 || !he2 || !ev2 || (bnd && !cnt))
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face-varying levels)");
         else
-            ccn__level_child_numbering(vm, ne, hv0, he0, ev0, hv2, he2, ev2, p->threads);
+            ccn__children_numbering(vm, ne, hv0, he0, ev0, hv2, he2, ev2, p->threads);
         free(cnt);
         cnt = NULL;
         if (l) { free(hv); free(he); free(ev); }

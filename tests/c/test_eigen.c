@@ -210,6 +210,25 @@ static double eigen_identity_error(int n, const double *M, const double *P, doub
     return err / scale;
 }
 
+/* Does M have an eigen polyhedron for lambda, whatever polyhedron it was built from? That is
+ * (M - lambda I) P = 1 T for a planar P with V = 0 besides the trivial solution: the
+ * (2n+1) x (2n+2) matrix [(M - lambda I) without V's column | -1] has a two-dimensional null
+ * space. Returns its second smallest singular value over the largest (0 when it holds). */
+static double eigen_structure_error(int n, const double *M, double lambda) {
+    int N = SZ(n), r, c;
+    double A[SZ(12) * (SZ(12) + 1)], sv[SZ(12) + 1], superb[SZ(12) + 1];
+    for (r = 0; r < N; r++) {
+        int k = 0;
+        for (c = 0; c < N; c++)
+            if (c != iV(n)) A[r * N + k++] = M[r * N + c] - (r == c ? lambda : 0);
+        A[r * N + k] = -1;
+    }
+    /* N rows, N columns (2n F/E columns + the T column) */
+    if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'N', N, N, A, N, sv, NULL, 1, NULL, 1, superb) != 0)
+        return INFINITY;
+    return sv[N - 2] / sv[0];
+}
+
 /* ---- tests -------------------------------------------------------------------------------- */
 
 static void test_argument_errors(void) {
@@ -440,7 +459,9 @@ static void test_nurss_rows(void) {
     printf("# NURSS rows sum error (uniform and log-uniform [1e-9,1]): %.2g\n", rows);
 }
 
-/* Fallback: extreme ratios never give NaN; a fallback M equals the NURSS M exactly. */
+/* Fallback: extreme ratios never give NaN; where the eigen construction fails M is the NURSS M
+ * exactly, and near its limits (the blend band, "blended in") a convex combination of the two
+ * whose entries lie between theirs. */
 static void test_fallback(void) {
     double M[SZ(24) * SZ(24)], R[SZ(24) * SZ(24)], d[24];
     int v, k, i, total = 0, seen = 0;
@@ -459,7 +480,11 @@ static void test_fallback(void) {
                 CHECK(err.status == CCN_OK && strstr(err.message, "NURSS") != NULL, "note '%s'",
                       err.message);
                 ccn_ev_matrix(n, d, CCN_SCHEME_NURSS, R, NULL, NULL);
-                CHECK(max_abs_diff(M, R, n) == 0, "fallback M is not the NURSS M");
+                if (strstr(err.message, "NURSS rules used"))
+                    CHECK(max_abs_diff(M, R, n) == 0, "fallback M is not the NURSS M");
+                else
+                    CHECK(strstr(err.message, "blended in") && max_abs_diff(M, R, n) > 0,
+                          "a blended M: '%s'", err.message);
                 if (!seen++) printf("# fallback example (n %d): %s\n", n, err.message);
             } else {
                 CHECK(info.residual <= 1e-8, "residual %g without fallback", info.residual);
@@ -605,7 +630,7 @@ static void test_candidate_identity(void) {
                 CHECK(ccn_ev_matrix_polyhedron(n, d, CCN_SCHEME_EIGEN, k, M, &info, NULL) == CCN_OK, "ok");
                 CHECK(matrix_finite(M, n) && max_row_sum_error(M, n) <= 1e-12, "rows");
                 total++;
-                if (info.fallback) { fallbacks++; CHECK(info.polyhedron == 0, "fallback names a polyhedron"); continue; }
+                if (info.fallback) { fallbacks++; continue; } /* NURSS, or blended towards it */
                 CHECK(info.polyhedron == k, "info.polyhedron %d for %d", info.polyhedron, k);
                 effective_d(n, d, de);
                 lam = candidate_polyhedron(k, n, de, P);
@@ -640,13 +665,14 @@ static void test_candidates_at_valence4(void) {
     printf("# n = 4: the choice vs tensor knot insertion %.2g, the Greville candidate %.2g\n", worst, grev);
 }
 
-/* The choice: ratio <= 5 -> the paper's, unchecked; otherwise a verified candidate whose M is
- * exactly ccn_ev_matrix_polyhedron's, or the paper's flagged outside_g1; invariant under
- * rotation and reflection of the spoke order. */
+/* The choice: ratio <= 4 -> the paper's, unchecked; from 5 on verified (between, both); M is
+ * exactly a single candidate's M or, where candidates are blended, still has an eigen
+ * polyhedron for lambda (checked without it, eigen_structure_error); invariant under rotation
+ * and reflection of the spoke order. */
 static void test_selection(void) {
     static const int ns[] = {3, 5, 6, 7, 8};
     double M[SZ(8) * SZ(8)], R[SZ(8) * SZ(8)], P[2 * SZ(8)], d[8], d2[8], de[8], T0[2];
-    int c, i, trusted = 0, verified = 0, other = 0, outside = 0;
+    int c, i, trusted = 0, verified = 0, other = 0, outside = 0, blends = 0;
     for (c = 0; c < 400; c++) {
         int n = ns[c % 5], sh = c % n, refl = (c / 5) & 1;
         ccn_ev_info info, info2;
@@ -654,23 +680,27 @@ static void test_selection(void) {
         for (i = 0; i < n; i++) d[i] = c % 3 == 0 ? unif(0.25, 1) : c % 3 == 1 ? unif(1e-6, 1) : logunif(1e-3, 1);
         for (i = 0; i < n; i++) mn = fmin(mn, d[i]), mx = fmax(mx, d[i]);
         CHECK(ccn_ev_matrix(n, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "ok");
-        if (mx <= 5 * mn) {
+        if (mx <= 4 * mn) {
             trusted++;
             CHECK(info.polyhedron == CCN_POLY_PAPER && info.verified == 0 && !info.outside_g1,
                   "ratio %.3g: polyhedron %d verified %d", mx / mn, info.polyhedron, info.verified);
-        } else {
+        } else if (mx >= 5 * mn) {
             verified++;
             CHECK(info.verified >= 1, "ratio %.3g not verified", mx / mn);
             other += info.polyhedron > CCN_POLY_PAPER;
         }
         outside += info.outside_g1;
-        if (info.outside_g1) CHECK(info.polyhedron == CCN_POLY_PAPER || info.fallback, "outside: the paper's");
-        if (info.fallback) { CHECK(info.outside_g1, "a fallback M is never chosen"); continue; }
+        if (info.fallback) continue; /* the NURSS M blended in: no eigen polyhedron */
         CHECK(ccn_ev_matrix_polyhedron(n, d, CCN_SCHEME_EIGEN, info.polyhedron, R, NULL, NULL) == CCN_OK, "ok");
-        CHECK(max_abs_diff(M, R, n) == 0, "M is not candidate %d's", info.polyhedron);
-        effective_d(n, d, de);
-        double lam = candidate_polyhedron(info.polyhedron, n, de, P);
-        CHECK(eigen_identity_error(n, M, P, lam, T0) <= 1e-10, "identity of the chosen polyhedron");
+        if (max_abs_diff(M, R, n) == 0) {
+            effective_d(n, d, de);
+            double lam = candidate_polyhedron(info.polyhedron, n, de, P);
+            CHECK(eigen_identity_error(n, M, P, lam, T0) <= 1e-10, "identity of the chosen polyhedron");
+        } else {
+            blends++;
+            double e = eigen_structure_error(n, M, info.lambda);
+            CHECK(e <= 1e-10, "a blend of candidates without an eigen polyhedron: %g", e);
+        }
         for (i = 0; i < n; i++) d2[i] = d[refl ? (sh - i + 2 * n) % n : (sh + i) % n];
         CHECK(ccn_ev_matrix(n, d2, CCN_SCHEME_EIGEN, R, &info2, NULL) == CCN_OK, "ok");
         CHECK(info2.polyhedron == info.polyhedron && info2.outside_g1 == info.outside_g1,
@@ -678,8 +708,9 @@ static void test_selection(void) {
     }
     CHECK(trusted > 50 && verified > 100 && other > 0, "sample: %d trusted %d verified %d other", trusted,
           verified, other);
-    printf("# choice on 400 cases: %d accepted unchecked (ratio <= 5), %d verified, %d of them another "
-           "candidate, %d outside the G1 range\n", trusted, verified, other, outside);
+    printf("# choice on 400 cases: %d accepted unchecked (ratio <= 4), %d verified (ratio >= 5), %d of them "
+           "another candidate, %d blends of candidates, %d outside the G1 range\n", trusted, verified, other,
+           blends, outside);
 }
 
 static void test_bilinear_inverse(void) {

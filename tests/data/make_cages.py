@@ -427,6 +427,28 @@ FIGS = [
     ("fig16_v6.obj", 6, (1, 10, 10, 1, 1, 10)),
     ("fig17_v7.obj", 7, (1, 8, 8, 1, 1, 1, 8)),
     ("fig18_v8.obj", 8, (1, 5, 5, 1, 1, 1, 5, 1)),
+    # continuity regressions: spoke intervals where a switched polyhedron choice once jumped
+    # in the 9th digit (every nearby value chose another candidate)
+    ("continuity_v7.obj", 7, (1, 1, 5.942921586, 1, 1, 5.942921586, 1)),
+]
+
+
+def knotted_cube():
+    """The cube with the x- and y-parallel edge rings at 22.4300098, the z ring at 1."""
+    V, F = cube()
+    knots = {}
+    for f in F:
+        for k in range(4):
+            a, b = f[k], f[(k + 1) % 4]
+            axis = [i for i in range(3) if V[a][i] != V[b][i]][0]
+            knots[(min(a, b), max(a, b))] = 22.4300098 if axis < 2 else 1.0
+    return V, F, sorted(knots.items())
+
+
+KNOTTED = [
+    ("continuity_cube.obj", knotted_cube,
+     "closed cube, valence-3 vertices; x and y edge rings 22.4300098, z ring 1 (a continuity "
+     "regression: the polyhedron choice once flipped at this value)"),
 ]
 
 
@@ -514,6 +536,9 @@ def main():
         V, F = fn()
         assert len(F) <= 300, name
         write(outdir, name, V, F, comment)
+    for name, fn, comment in KNOTTED:
+        V, F, knots = fn()
+        write(outdir, name, V, F, comment, knots)
     for name, n, d in FIGS:
         V, F, knots = fig(n, d)
         write(outdir, name, V, F,
