@@ -261,6 +261,7 @@ def _reload(forget):
     _saving[0] = False  # a save that failed between save_pre and save_post ends here
     if forget:
         sync.forget_all()
+        hygiene.removed_note.clear()
     run_collect()
     sync_all()
 

@@ -11,6 +11,11 @@ after updates that change the object or group count or touch a cage whose owners
   append with a new name): the group, its proxies and their names follow;
 * two live groups naming the same proxy (a duplicated node tree): the proxy stays with the
   group whose owner it records; the other cage gets new proxies;
+* one CCNURBS per object: a second one (the modifier panel's Duplicate, Copy to Selected or Copy
+  Modifiers onto a cage, a Nodes modifier given one of our groups) is removed, the first in the
+  stack stays, and the panel says so (`removed_note`). Two would share a group and its proxies:
+  the second would read the first's limit as its cage and write the limit of the limit into the
+  same proxy, growing at every edit;
 * a cage whose modifier is gone (Apply, X) stops being a cage; an applied limit loses its
   marker attribute (and, 4.4+, the custom normals: the mesh Subsurf's Apply would give);
 * groups no live cage uses, proxies no live group names, and our empty/scratch meshes are
@@ -21,6 +26,10 @@ import numpy as np
 
 from . import compat, modifier, proxies
 
+REMOVED_NOTE = ("A second CCNURBS modifier (\"%s\") was removed: one per object. To subdivide "
+                "the limit again, apply this one first.")
+removed_note = {}  # object name -> the note shown in the panel after a second modifier went
+
 SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "uv_smooth",
             "normals", "use_creases", "store_render_mesh")
 PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
@@ -30,11 +39,18 @@ def is_live(obj):
     return obj.library is None and obj.users > 0 and len(obj.users_scene) > 0
 
 
+def ours(obj):
+    """The object's CCNURBS modifiers (Nodes modifiers using one of our groups), in stack order."""
+    return [m for m in obj.modifiers if m.type == 'NODES' and modifier.is_group(m.node_group)]
+
+
 def suspicious(obj):
     """Cheap per-object test the update handler runs on updated objects: does this need a
-    collect()? (copied modifier, shared group, renamed cage, applied modifier)."""
+    collect()? (copied modifier, shared group, renamed cage, applied modifier, a second one)."""
     if obj.type != 'MESH' or obj.library is not None:
         return False
+    if len(ours(obj)) > 1:
+        return True
     mod = modifier.get_modifier(obj)
     if mod is None:
         return obj.ccnurbs.role == 'CAGE'
@@ -79,12 +95,27 @@ def _applied(me):
                 me.attributes.remove(e)
 
 
+def _one_per_object(obj):
+    """Removes every CCNURBS modifier of obj but the first; the note says which went. Returns
+    True if one went (the object's evaluation, and its tap, are stale until the next one)."""
+    extra = ours(obj)[1:]
+    for m in extra:
+        name = m.name
+        obj.modifiers.remove(m)
+        removed_note[obj.name_full] = REMOVED_NOTE % name
+        print("CCNURBS: %s: %s" % (obj.name_full, REMOVED_NOTE % name))
+    return bool(extra)
+
+
 def collect():
-    """One hygiene pass. Returns (renamed [(old, new)], fresh [objects], removed count)."""
-    users = {}
+    """One hygiene pass. Returns (renamed [(old, new)], fresh [objects: new groups, or a second
+    modifier removed; their taps are read after a new evaluation], removed count)."""
+    users, trimmed = {}, []
     for o in bpy.data.objects:
         if o.type != 'MESH' or o.library is not None:
             continue
+        if len(o.modifiers) > 1 and _one_per_object(o):
+            trimmed.append(o)
         mod = modifier.get_modifier(o)
         if mod is None:
             if o.ccnurbs.role == 'CAGE':
@@ -124,6 +155,7 @@ def collect():
             _copy_settings(src, obj)
         modifier.ensure(obj, fresh=True)
         made.append(obj)
+    made += [o for o in trimmed if o not in made]  # evaluated again before their taps are read
     return renamed, made, _remove_unused()
 
 

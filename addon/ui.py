@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import errors, modifier, native, sync, tap, values
+from . import errors, hygiene, modifier, native, sync, tap, values
 
 
 def active_edge_interval(obj):
@@ -101,10 +101,10 @@ def _draw_status(layout, obj):
             box.label(text=lines[0], icon='INFO')
             for line in lines[1:]:
                 box.label(text=line, icon='BLANK1')
-        note = tap.edit_note.get(obj.name_full)
-        if note:
-            for i, line in enumerate(_wrap(note, 48)):
-                box.label(text=line, icon='INFO' if i == 0 else 'BLANK1')
+        for note in (tap.edit_note.get(obj.name_full), hygiene.removed_note.get(obj.name_full)):
+            if note:
+                for i, line in enumerate(_wrap(note, 48)):
+                    box.label(text=line, icon='INFO' if i == 0 else 'BLANK1')
         box.label(text="Updated in %.1f ms" % (1000 * st.seconds))
 
 

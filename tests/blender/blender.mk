@@ -6,7 +6,7 @@ BLENDER_SAVED_GOAL := $(.DEFAULT_GOAL)
 APT_PKGS  += blender zip
 ADDON_SRC  = $(sort $(wildcard addon/*.py)) blender_manifest.toml
 
-.PHONY: package deps-bpy
+.PHONY: package deps-bpy storm
 package: $(B)/ccnurbs.zip
 
 # `make deps` also makes the Blender 4.5 / 5.x environments (PyPI `bpy` wheels, cached outside
@@ -35,4 +35,9 @@ $(B)/ccnurbs.zip: $(ADDON_SRC) $(B)/package-lib/libccnurbs.so tests/blender/blen
 	@echo "package: $@"
 
 TEST_DEPS += $(B)/ccnurbs.zip
+
+# the long storm of artist operations (tests/blender/long_storm.sh; `make test` runs a short one)
+storm: deps
+	@$(MAKE) --no-print-directory build $(B)/ccnurbs.zip
+	@sh tests/blender/long_storm.sh
 .DEFAULT_GOAL := $(BLENDER_SAVED_GOAL)

@@ -74,8 +74,26 @@ def mesh_positions(me):
     return co.reshape(-1, 3).astype(np.float64)
 
 
-def write_cage_obj(me, path):
-    """Writes the mesh (object mode data) as an OBJ cage with its knot intervals."""
+def edge_vertex_creases(me):
+    """(edge creases (E,), vertex creases (V,)) in [0, 1]: the `crease_edge` / `crease_vert`
+    attributes (4.0+), MeshEdge.crease and the vertex crease layer (3.x); zeros when unset."""
+    ec, vc = np.zeros(len(me.edges), np.float32), np.zeros(len(me.vertices), np.float32)
+    if bpy.app.version >= (4, 0, 0):
+        for name, out in (("crease_edge", ec), ("crease_vert", vc)):
+            a = me.attributes.get(name)
+            if a is not None:
+                a.data.foreach_get("value", out)
+    else:
+        me.edges.foreach_get("crease", ec)
+        layers = getattr(me, "vertex_creases", None)
+        if layers:
+            layers[0].data.foreach_get("value", vc)
+    return ec, vc
+
+
+def write_cage_obj(me, path, creases=False):
+    """Writes the mesh (object mode data) as an OBJ cage with its knot intervals (and its
+    creases as OpenSubdiv sharpness 10 c^2, Blender's mapping, if creases)."""
     P = mesh_positions(me)
     sizes = np.empty(len(me.polygons), np.int32)
     me.polygons.foreach_get("loop_total", sizes)
@@ -93,6 +111,14 @@ def write_cage_obj(me, path):
             for (a, b), d in zip(edge_keys(me), k):
                 if d > 0:
                     fh.write("# knot %d %d %.9g\n" % (a + 1, b + 1, d))
+        if creases:
+            ec, vc = edge_vertex_creases(me)
+            for (a, b), c in zip(edge_keys(me), ec):
+                if c > 0:
+                    fh.write("# crease %d %d %.17g\n" % (a + 1, b + 1, 10 * float(c) ** 2))
+            for i, c in enumerate(vc):
+                if c > 0:
+                    fh.write("# corner %d %.17g\n" % (i + 1, 10 * float(c) ** 2))
 
 
 def read_limit_obj(path):
@@ -106,11 +132,11 @@ def read_limit_obj(path):
     return np.array(V, np.float64).reshape(-1, 3), np.array(N, np.float64).reshape(-1, 3)
 
 
-def cli_limit(cli, me, levels, scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL"):
+def cli_limit(cli, me, levels, scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", creases=False):
     """Runs `ccnurbs limit` on the mesh; returns (positions, normals)."""
     with tempfile.TemporaryDirectory() as d:
         src, dst = os.path.join(d, "cage.obj"), os.path.join(d, "limit.obj")
-        write_cage_obj(me, src)
+        write_cage_obj(me, src, creases)
         cmd = [cli, "limit", "--levels", str(levels), "--scheme", CLI_SCHEME[scheme],
                "--cap", CLI_CAP[cap], "--corners", CLI_CORNERS[boundary], src, dst]
         r = subprocess.run(cmd, capture_output=True, text=True)

@@ -531,6 +531,80 @@ class TestModifier(AddonTestCase):
         np.testing.assert_array_equal(evaluated_positions(ob), before)
         self.assertGreater(evaluated_positions(dup)[:, 2].max(), 0.5)
 
+    def _ours(self, ob):
+        return [m for m in ob.modifiers if m.type == 'NODES' and ccn.modifier.is_group(m.node_group)]
+
+    def test_duplicated_modifier_is_removed(self):
+        """The modifier panel's Duplicate (object.modifier_copy): the second CCNURBS shared the
+        first's group, read the first's limit as its cage and wrote the limit of the limit into
+        the same proxy, growing at every edit. It is removed, with a note; the surface stays
+        the cage's limit through later edits."""
+        ob = add_modifier(load_cage("Fan5Dup", os.path.join(DATA, "fan5.obj")))
+        n0 = len(evaluated_positions(ob))
+        bpy.ops.object.modifier_copy(modifier=ccn.modifier.get_modifier(ob).name)
+        update()
+        self.assertEqual(len(self._ours(ob)), 1, "one CCNURBS modifier per object")
+        self.assertEqual(len(evaluated_positions(ob)), n0)
+        self.assertMatchesCLI(ob)
+        for k in range(3):  # later edits: no growth
+            ob.data.vertices[k].co.z += 0.1
+            ob.data.update()
+            update()
+            self.assertMatchesCLI(ob, normals=False)
+        bpy.context.view_layer.objects.active = ob
+        self.assertIn("one per object", labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier)))
+
+    def test_copy_to_selected_keeps_the_targets_surface(self):
+        """Copy to Selected of the modifier onto a cage that has its own CCNURBS: the target
+        keeps exactly one working modifier with its own group, showing its own limit, also
+        after save and reopen."""
+        src = add_modifier(grid(3, "Src"))
+        dst = add_modifier(load_cage("Dst", os.path.join(DATA, "fan5.obj")))
+        own_group = ccn.modifier.get_modifier(dst).node_group
+        bpy.ops.object.select_all(action='DESELECT')
+        dst.select_set(True)
+        src.select_set(True)
+        bpy.context.view_layer.objects.active = src
+        if hasattr(bpy.ops.object, "modifier_copy_to_selected"):
+            bpy.ops.object.modifier_copy_to_selected(modifier=ccn.modifier.get_modifier(src).name)
+        else:  # what it does: the source's modifier, appended to the target
+            m = dst.modifiers.new("CCNURBS.001", 'NODES')
+            m.node_group = ccn.modifier.get_modifier(src).node_group
+        update()
+        update()
+        mods = self._ours(dst)
+        self.assertEqual(len(mods), 1, "one CCNURBS on the target")
+        self.assertIs(mods[0].node_group, own_group)
+        self.assertEqual(ccn.modifier.owner_of(mods[0].node_group), dst.name_full)
+        self.assertMatchesCLI(dst)
+        self.assertMatchesCLI(src)
+        path = os.path.join(TMP, "ccn_copy_to_selected.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        bpy.ops.wm.open_mainfile(filepath=path)
+        dst = bpy.data.objects["Dst"]
+        self.assertEqual(len(self._ours(dst)), 1)
+        self.assertMatchesCLI(dst)
+
+    def test_a_part_ignores_a_disconnected_part(self):
+        """The limit of a part of a cage is the same whatever else the cage holds: a fan with
+        non-uniform intervals and extraordinary points, alone and next to a pentagon with much
+        larger intervals (it changes the intervals' normalisation and splits an n-gon)."""
+        V, F, K = cagelib.read_obj(os.path.join(DATA, "fan5.obj"))
+        K = {e: 0.2 + 0.37 * (i % 5) for i, e in enumerate(sorted(
+            {(min(f[k], f[(k + 1) % 4]), max(f[k], f[(k + 1) % 4])) for f in F for k in range(4)}))}
+        alone = add_modifier(load_cage("Alone", V=V, F=F, K=K))
+        A = evaluated_positions(alone)
+        n = len(V)
+        pent = np.array([[10 + np.cos(2 * np.pi * k / 5), np.sin(2 * np.pi * k / 5), 0.3 * k] for k in range(5)])
+        K2 = dict(K)
+        K2.update({(n + k, n + (k + 1) % 5) if k < 4 else (n, n + 4): 40.0 + k for k in range(5)})
+        both = add_modifier(load_cage("Both", V=np.vstack([V, pent]), F=list(F) + [list(range(n, n + 5))], K=K2))
+        B = evaluated_positions(both)
+        far = max(np.abs(B - a).max(1).min() for a in A)
+        size = float(np.linalg.norm(V.max(0) - V.min(0)))
+        self.assertLessEqual(far / size, 1e-6, "the fan's limit moved by %g of its size next to a "
+                             "disconnected pentagon" % (far / size))
+
     def test_add_is_undoable(self):
         ob = grid(2, "UndoMe")
         bpy.ops.ed.undo_push(message="before add")

@@ -25,7 +25,7 @@ import bltest  # noqa: E402
 
 CASES = ("case_package", "case_knots", "case_modifier", "case_creases", "case_primitives",
          "case_stack", "case_animation", "case_files", "case_objio", "case_values", "case_uv",
-         "case_cad_export", "case_zenable")
+         "case_cad_export", "case_storm", "case_zenable")
 
 
 class _Result(unittest.TestResult):
