@@ -13,6 +13,9 @@
  *             surface's K (H) takes the other sign somewhere (samples of every bi-5 patch);
  *   kratio    max over caps of max |K| on the cap surface / max |K| of the refined limit in
  *             the same hole;
+ *   kring     max over caps of max |K| on the cap surface / max |K| of the refined limit on
+ *             the ring of output vertices around the hole (the refined limit's curvature in
+ *             the hole is unbounded at a non-uniform EV, so this is the measure there);
  *   kjump     max over caps of the jump of K across cap-cap and cap-ring joins / max |K| there;
  *   centre    angle between the cap-centre normal (from the cap patches) and the exact limit
  *             normal at the EV (the refine plan's), orientation included;
@@ -36,7 +39,7 @@
 #endif
 
 typedef struct {
-    double turn, turn_ref, kratio, kjump, centre, outside, g1, jac;
+    double turn, turn_ref, kratio, kring, kjump, centre, outside, g1, jac;
     int ksign, hsign, caps, fallbacks, holes_checked;
 } fair;
 
@@ -197,6 +200,16 @@ static void measure_cap(const ccn_plan *plan, const ccn__cap *cp, const fplan *p
         kmin = fmin(kmin, K), kmax = fmax(kmax, K), hmin = fmin(hmin, H), hmax = fmax(hmax, H);
         kref = fmax(kref, fabs(K));
     }
+    double kout = 0; /* the ring around the hole: outside it, next to a vertex inside */
+    for (int32_t v = 0; v < pr->nv; v++) {
+        if (in_hole_of[v]) continue;
+        int next = 0;
+        for (int32_t q = nbs[v]; q < nbs[v + 1] && !next; q++) next = in_hole_of[nb[q]] == cap_id + 1;
+        if (!next) continue;
+        double K, H;
+        ring_curvature(pr->x, pr->n, nbs, nb, v, &K, &H);
+        kout = fmax(kout, fabs(K));
+    }
     const double *nev = pr->n + 3 * ev_out;
     /* the cap surface: samples of every patch */
     double kc = 0, cmin = 1e300, cmaxk = -1e300, chmin = 1e300, chmax = -1e300;
@@ -220,6 +233,7 @@ static void measure_cap(const ccn_plan *plan, const ccn__cap *cp, const fplan *p
     if ((kmin > 0 && cmin <= 0) || (kmax < 0 && cmaxk >= 0)) F->ksign++;
     if ((hmin > 0 && chmin <= 0) || (hmax < 0 && chmax >= 0)) F->hsign++;
     if (kref > 0) F->kratio = fmax(F->kratio, kc / kref);
+    if (kout > 0) F->kring = fmax(F->kring, kc / kout);
     /* joins: cap-cap separators (cap s edge u = 0 vs cap s+1 edge v = 0, bi5_props.h cap_g1) and
      * cap-ring (cap edge u = 1 / v = 1 vs the last ring's A / C at u = rho / v = rho) */
     double jump = 0;

@@ -1,0 +1,77 @@
+/* The table of the guided bi-5 cap on random stars (tests/experiments/cap_table.sh builds and
+ * runs it): for valence n = 3, 5..12 and spoke max/min ratios R = 1 (equal), 2, 4, 10
+ * (log-uniform in [1, R], one spoke at 1 and one at R), `cases` random general stars (3 x 3
+ * quads per sector, jittered, random heights: not a symmetric dome), output level L: how many
+ * extraordinary points get a cap, and for the capped ones the fairness measures of
+ * tests/c/cap_fair.h against the refined limit (normal-turn excess, curvature sign changes,
+ * max |K| over the refined limit's on the ring around the hole, K jump across the cap's joins,
+ * G1 at the joins, folds). Built against the default library it measures what ships; against a
+ * library compiled with -DCCN_CAP_KAPPA_RANGE=1e9 it measures today's non-uniform construction
+ * wherever it can be built.
+ *
+ *   cap_table [cases] [level] [seed]     one line per (n, R), then the totals */
+#include "../c/testlib.h"
+
+#include "../c/cap_fair.h"
+
+static void general_star(int n, const double *d, fcage *c) {
+    star_cage(n, 3, d, c);
+    for (int32_t v = 1; v < c->nv; v++) { /* jitter and random heights: a general shape */
+        c->pos[3 * v] += 0.25 * (tl_rand01() - 0.5);
+        c->pos[3 * v + 1] += 0.25 * (tl_rand01() - 0.5);
+        c->pos[3 * v + 2] += 0.5 * (tl_rand01() - 0.5);
+    }
+    c->pos[2] = 0.3 + 0.6 * tl_rand01();
+}
+
+int main(int argc, char **argv) {
+    int cases = argc > 1 ? atoi(argv[1]) : 4, L = argc > 2 ? atoi(argv[2]) : 5;
+    tl_rng_state ^= (unsigned long long)(argc > 3 ? atoi(argv[3]) : 1) * 0x9E3779B97F4A7C15ull;
+    const double Rs[] = {1, 2, 4, 10};
+    printf("%-3s %-4s %5s %6s %6s %6s %5s %5s %7s %7s %8s %6s\n", "n", "R", "EVs", "capped", "turn", "turnOK", "Ksgn",
+           "Hsgn", "K/ring", "Kjump", "G1", "jac");
+    int tot = 0, totcap = 0, totpass = 0;
+    for (int ri = 0; ri < 4; ri++)
+        for (int n = 3; n <= 12; n++) {
+            if (n == 4) continue;
+            fair all;
+            fair_init(&all);
+            int evs = 0, passed = 0;
+            for (int k = 0; k < cases; k++) {
+                double d[12], R = Rs[ri];
+                for (int s = 0; s < n; s++) d[s] = exp(log(R) * tl_rand01());
+                if (R > 1) {
+                    int a = (int)(tl_rand01() * n), b = (a + 1 + (int)(tl_rand01() * (n - 1))) % n;
+                    d[a] = 1, d[b] = R;
+                }
+                fcage c;
+                general_star(n, d, &c);
+                ccn_cage g = fcage_view(&c);
+                fair F;
+                fair_init(&F);
+                ccn_options o = {0};
+                if (fair_measure(&g, L, o, &F) == 0) {
+                    evs++;
+                    int ok = F.caps > 0 && F.turn <= 0.25 && !F.ksign && !F.hsign && F.kring <= 2 && F.kjump <= 0.15 &&
+                             F.g1 <= 1e-9;
+                    passed += ok;
+                    all.caps += F.caps, all.fallbacks += F.fallbacks;
+                    if (F.caps) {
+                        all.turn = fmax(all.turn, F.turn), all.kring = fmax(all.kring, F.kring);
+                        all.kjump = fmax(all.kjump, F.kjump), all.g1 = fmax(all.g1, F.g1);
+                        all.jac = fmin(all.jac, F.jac);
+                        all.ksign += F.ksign, all.hsign += F.hsign;
+                    }
+                }
+                fcage_free(&c);
+            }
+            printf("%-3d %-4g %5d %6d %6.2f %6d %5d %5d %7.2f %7.3f %8.1e %6.3f\n", n, Rs[ri], evs, all.caps,
+                   all.caps ? all.turn : 0.0, passed, all.ksign, all.hsign, all.caps ? all.kring : 0.0,
+                   all.caps ? all.kjump : 0.0, all.caps ? all.g1 : 0.0, all.caps ? all.jac : 0.0);
+            fflush(stdout);
+            tot += evs, totcap += all.caps, totpass += passed;
+        }
+    printf("# %d EVs: %d capped (%.1f %%), %d capped and passing the harness (%.1f %%)\n", tot, totcap,
+           100.0 * totcap / (tot ? tot : 1), totpass, 100.0 * totpass / (tot ? tot : 1));
+    return 0;
+}
