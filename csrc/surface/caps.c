@@ -24,9 +24,13 @@
  * this factor of 1 (issue 14: beyond it the measured curvature of the cap fails the acceptance
  * figures -- README "The guided bi-5 cap"); the others use the exact refined limit (counted as
  * cap fallbacks). kappa = 1 for every spoke (equal or alternating intervals) always qualifies. */
-#ifndef CCN_CAP_KAPPA_RANGE /* a research build may widen it (tests/experiments/cap_fair.sh) */
+#ifndef CCN_CAP_KAPPA_RANGE /* a research build may widen it (tests/experiments/cap_table.sh) */
 #define CCN_CAP_KAPPA_RANGE 1.05
 #endif
+/* ... and the cap is blended with the refined limit in its hole (weight w, ccn__cap.w) as the
+ * largest |log kappa_s| goes from log(CCN_CAP_KAPPA_FULL) to log(CCN_CAP_KAPPA_RANGE), so the
+ * surface does not jump where an EV's spokes leave the range. */
+#define CCN_CAP_KAPPA_FULL 1.04
 
 /* Sharp edges or vertex sharpness at v (boundary edges not counted)? */
 static int creased(const ccn_mesh *m, int32_t v) {
@@ -192,12 +196,17 @@ static void cap_begin(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn__ca
             c->l0[j] = s->wp[j], c->l0[2 * n + 1 + j] = s->wu[j], c->l0[4 * n + 2 + j] = s->wv[j];
         int nu = 0, uni = 1; /* some kappa_s = d_{s+1}/d_{s-1} != 1: taus, once (no positions) */
         const double krange = CCN_CAP_KAPPA_RANGE;
+        double lk = 0;
         for (int32_t k = 0; k < n; k++) {
             double kap = c->knots[(k + 1) % n] / c->knots[(k + n - 1) % n];
             nu |= fabs(kap - 1.0) > 1e-12;
             uni &= fabs(c->knots[k] / c->knots[0] - 1.0) <= 1e-12;
+            lk = fmax(lk, fabs(log(kap)));
             if (kap > krange * (1 + 1e-12) || kap * krange < 1 - 1e-12) ok = 0; /* measured range */
         }
+        double x = (log(krange) - lk) / (log(krange) - log(CCN_CAP_KAPPA_FULL));
+        c->w = x >= 1 ? 1.0 : x * x * (3 - 2 * x);
+        if (!(c->w > 0)) ok = 0; /* at the range's end the refined limit alone */
         t->uni = uni;
         if (ok && nu) {
             c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
@@ -373,12 +382,26 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
     }
     for (int32_t i = 0; i < p->nhv; i++) {
         const ccn__cap *cp = &p->caps[p->hv_cap[i]];
-        double x[3], du[3], dv[3];
+        double x[3], du[3], dv[3], w = cp->w;
         ccn__bi5_eval(cp->op, cp->patches, p->hv_sector[i], p->hv_uv[2 * i], p->hv_uv[2 * i + 1], x, du, dv);
         int32_t o = p->hv_out[i];
         if (written) written[o] = 1;
-        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
-        if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
+        double *po = out->positions + 3 * (size_t)o, *no = out->normals ? out->normals + 3 * (size_t)o : NULL;
+        if (w < 1) { /* near the end of the cap's range: blended with the refined limit (there) */
+            double nc[3], nb[3];
+            for (int k = 0; k < 3; k++) po[k] = w * x[k] + (1 - w) * po[k];
+            if (no) {
+                ccn__unit_normal(du, dv, nc);
+                if (nc[0] * no[0] + nc[1] * no[1] + nc[2] * no[2] < 0)
+                    for (int k = 0; k < 3; k++) nc[k] = -nc[k];
+                for (int k = 0; k < 3; k++) nb[k] = w * nc[k] + (1 - w) * no[k];
+                double l = sqrt(nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2]);
+                for (int k = 0; k < 3; k++) no[k] = nb[k] / l;
+            }
+            continue;
+        }
+        memcpy(po, x, sizeof x);
+        if (no) ccn__unit_normal(du, dv, no);
     }
     eval_ring_faces(p, out, written);
     return CCN_OK;

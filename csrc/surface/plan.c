@@ -379,6 +379,19 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         memset(written, 0, (size_t)p->nout_v);
         for (int32_t i = 0; i < r->nrows; i++) written[r->rows[i]] = 1;
         eval_stencils(p, out, r->rows, r->nrows);
+        /* a cap blended with the refined limit (caps.c) reads the limit in its whole hole */
+        int32_t nb = 0, *blend = NULL;
+        for (int32_t i = 0; i < p->nhv; i++)
+            if (p->caps[p->hv_cap[i]].w < 1 && !written[p->hv_out[i]]) {
+                if (!blend && !(blend = malloc(sizeof(int32_t) * (size_t)p->nhv))) {
+                    ccn__edit_region_free(r);
+                    return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+                }
+                written[p->hv_out[i]] = 1;
+                blend[nb++] = p->hv_out[i];
+            }
+        if (nb) eval_stencils(p, out, blend, nb);
+        free(blend);
     } else {
         eval_stencils(p, out, NULL, 0);
     }

@@ -23,6 +23,8 @@ typedef struct {
     double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
     void *taus;         /* non-uniform (some kappa != 1): the n cap taus (double complex[36] each,
                            bi5.h [R11]), computed once at create; NULL otherwise */
+    double w;           /* the cap's weight against the refined limit in its hole: 1, falling
+                           smoothly to 0 as the spoke ratios reach the cap's range (caps.c) */
 } ccn__cap;
 
 struct ccn_plan {

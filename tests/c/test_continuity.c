@@ -110,11 +110,13 @@ static ccn_cage star_cage(star *c) {
     return (ccn_cage){c->nv, c->nf, c->ne, c->pos, c->fsz, c->fv, c->ev, c->knots, NULL, NULL};
 }
 
-/* The default limit surface (levels 2) of cage; out: 3 * num_verts (malloc'ed). */
+static int sweep_levels = 2; /* the output level of the sweeps */
+
+/* The default limit surface (levels sweep_levels) of cage; out: 3 * num_verts (malloc'ed). */
 static int limit_of(const ccn_cage *cage, ccn_cache *cache, double **out, int32_t *nv) {
     ccn_options o;
     memset(&o, 0, sizeof o);
-    o.levels = 2;
+    o.levels = sweep_levels;
     o.threads = 1;
     ccn_plan *p = NULL;
     ccn_error err;
@@ -159,8 +161,10 @@ typedef struct {
     int failed;
 } sweep_job;
 
+static double sweep_span = 4.0; /* the sweep covers d0 / sqrt(span) .. d0 * sqrt(span) */
+
 static double sweep_value(const sweep_job *j, int step) {
-    return j->d0 * exp(log(4.0) * ((double)step / j->steps - 0.5));
+    return j->d0 * exp(log(sweep_span) * ((double)step / j->steps - 0.5));
 }
 
 static void *sweep_worker(void *arg) {
@@ -364,8 +368,32 @@ static void test_regressions(void) {
     regression("tests/data/continuity_v7.obj", 5.942921586);
 }
 
+/* The guided cap's range: an EV whose spoke ratio kappa leaves [1/1.05, 1.05] has no cap; the
+ * cap is blended with the refined limit from 1.04 on, so sweeping a spoke's interval through
+ * the end of the range (level 4: caps are built) moves the surface without a jump. */
+static void test_cap_range(void) {
+    int small = getenv("CCN_TEST_SMALL") != NULL;
+    for (int32_t n = 3; n <= (small ? 3 : 6); n++) {
+        if (n == 4) continue;
+        star c;
+        star_make(&c, n, 3, 1);
+        for (int32_t i = 0; i < c.nrings; i++) c.ring_d[i] = 1.0;
+        c.ring_d[0] = sqrt(1.03 * 1.06);
+        sweep_span = 1.06 / 1.03, sweep_levels = 4;
+        double pert = 0, at = 0, fine = 0, r = sweep(&c, 0, small ? 40 : 120, &pert, &at, &fine);
+        sweep_span = 4.0, sweep_levels = 2;
+        CHECK(fine <= 10 && pert <= 1e-7, "valence %d: spoke 0 swept through the cap's range (1.03 .. 1.06): "
+              "largest step %.3g x the median (at %.6g; cut 4096-fold %.3g x), +-1e-9 moves %.3g", (int)n, r, at,
+              fine, pert);
+        printf("# valence %d, spoke 0 through the cap's range 1.03 .. 1.06, level 4: largest step %.3g x the "
+               "median, cut 4096-fold %.3g x (bound 10: no jump)\n", (int)n, r, fine);
+        star_free(&c);
+    }
+}
+
 int main(void) {
     RUN(test_regressions);
+    RUN(test_cap_range);
     RUN(test_random_sweeps);
     return TEST_SUMMARY();
 }

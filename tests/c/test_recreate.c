@@ -24,9 +24,10 @@ typedef struct {
 } edit_cage;
 
 /* Interval of a new edge: 1 (random_knots 0), random in [0.05, 20] (1), or in [1, 1.02] (2:
- * spoke ratios within the guided cap's range, so non-uniform caps with taus are built). */
+ * spoke ratios within the guided cap's range, so non-uniform caps with taus are built; 3: [1,
+ * 1.045], so some caps are blended with the refined limit near the end of the range). */
 static double new_knot(int random_knots) {
-    if (random_knots == 2) return 1.0 + 0.02 * tl_rand01();
+    if (random_knots >= 2) return 1.0 + (random_knots == 2 ? 0.02 : 0.045) * tl_rand01();
     return random_knots ? 0.05 + 19.95 * tl_rand01() * tl_rand01() : 1.0;
 }
 
@@ -171,7 +172,7 @@ static void chain(const char *name, int random_knots, int random_creases, int le
         int32_t e = (int32_t)(tl_rand01() * c.ne);
         double mx = 0;
         for (int32_t i = 0; i < c.ne; i++) mx = fmax(mx, c.knots[i]);
-        if (random_knots == 2) c.knots[e] = 1.0 + 0.02 * tl_rand01(); /* caps stay caps */
+        if (random_knots >= 2) c.knots[e] = new_knot(random_knots); /* caps stay caps */
         else if (step == 0) c.knots[e] = 3.0 * mx;          /* a new largest interval */
         else if (step == 1) c.knots[e] = 0.05 + 5 * tl_rand01(); /* one ring */
         else if (step == 2) { /* nothing changed */ }
@@ -224,6 +225,8 @@ static void test_interval_edits(void) {
     static const char *capped[] = {"fan5", "fan8", "fan3", "fan7", "pole12", "jitter_sphere"};
     for (size_t i = 0; i < sizeof capped / sizeof *capped; i++)
         for (int k = 0; k < 3; k++) chain(capped[i], 2, 0, 3, &runs, worst);
+    /* spoke ratios up to 1.045: caps blended with the refined limit near the end of their range */
+    for (size_t i = 0; i < sizeof capped / sizeof *capped; i++) chain(capped[i], 3, 0, 3, &runs, worst);
     printf("  %d recreated plans, largest difference from a new plan %.1e (positions, of the cage's size), "
            "%.1e (unit normals)\n", runs, worst[0], worst[1]);
     CHECK(runs >= 150, "only %d plans compared", runs);
