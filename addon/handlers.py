@@ -12,8 +12,8 @@
   then `depsgraph.update()` so the engine renders them (headless included).
 * render_complete / render_cancel: render proxies emptied and render plans freed (unless the
   cage stores its render mesh in the file).
-* save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write in place
-  (proxies.py, idmem.py): nothing is tagged, evaluated or rebuilt, before or after the save.
+* save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write
+  (proxies.py): nothing is rebuilt; the proxies are evaluated again at the next redraw.
 * load_post, undo_post, redo_post: hygiene, then every cage re-read.
 """
 import traceback

@@ -3,15 +3,15 @@
 All bulk data goes through foreach_set. A proxy's mesh is its own (never the shared empty mesh
 used while saving). Saving: a viewport proxy shows what the add-on computes again on load, so
 it points at one empty mesh during the write (`save_pre` / `save_post`: O(1) per cage, the mesh
-itself is untouched; done in place by idmem, so the save tags nothing and the next redraw
-evaluates nothing; the empty mesh stays in the session with no user, never saved); a render
-proxy is empty outside renders unless the cage's *Store Render Mesh in File* is on, and is then
-written as it is (never rebuilt by saving).
+itself is untouched; through the Python API, so the proxies are evaluated again at the next
+redraw -- the add-on writes nothing into Blender's memory behind its API); a render proxy is
+empty outside renders unless the cage's *Store Render Mesh in File* is on, and is then written
+as it is (never rebuilt by saving).
 """
 import bpy
 import numpy as np
 
-from . import attrs, compat, idmem
+from . import attrs, compat
 
 EMPTY_NAME = ".CCNURBS empty"
 KEY_PROP = "ccnurbs_key"
@@ -19,7 +19,7 @@ LIMIT_ATTR = "ccn_limit"  # FACE bool on every limit face: tells an applied limi
 TOPO_PROP = "ccnurbs_topology"
 PLAN_PROP = "ccnurbs_plan"  # the plan (intervals included) its UV maps and attributes come from
 
-_detached = []  # (proxy name, mesh name, empty mesh name, in place?) swapped out for a save
+_detached = []  # (proxy name, mesh name) swapped out for a save
 
 
 def own_mesh(p):
@@ -120,44 +120,27 @@ def _empty_mesh():
 
 def detach_for_save(view_proxies):
     """Points each non-empty viewport proxy at one empty mesh for the write; its limit mesh then
-    has no user and is not saved. Where idmem's layout is verified, the pointer and the user
-    counts are written in place, so nothing is tagged and the first redraw after the save
-    evaluates nothing; else through the API (which re-evaluates the proxies afterwards)."""
+    has no user and is not saved (the proxies are evaluated again at the next redraw)."""
     _detached.clear()
     empty = None
-    direct = idmem.layout() is not None
     for p in view_proxies:
         if p is None or p.library is not None or p.data is None or not len(p.data.vertices):
             continue
         empty = empty or _empty_mesh()
-        me = p.data
-        _detached.append((p.name, me.name, empty.name, direct))
-        if direct:
-            idmem.set_data(p, empty)
-            idmem.set_users(empty, empty.users + 1)
-            idmem.set_users(me, me.users - 1)
-        else:
-            p.data = empty
+        _detached.append((p.name, p.data.name))
+        p.data = empty
 
 
 def reattach_after_save():
-    """Gives the viewport proxies their meshes back; returns whether any was swapped through
-    the API (then their next update is the swap's echo)."""
+    """Gives the viewport proxies their meshes back; returns whether any was swapped (then their
+    next update is the swap's echo)."""
     swapped = False
-    for pname, mname, ename, direct in _detached:
+    for pname, mname in _detached:
         p, me = bpy.data.objects.get(pname), bpy.data.meshes.get(mname)
         if p is None or me is None:
             continue
-        if direct:
-            empty = p.data
-            if empty is None or empty.name != ename:  # reassigned during the save: leave it
-                continue
-            idmem.set_data(p, me)
-            idmem.set_users(me, me.users + 1)
-            idmem.set_users(empty, empty.users - 1)
-        else:
-            p.data = me
-            swapped = True
+        p.data = me
+        swapped = True
     _detached.clear()
     me = bpy.data.meshes.get(EMPTY_NAME)
     if me is not None and me.users == 0 and swapped:

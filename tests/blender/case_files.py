@@ -242,57 +242,47 @@ class TestFileHygiene(AddonTestCase):
 
 
     def test_save_leaves_the_proxies_as_they_were(self):
-        """The save writes the viewport proxy with the empty mesh and changes nothing the
-        depsgraph sees (idmem; verified on this Blender), also with materials; the API path,
-        where the layout cannot be verified, gives the same file."""
-        self.assertIsNotNone(ccn.idmem.layout(), "in-place save path unavailable on this Blender")
-        for path_kind in ("in place", "api"):
-            with self.subTest(path=path_kind):
-                reset_scene()
-                ob = add_modifier(grid(4, "Saved"))
-                for name in ("Red", "Blue"):
-                    ob.data.materials.append(bpy.data.materials.new(name))
-                ob.data.polygons[3].material_index = 1
-                ob.data.update()
-                update()
-                p = ccn.modifier.proxy(ob, 'VIEW')
-                me, users = p.data, p.data.users
-                self.assertEqual(len(p.material_slots), 2)
-                seen = []
+        """The save writes the viewport proxy with the empty mesh and gives it its limit mesh
+        back (through the Python API: nothing is written into Blender's memory, so the proxy
+        is evaluated again), also with materials; the file holds no limit mesh."""
+        ob = add_modifier(grid(4, "Saved"))
+        for name in ("Red", "Blue"):
+            ob.data.materials.append(bpy.data.materials.new(name))
+        ob.data.polygons[3].material_index = 1
+        ob.data.update()
+        update()
+        p = ccn.modifier.proxy(ob, 'VIEW')
+        me, users = p.data, p.data.users
+        self.assertEqual(len(p.material_slots), 2)
+        path = save("hyg_save_swap")
+        update()
+        self.assertEqual(p.data, me, "the proxy keeps its limit mesh")
+        self.assertEqual(me.users, users)
+        empty = bpy.data.meshes.get(ccn.proxies.EMPTY_NAME)
+        self.assertTrue(empty is None or empty.users == 0)
+        bpy.data.orphans_purge()
+        self.assertEqual(p.data, me, "purging orphans keeps the limit mesh")
+        self.assertEqual(me.users, users)
+        self.assertOwnSurface(ob)
+        self.assertClean(path, "save")
+        bpy.ops.wm.open_mainfile(filepath=path)
+        ob = bpy.data.objects["Saved"]
+        update()
+        self.assertOwnSurface(ob)
+        p = ccn.modifier.proxy(ob, 'VIEW')
+        self.assertEqual([m.name for m in p.data.materials], ["Red", "Blue"])
+        self.assertEqual(len(p.material_slots), 2)
 
-                def watch(scene, depsgraph=None):
-                    seen.extend(u.id.original.name for u in (depsgraph or
-                                bpy.context.evaluated_depsgraph_get()).updates)
-                if path_kind == "api":
-                    ccn.idmem._layout[:] = [None]
-                bpy.app.handlers.depsgraph_update_post.append(watch)
-                try:
-                    path = save("hyg_inplace_" + path_kind.replace(" ", "_"))
-                    update()
-                finally:
-                    bpy.app.handlers.depsgraph_update_post.remove(watch)
-                    ccn.idmem._layout.clear()
-                self.assertEqual(p.data, me, "the proxy keeps its limit mesh")
-                self.assertEqual(me.users, users)
-                empty = bpy.data.meshes.get(ccn.proxies.EMPTY_NAME)
-                self.assertTrue(empty is None or empty.users == 0)
-                if path_kind == "in place":
-                    self.assertNotIn(p.name, seen, "the save made the proxy re-evaluate")
-                    self.assertNotIn(ob.name, seen, "the save made the cage re-evaluate")
-                else:
-                    self.assertIn(p.name, seen)  # the check above can fail
-                bpy.data.orphans_purge()
-                self.assertEqual(p.data, me, "purging orphans keeps the limit mesh")
-                self.assertEqual(me.users, users)
-                self.assertOwnSurface(ob)
-                self.assertClean(path, path_kind)
-                bpy.ops.wm.open_mainfile(filepath=path)
-                ob = bpy.data.objects["Saved"]
-                update()
-                self.assertOwnSurface(ob)
-                p = ccn.modifier.proxy(ob, 'VIEW')
-                self.assertEqual([m.name for m in p.data.materials], ["Red", "Blue"])
-                self.assertEqual(len(p.material_slots), 2)
+    def test_no_write_into_blenders_memory(self):
+        """The add-on's modules hold no ctypes access to Blender's memory."""
+        import pkgutil
+        pkg = sys.modules[type(ccn).module]
+        for info in pkgutil.iter_modules(pkg.__path__):
+            mod = sys.modules.get(pkg.__name__ + "." + info.name)
+            if mod is None or info.name == "native":  # native: the library through ctypes, by design
+                continue
+            src = open(mod.__file__).read()
+            self.assertNotIn("from_address", src, "%s reads or writes Blender's memory" % info.name)
 
 
 class TestSaveCost(AddonTestCase):
@@ -365,7 +355,5 @@ class TestSaveCost(AddonTestCase):
         # the write itself, generous margin against millisecond noise (target 1.2x)
         self.assertLessEqual(times["CCNURBS"][0], 3.0 * times["SUBSURF"][0] + 0.05,
                              "saving is far slower than with Subsurf (target 1.2x)")
-        # and what the save leaves for the next redraw: nothing to evaluate (the proxies are
-        # swapped in place; through the API this was 0.5 s on 3.4)
-        self.assertLessEqual(times["CCNURBS"][2], 3.0 * times["SUBSURF"][2] + 0.05,
-                             "the save leaves an evaluation behind (target 1.2x)")
+        # what the save leaves for the next redraw (the proxies evaluated again: the swap goes
+        # through the Python API) is measured above, not asserted: performance is `make bench`'s
