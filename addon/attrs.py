@@ -116,6 +116,39 @@ def _hash(parts):
     return h.hexdigest()
 
 
+UV_CONNECT_LIMIT = 1e-4  # Blender's STD_UV_CONNECT_LIMIT: UVs of one vertex this close are one
+
+
+def _weld_close(uniq, inv):
+    """The distinct (vertex, u, v) rows of a UV map, with the rows of one vertex whose UVs lie
+    within UV_CONNECT_LIMIT (in u and in v) of a group's first row merged into it, as Blender's
+    Subdivision Surface connects them (Unwrap leaves UVs one float step apart at shared
+    vertices; kept apart they were a seam). Greedy in row order, as Blender's UV vertex map."""
+    verts = uniq[:, 0]
+    starts = np.flatnonzero(np.r_[True, verts[1:] != verts[:-1]])
+    counts = np.diff(np.r_[starts, len(verts)])
+    multi = starts[counts > 1]
+    if not len(multi):
+        return uniq, inv
+    uv = uniq[:, 1:].astype(np.uint32).view(np.float32)
+    target = np.arange(len(uniq))
+    for s0, c in zip(multi, counts[counts > 1]):
+        reps = []
+        for r in range(s0, s0 + c):
+            for q in reps:
+                if abs(uv[r, 0] - uv[q, 0]) < UV_CONNECT_LIMIT and abs(uv[r, 1] - uv[q, 1]) < UV_CONNECT_LIMIT:
+                    target[r] = q
+                    break
+            else:
+                reps.append(r)
+    if (target == np.arange(len(uniq))).all():
+        return uniq, inv
+    keep = np.flatnonzero(target == np.arange(len(uniq)))
+    new_index = np.full(len(uniq), -1, np.int64)
+    new_index[keep] = np.arange(len(keep))
+    return uniq[keep], new_index[target[inv]]
+
+
 def uv_channels(name, x, face_verts):
     """Each UV map as (values (N, 2) f64, value index per face corner), and the key of their
     topology (seams): cached per object while the UVs are unchanged."""
@@ -131,6 +164,8 @@ def uv_channels(name, x, face_verts):
         key[:, 0] = face_verts
         key[:, 1:] = a.view(np.uint32)
         uniq, inv = np.unique(key, axis=0, return_inverse=True)
+        inv = np.asarray(inv, np.int64).ravel()
+        uniq, inv = _weld_close(uniq, inv)
         values = uniq[:, 1:].astype(np.uint32).view(np.float32).astype(np.float64)
         chans.append((np.ascontiguousarray(values), np.asarray(inv, np.int32).ravel()))
     res = (chans, _hash([repr(x.uv_names).encode()] + [c[1] for c in chans]))

@@ -205,16 +205,22 @@ def on_depsgraph_update_post(scene, depsgraph=None):
     _guarded(_on_update, depsgraph or bpy.context.evaluated_depsgraph_get())
 
 
+def cages_in(depsgraph):
+    """The cages this depsgraph evaluates: those of its scene and those its collection
+    instances draw (assets, characters: in no scene themselves)."""
+    evaluated = {i.original for i in depsgraph.ids if isinstance(i, bpy.types.Object)}
+    return [o for o in modifier.cages() if o in evaluated]
+
+
 def _on_frame(depsgraph):
     if depsgraph is None:
         return
     if depsgraph.mode == 'RENDER':
-        cages = modifier.cages(depsgraph.scene.objects)
-        if sync_cages(depsgraph, cages, 'RENDER'):
+        if sync_cages(depsgraph, cages_in(depsgraph), 'RENDER'):
             sync.stats["render_frames"] += 1
             depsgraph.update()
         return
-    if sync_cages(depsgraph, modifier.cages(depsgraph.scene.objects), 'VIEW'):
+    if sync_cages(depsgraph, cages_in(depsgraph), 'VIEW'):
         depsgraph.update()
 
 
@@ -305,7 +311,10 @@ def register():
             lst.remove(h)
         lst.append(fn)
     _refresh[0] = True
-    bpy.app.timers.register(refresh_after_enable, first_interval=0.0)
+    if isinstance(bpy.data, bpy.types.BlendData):  # enabled from a script or the preferences:
+        refresh_after_enable()                       # the data is open, refresh now
+    else:  # at start-up bpy.data is restricted while add-ons register: at the first chance
+        bpy.app.timers.register(refresh_after_enable, first_interval=0.0)
 
 
 def unregister():

@@ -1,7 +1,7 @@
 """File hygiene: which groups and proxies belong to which live cage; everything else goes.
 
-A *live* cage is a local mesh object in some scene with a CCNURBS modifier using one of our
-groups. One pass over bpy.data (`collect`, O(objects + groups), run on save, load, undo, and
+A *live* cage is a local mesh object the file keeps (in a scene, in a collection that an
+instance draws, or with a fake user) with a CCNURBS modifier using one of our groups. One pass over bpy.data (`collect`, O(objects + groups), run on save, load, undo, and
 after updates that change the object or group count or touch a cage whose ownership is off):
 
 * a group used by several live objects (Shift+D, Alt+D, Copy Modifiers, Copy to Selected) stays
@@ -36,7 +36,10 @@ PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
 
 
 def is_live(obj):
-    return obj.library is None and obj.users > 0 and len(obj.users_scene) > 0
+    """A local object the file keeps: in a scene, in a collection (a collection instance draws
+    it without it being in any scene: assets, characters), or with a fake user. An object with
+    no user is gone at the next save, and so are its group and proxies."""
+    return obj.library is None and obj.users > 0
 
 
 def ours(obj):

@@ -45,7 +45,7 @@ pending_normals = set()  # names of cages whose viewport proxy waits for its exa
 
 class Status:
     __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
-                 "showing", "loose", "element")
+                 "showing", "loose", "element", "key")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
@@ -55,6 +55,7 @@ class Status:
         self.showing = "limit"   # limit | last valid limit | cage
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
         self.element = None      # (ccn_element_kind, index) an error names (errors.py)
+        self.key = None          # the proxy key it describes (sync_object)
 
 
 def status(obj, kind='VIEW'):
@@ -174,10 +175,14 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             pending_normals.add(obj.name_full)  # e.g. after undo: still waiting
         if not force and (stored == key or stored == key + PENDING and defer_normals):
             stats["skipped"] += 1
-            if old is None or old.error:  # unknown (file just loaded) or fixed by undo
-                old = Status(kind, levels)
+            if old is None or old.error or old.key != key:  # file just loaded, or undo restored
+                old = Status(kind, levels)                  # another proxy: describe this one
                 old.num_verts, old.num_faces = len(me.vertices), len(me.polygons)
                 old.loose = st.loose
+                old.key = key
+                cached = _plans.get(key_name)
+                if cached is not None and cached[0] == topo:
+                    old.sizes = dict(cached[1].sizes)
                 _status[key_name] = old
             return old
         stats["syncs"] += 1
@@ -214,6 +219,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         me[proxies.PLAN_PROP] = topo
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
         st.sizes = dict(plan.sizes)
+        st.key = key
     except native.CCNError as e:
         st.error = str(e)
         st.element = (e.element_kind, e.element) if e.element >= 0 else None

@@ -6,7 +6,8 @@ evaluation it is read:
 
 * 4.3+: `Object.evaluated_geometry().instance_references()` of each cage (per object);
 * 3.x: `depsgraph.object_instances`, the one walk Blender offers; it stops as soon as every cage
-  asked for has been found (instances of other objects before them are skipped unread).
+  asked for has been found (instances of other objects before them are skipped unread). A cage
+  drawn by a collection instance is the instance object of its tap's instance there.
 
 The temporary objects of `object_instances` are only valid during their iteration step, so the
 cage arrays are read there and then.
@@ -99,8 +100,12 @@ def read(depsgraph, objects):
     for inst in depsgraph.object_instances:
         if not inst.is_instance:
             continue
-        parent = inst.parent
+        # the tap's instancer: the cage itself (parent), or, where a collection instance draws
+        # the cage, the cage as the instance object under that instancer
+        parent, io = inst.parent, inst.instance_object
         name = parent.original.name_full if parent is not None else None
+        if name not in wanted and io is not None:
+            name = io.original.name_full
         if name not in wanted or name in found:
             continue
         me = inst.object.data

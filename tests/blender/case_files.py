@@ -273,6 +273,72 @@ class TestFileHygiene(AddonTestCase):
         self.assertEqual([m.name for m in p.data.materials], ["Red", "Blue"])
         self.assertEqual(len(p.material_slots), 2)
 
+    def _instanced_positions(self, name):
+        """The positions a collection instance draws for object `name` (evaluated)."""
+        dg = update()
+        for inst in dg.object_instances:
+            if inst.is_instance and inst.instance_object and inst.instance_object.original.name == name:
+                return cagelib.mesh_positions(inst.instance_object.data)
+        return None
+
+    def test_collection_instance_shows_the_surface(self):
+        """A cage inside a collection that an Empty instances (Add > Collection Instance; how
+        assets and characters are reused), the collection itself in no scene: the instance
+        shows the cage's limit, follows its edits, and keeps it after save and reopen."""
+        coll = bpy.data.collections.new("Asset")
+        bpy.context.scene.collection.children.link(coll)
+        ob = load_cage("Piece", os.path.join(DATA, "fan5.obj"))
+        for c in list(ob.users_collection):
+            c.objects.unlink(ob)
+        coll.objects.link(ob)
+        d = ob.modifiers.new("Displace", 'DISPLACE')
+        d.strength = 0.0
+        d.keyframe_insert("strength", frame=1)
+        d.strength = 0.5
+        d.keyframe_insert("strength", frame=5)
+        bpy.context.scene.frame_set(1)
+        add_modifier(ob)
+        bpy.context.scene.collection.children.unlink(coll)
+        emp = bpy.data.objects.new("Instance", None)
+        emp.instance_type = 'COLLECTION'
+        emp.instance_collection = coll
+        bpy.context.scene.collection.objects.link(emp)
+        update()
+        ob.data.vertices[0].co.z += 0.4  # an edit of the cage (Tab into it, or a script)
+        ob.data.update()
+        update()
+        for step in ("edited", "reopened"):
+            P = self._instanced_positions("Piece")
+            R, _ = reference(bpy.data.objects["Piece"])
+            self.assertIsNotNone(P, "%s: no instance drawn" % step)
+            self.assertEqual(P.shape, R.shape, "%s: the instance shows the cage, not its limit" % step)
+            self.assertLessEqual(np.abs(P - R).max(), POS_TOL, step)
+            if step == "edited":
+                # an animated cage in the instance follows the frames (Displace above CCNURBS)
+                bpy.context.scene.frame_set(5)
+                P5 = self._instanced_positions("Piece")
+                bpy.context.scene.frame_set(1)
+                P1 = self._instanced_positions("Piece")
+                self.assertGreater(np.abs(P5 - P1).max(), 0.1, "the instance did not follow the frame")
+                self.assertLessEqual(np.abs(P1 - R).max(), POS_TOL, "frame 1")
+                path = save("hyg_instance")
+                bpy.ops.wm.open_mainfile(filepath=path)
+
+    def test_fake_user_cage_outside_scenes_keeps_its_surface(self):
+        """An object kept with a fake user and in no scene keeps its group and proxies on save."""
+        ob = add_modifier(grid(3, "Kept"))
+        ob.use_fake_user = True
+        for c in list(ob.users_collection):
+            c.objects.unlink(ob)
+        update()
+        path = save("hyg_fake_user")
+        bpy.ops.wm.open_mainfile(filepath=path)
+        ob = bpy.data.objects["Kept"]
+        self.assertIsNotNone(ccn.modifier.get_modifier(ob))
+        self.assertTrue(ccn.modifier.is_group(ccn.modifier.get_modifier(ob).node_group),
+                        "the group was deleted on save")
+        self.assertTrue(all(ccn.modifier.proxies(ob)), "the proxies were deleted on save")
+
     def test_no_write_into_blenders_memory(self):
         """The add-on's modules hold no ctypes access to Blender's memory."""
         import pkgutil

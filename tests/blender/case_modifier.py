@@ -605,6 +605,23 @@ class TestModifier(AddonTestCase):
         self.assertLessEqual(far / size, 1e-6, "the fan's limit moved by %g of its size next to a "
                              "disconnected pentagon" % (far / size))
 
+    def test_undo_of_a_levels_change_updates_the_panel(self):
+        """Undo of a Levels change: the surface and the panel's counts are the restored ones."""
+        ob = add_modifier(grid(3, "UndoLevels"), levels=1)
+        bpy.ops.ed.undo_push(message="levels 1")
+        ob.ccnurbs.levels = 2
+        update()
+        bpy.ops.ed.undo_push(message="levels 2")
+        self.assertEqual(ccn.sync.status(ob, 'VIEW').num_verts, len(evaluated_positions(ob)))
+        bpy.ops.ed.undo()
+        ob = bpy.data.objects["UndoLevels"]
+        update()
+        n = len(evaluated_positions(ob))
+        self.assertEqual(ob.ccnurbs.levels, 1)
+        self.assertEqual(n, (3 * 2 + 1) ** 2)
+        st = ccn.sync.status(ob, 'VIEW')
+        self.assertEqual(st.num_verts, n, "the panel reports %d vertices, the surface has %d" % (st.num_verts, n))
+
     def test_add_is_undoable(self):
         ob = grid(2, "UndoMe")
         bpy.ops.ed.undo_push(message="before add")

@@ -73,7 +73,8 @@ def setup(kind):
 
 
 class TestUVs(AddonTestCase):
-    def compare_with_subsurf(self, kind, levels, mode, second_map=False, quality=QUALITY):
+    def compare_with_subsurf(self, kind, levels, mode, second_map=False, quality=QUALITY,
+                             nudge=False):
         """Checks every face corner's UVs against Subdivision Surface's at `quality` (<= UV_TOL;
         with SMOOTH_ALL at lower Quality only the corners away from UV island corners) and
         returns the worst difference (away from island corners, at them)."""
@@ -87,6 +88,21 @@ class TestUVs(AddonTestCase):
             extra.data.foreach_set("uv", (0.5 * uv + 0.25).astype(np.float32))
             extra.active_render = True
             ob.data.uv_layers.active_index = 0
+        if nudge:  # one corner of each vertex whose corners share a UV: one float step off
+            me = ob.data
+            n = len(me.loops)
+            uv = np.empty(2 * n, np.float32)
+            me.uv_layers.active.data.foreach_get("uv", uv)
+            uv = uv.reshape(-1, 2)
+            lv = np.empty(n, np.int32)
+            me.loops.foreach_get("vertex_index", lv)
+            seen = {}
+            for c in range(n):
+                key = (int(lv[c]), float(uv[c, 0]), float(uv[c, 1]))
+                if key in seen and seen[key] == 1:
+                    uv[c, 0] = np.nextafter(uv[c, 0], np.float32(2))
+                seen[key] = seen.get(key, 0) + 1
+            me.uv_layers.active.data.foreach_set("uv", uv.ravel())
         ref = ob.copy()
         ref.data = ob.data.copy()
         bpy.context.collection.objects.link(ref)
@@ -134,6 +150,14 @@ class TestUVs(AddonTestCase):
                         reset_scene()
                         self.compare_with_subsurf(kind, levels, mode,
                                                   second_map=(kind == "cube" and levels == 1))
+
+    def test_uvs_one_float_step_apart_are_one(self):
+        """Blender's Unwrap leaves the UVs of a vertex's corners one float step apart; Subdivision
+        Surface connects UVs within 1e-4 (no seam there), and so does the modifier."""
+        for kind in ("cube", "suzanne"):
+            with self.subTest(kind=kind):
+                reset_scene()
+                self.compare_with_subsurf(kind, 2, 'PRESERVE_BOUNDARIES', nudge=True)
 
     def test_high_valence_cylinder_uvs(self):
         """A 64-sided cylinder (its cap disks' centres have 64 UV neighbours: more probe colours
