@@ -1,9 +1,8 @@
 """UV maps and attributes carried from the cage to the limit mesh.
 
 * UV maps: each UV map of the cage (as the stack above hands it over, tap.py) is a face-varying
-  channel of the plan. The corners of a vertex whose UVs are equal share one value; where they
-  differ the edge is a seam (Blender's Subdivision Surface merges UVs closer than 1e-4; here
-  they must be equal, as an unwrap makes them). Interpolated with the UV Smooth setting
+  channel of the plan. The corners of a vertex whose UVs are within 1e-4 share one value, as
+  Blender's Subdivision Surface connects them; where they differ more the edge is a seam. Interpolated with the UV Smooth setting
   (Subdivision Surface's names and default, OpenSubdiv's FVarLinearInterpolation modes), with
   the intervals and creases of the surface, to their exact limit; written as UV maps of the
   same names, in the same order, the active and the render-active one kept.

@@ -216,9 +216,17 @@ def _on_frame(depsgraph):
     if depsgraph is None:
         return
     if depsgraph.mode == 'RENDER':
-        if sync_cages(depsgraph, cages_in(depsgraph), 'RENDER'):
+        cages = cages_in(depsgraph)
+        if sync_cages(depsgraph, cages, 'RENDER'):
             sync.stats["render_frames"] += 1
             depsgraph.update()
+        for o in cages:  # a render at other levels than asked for is said, not silent
+            st = sync.status(o, 'RENDER')
+            if st is not None and st.error:
+                print("CCNURBS: %s: Render levels %d not rendered (%s); rendering %s"
+                      % (o.name, o.ccnurbs.render_levels, st.error,
+                         "the viewport limit" if modifier.proxy(o, 'VIEW') is not None
+                         and len(modifier.proxy(o, 'VIEW').data.vertices) else "the cage"))
         return
     if sync_cages(depsgraph, cages_in(depsgraph), 'VIEW'):
         depsgraph.update()

@@ -282,6 +282,47 @@ class TestModifier(AddonTestCase):
         self.assertEqual(len(evaluated_positions(ob)), n_view, "viewport result not restored")
         self.assertMatchesCLI(ob, normals=False)
 
+    def test_refused_render_levels_are_said(self):
+        """Render levels that would not fit in memory are refused; the render then shows the
+        viewport limit and says so on the console (not silently)."""
+        import contextlib
+        import io
+        ob = add_modifier(load_cage("Fan5R", os.path.join(DATA, "fan5.obj")), levels=1,
+                          render_levels=10)
+        n_view = len(evaluated_positions(ob))
+        seen = {}
+
+        class ProbeEngine(bpy.types.RenderEngine):
+            bl_idname = "CCNURBS_TEST_PROBE2"
+            bl_label = "probe"
+
+            def render(self, depsgraph):
+                for inst in depsgraph.object_instances:
+                    if inst.object.original.name == ob.name and not inst.is_instance:
+                        seen["verts"] = len(inst.object.data.vertices)
+                r = self.begin_result(0, 0, 4, 4)
+                self.end_result(r)
+
+        bpy.utils.register_class(ProbeEngine)
+        out = io.StringIO()
+        try:
+            scene = bpy.context.scene
+            cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+            scene.collection.objects.link(cam)
+            scene.camera = cam
+            scene.render.engine = ProbeEngine.bl_idname
+            scene.render.resolution_x = scene.render.resolution_y = 4
+            free = ccn.memory.free_bytes
+            ccn.memory.free_bytes = lambda: 50 * 2 ** 20
+            with contextlib.redirect_stdout(out):
+                bpy.ops.render.render()
+        finally:
+            ccn.memory.free_bytes = free
+            bpy.utils.unregister_class(ProbeEngine)
+        self.assertEqual(seen.get("verts"), n_view, "the render shows the viewport limit")
+        self.assertIn("Render levels 10 not rendered", out.getvalue())
+        self.assertIn("rendering the viewport limit", out.getvalue())
+
     def _reload_without_addon(self, path):
         """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender
         without the add-on."""
