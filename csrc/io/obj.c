@@ -30,8 +30,12 @@ struct ccn_obj {
     double *knot;  int32_t nk, cap_k;
     double *crease; int32_t cap_c;
     int has_crease;
-    /* vertex sharpness by vertex index (grown on demand; 0 = none) */
-    double *vcrease; int32_t cap_vc, nvc;
+    /* "# corner" statements in file order (vertex, sharpness): stored as given so that a
+     * large index costs nothing before the vertex count is known; expanded to vcrease (one
+     * value per vertex, 0 = none) once the file is read */
+    int32_t *ci;   int32_t nci, cap_ci;
+    double *cs;    int32_t cap_cs;
+    double *vcrease; int32_t nvc;
     /* UV map: vt values (3 per line, padded with 0), the texture index of each face corner
      * (-1: none), the most components a vt line had, the largest index used and its line */
     double *vt;    int32_t nvt, cap_vt, vt_width;
@@ -204,10 +208,12 @@ static ccn_status add_edge(ccn_obj *o, long a, long b, double knot, double creas
 
 /* Vertex a (0-based) gets sharpness s. */
 static ccn_status add_corner(ccn_obj *o, long a, double s, long line, ccn_error *err) {
-    if (grow((void **)&o->vcrease, &o->cap_vc, (int32_t)a + 1, sizeof(double))) return no_memory(err, line);
-    for (int32_t k = o->nvc; k <= (int32_t)a; k++) o->vcrease[k] = 0.0;
-    if (o->nvc < (int32_t)a + 1) o->nvc = (int32_t)a + 1;
-    o->vcrease[a] = s;
+    if (grow((void **)&o->ci, &o->cap_ci, o->nci + 1, sizeof(int32_t)) ||
+        grow((void **)&o->cs, &o->cap_cs, o->nci + 1, sizeof(double)))
+        return no_memory(err, line);
+    o->ci[o->nci] = (int32_t)a;
+    o->cs[o->nci] = s;
+    o->nci++;
     return CCN_OK;
 }
 
@@ -391,19 +397,23 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
         line += more;
         s = nl ? nl + 1 : end;
     }
-    if (o->nvc > 0) { /* vertex sharpness for every vertex (0 where no corner was given) */
-        if (o->nvc > o->nv) {
-            int32_t nvc = o->nvc, nv = o->nv;
+    if (o->nci > 0) { /* vertex sharpness for every vertex (0 where no corner was given) */
+        int32_t top = 0;
+        for (int32_t k = 0; k < o->nci; k++)
+            if (o->ci[k] > top) top = o->ci[k];
+        if (top >= o->nv) {
+            int32_t nv = o->nv;
             ccn_obj_destroy(o);
-            return ccn__fail(err, CCN_ERR_IO, CCN_ELEM_VERTEX, nvc - 1,
+            return ccn__fail(err, CCN_ERR_IO, CCN_ELEM_VERTEX, top,
                              "OBJ: a corner names vertex %d, but the file has %d vertices",
-                             (int)nvc, (int)nv);
+                             (int)top + 1, (int)nv);
         }
-        if (grow((void **)&o->vcrease, &o->cap_vc, o->nv, sizeof(double))) {
+        o->vcrease = calloc((size_t)(o->nv > 0 ? o->nv : 1), sizeof(double));
+        if (!o->vcrease) {
             ccn_obj_destroy(o);
             return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         }
-        for (int32_t k = o->nvc; k < o->nv; k++) o->vcrease[k] = 0.0;
+        for (int32_t k = 0; k < o->nci; k++) o->vcrease[o->ci[k]] = o->cs[k]; /* the last wins */
         o->nvc = o->nv;
     }
     ccn_status st = finish_uvs(o, err);
@@ -415,7 +425,7 @@ ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error 
 void ccn_obj_destroy(ccn_obj *o) {
     if (!o) return;
     free(o->pos); free(o->fsz); free(o->fv); free(o->ev); free(o->knot); free(o->crease);
-    free(o->vcrease); free(o->vt); free(o->fvt);
+    free(o->ci); free(o->cs); free(o->vcrease); free(o->vt); free(o->fvt);
     free(o);
 }
 
