@@ -16,14 +16,8 @@ ELEM_VERTEX, ELEM_EDGE, ELEM_FACE = 1, 2, 3
 
 # (pattern in the library's message, what to do)
 _ADVICE = (
-    ("shared by", "Delete or separate the extra faces on this edge (Select > Select All by "
-                  "Trait > Non Manifold finds every such edge)."),
-    ("faces form more than one fan", "Rip (V) or dissolve this vertex so that its faces form "
-                                     "one fan, or Merge by Distance if two parts only touch."),
     ("repeats vertex", "Merge by Distance or Mesh > Clean Up > Degenerate Dissolve."),
     ("vertices (at least 3 needed)", "Delete this face (it has fewer than 3 corners)."),
-    ("inconsistent orientation", "Recalculate the normals: Mesh > Normals > Recalculate "
-                                 "Outside (Shift+N)."),
     ("non-finite coordinate", "Move this vertex to a finite position or delete it."),
     ("coordinate beyond", "Scale the mesh down: coordinates must stay below 1e300."),
     ("NaN crease", "Set this element's crease to a number (Shift+E)."),

@@ -20,7 +20,7 @@ extern "C" {
 typedef enum {
     CCN_OK = 0,
     CCN_ERR_ARGUMENT,  /* bad argument: NULL, negative count, NaN/Inf coordinate, ... */
-    CCN_ERR_TOPOLOGY,  /* non-manifold edge/vertex, degenerate face, bad index, orientation */
+    CCN_ERR_TOPOLOGY,  /* degenerate face, bad index, valence or face size beyond the limit */
     CCN_ERR_KNOTS,     /* knot intervals that cannot be used */
     CCN_ERR_MEMORY,    /* allocation failed or size would overflow */
     CCN_ERR_INTERNAL,  /* a numerical failure the library could not recover from */

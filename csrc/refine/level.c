@@ -708,6 +708,10 @@ ccn_status ccn__level_topology_like(const ccn__level *c, ccn_mesh *like, ccn_mes
             goto done;
         }
     }
+    if (ccn__mesh_weld_child(m, r)) { /* a split cage: its copies' children (topology/mesh.c) */
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (weld)");
+        goto done;
+    }
     ccn__children_candidates(m, cand);
     if ((st = ccn__children_intervals(m, r, cand, err))) goto done;
     if ((st = child_sharpness(c, r, err))) goto done;

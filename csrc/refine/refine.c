@@ -48,6 +48,12 @@ static ccn_mesh *mesh_clone(const ccn_mesh *m) {
         memcpy(r->esharp, m->esharp, sizeof(float) * (size_t)m->ne);
         memcpy(r->vsharp, m->vsharp, sizeof(float) * (size_t)m->nv);
     }
+    if (m->vrep) { /* a split cage: its representatives, welded again */
+        r->vrep = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+        if (!r->vrep) { ccn_mesh_destroy(r); return NULL; }
+        memcpy(r->vrep, m->vrep, sizeof(int32_t) * (size_t)m->nv);
+        if (ccn__mesh_weld(r)) { ccn_mesh_destroy(r); return NULL; }
+    }
     r->knot_scale = m->knot_scale;
     r->info = m->info;
     return r;

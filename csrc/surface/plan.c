@@ -188,15 +188,18 @@ static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cach
     p->lev[0] = cage_mesh;
     p->ncage = cage->num_verts;
     p->scale = 1.0;
-    p->cage_pos = malloc(sizeof(double) * 3 * (size_t)(p->ncage ? p->ncage : 1));
+    /* level 0's points (a split non-manifold cage has copies of some vertices after the
+     * cage's, topology/split.c) */
+    p->cage_pos = malloc(sizeof(double) * 3 * (size_t)(cage_mesh->nv ? cage_mesh->nv : 1));
     if (!p->cage_pos) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto fail; }
-    memcpy(p->cage_pos, cage_mesh->pos, sizeof(double) * 3 * (size_t)p->ncage);
+    memcpy(p->cage_pos, cage_mesh->pos, sizeof(double) * 3 * (size_t)cage_mesh->nv);
     for (int32_t v = 0; v < cage_mesh->nv && !st; v++)
         if (cage_mesh->vfan_start[v + 1] > cage_mesh->vfan_start[v] &&
             ccn__valence(cage_mesh, v) > CCN_EV_MATRIX_MAX_VALENCE)
-            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, v,
+            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cage_mesh->vrep ? cage_mesh->vrep[v] : v,
                            "vertex %d has valence %d; the limit surface supports at most %d",
-                           (int)v, (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE);
+                           (int)(cage_mesh->vrep ? cage_mesh->vrep[v] : v),
+                           (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE);
     for (int32_t f = 0; f < cage_mesh->nf && !st; f++)
         if (ccn__fsize(cage_mesh, f) > CCN_EV_MATRIX_MAX_VALENCE)
             st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
@@ -349,7 +352,7 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         ccn_status st = ccn_mesh_set_positions(p->lev[0], positions, err);
         if (st) return st;
     } else { /* the cage's own positions, as given to ccn_plan_create */
-        memcpy(p->lev[0]->pos, p->cage_pos, sizeof(double) * 3 * (size_t)p->ncage);
+        memcpy(p->lev[0]->pos, p->cage_pos, sizeof(double) * 3 * (size_t)p->lev[0]->nv);
     }
     /* every rule is affine-invariant: work in a unit box so that huge coordinates (1e300)
      * cannot overflow, and map back at the end */

@@ -273,9 +273,11 @@ ccn_status ccn_plan_evaluate_vertex_data(ccn_plan *p, int32_t width, const doubl
     double down = ldexp(1.0, -e), up = ldexp(1.0, e);
     ccn_mesh *m0 = p->lev[0];
     for (int32_t c0 = 0; c0 < width; c0 += 3) {
-        for (int32_t v = 0; v < m0->nv; v++)
+        for (int32_t v = 0; v < m0->nv; v++) {
+            size_t d = (size_t)width * (size_t)(m0->vrep ? m0->vrep[v] : v); /* copies: the cage vertex's */
             for (int k = 0; k < 3; k++)
-                m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * data[(size_t)width * v + c0 + k] : 0.0;
+                m0->pos[3 * (size_t)v + k] = c0 + k < width ? down * data[d + c0 + k] : 0.0;
+        }
         for (int32_t l = 0; l < top; l++) ccn__level_points(&p->prep[l], p->lev[l + 1]->pos);
         if (p->has_sub) {
             ccn__level_tabulate_subset(&p->sub, p->near, p->nnear);

@@ -42,9 +42,9 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     int32_t no = 0;
     for (int32_t v = 0; v < mL->nv; v++) p->vmapL[v] = -1;
     for (int32_t h = 0; h < mL->nh; h++) {
-        int32_t v = mL->hvert[h];
-        if (p->vmapL[v] < 0) p->vmapL[v] = no++;
-        p->out_fv[h] = p->vmapL[v];
+        int32_t v = mL->hvert[h], r = mL->vrep ? mL->vrep[v] : v; /* a split cage: welded */
+        if (p->vmapL[r] < 0) p->vmapL[r] = no++;
+        p->out_fv[h] = p->vmapL[v] = p->vmapL[r];
     }
     p->nout_v = no;
     p->nout_f = mL->nf;
@@ -58,7 +58,7 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     }
     for (int32_t e = 0; e < mL->ne; e++) emap[e] = -1;
     for (int32_t h = 0; h < mL->nh; h++) {
-        int32_t e = mL->hedge[h];
+        int32_t e = mL->erep ? mL->erep[mL->hedge[h]] : mL->hedge[h];
         if (emap[e] < 0) {
             emap[e] = ne;
             p->out_ev[2 * (size_t)ne] = p->vmapL[mL->everts[2 * (size_t)e]];
@@ -71,8 +71,8 @@ static ccn_status output_topology(ccn_plan *p, ccn_error *err) {
     free(emap);
     p->out_vL = malloc(sizeof(int32_t) * (size_t)(no ? no : 1));
     if (!p->out_vL) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (output mesh)");
-    for (int32_t v = 0; v < mL->nv; v++)
-        if (p->vmapL[v] >= 0) p->out_vL[p->vmapL[v]] = v;
+    for (int32_t v = 0; v < mL->nv; v++) /* a welded vertex reads its representative */
+        if (p->vmapL[v] >= 0 && (!mL->vrep || mL->vrep[v] == v)) p->out_vL[p->vmapL[v]] = v;
     for (int32_t f = 0; f < mL->nf; f++) {
         int32_t g = f;
         for (int32_t l = p->L; l > 0; l--) g = p->lev[l - 1]->hface[g];

@@ -38,6 +38,13 @@ struct ccn_mesh {
      * edges are infinitely sharp whatever esharp says. */
     float *esharp;       /* ne */
     float *vsharp;       /* nv */
+    /* A non-manifold cage split into a manifold one (topology/split.c): the copies of a
+     * vertex (or of the edges between copies) have the same points at every level, and the
+     * mesh's public view welds them: vrep[v] is v's representative (the smallest vertex of its
+     * group), vweld[v] its welded index (at level 0 the cage's vertex), erep / eweld the same
+     * for edges; nvw / new the welded counts. All NULL (0) for a manifold cage. */
+    int32_t *vrep, *vweld, *erep, *eweld;
+    int32_t nvw, new_;
     ccn_mesh_info info;
 };
 

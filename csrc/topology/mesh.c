@@ -1,19 +1,21 @@
 /* Cage topology: half-edge mesh from a polygon soup, with validation.
  *
  * Rejected (CCN_ERR_TOPOLOGY, the message names the element): a face with < 3 vertices or a
- * repeated vertex, an index out of range, an edge shared by more than two faces, two faces
- * using an edge in the same direction (inconsistent orientation), a vertex whose faces form
- * more than one fan (non-manifold vertex). Rejected (CCN_ERR_ARGUMENT): negative counts,
+ * repeated vertex, an index out of range. Rejected (CCN_ERR_ARGUMENT): negative counts,
  * NULL arrays, NaN/Inf coordinates or beyond +-CCN_COORD_MAX, no faces, NaN sharpness.
- * Ignored and counted: isolated vertices, knot or crease values given for vertex pairs that
- * are not edges of any face (loose edges). Sharpness <= 0 is smooth, >= 10 (and +Inf) is
- * stored as 10 (infinitely sharp), as OpenSubdiv does. Interior vertices of valence 2 are
- * accepted (Catmull-Clark / NURSS rules at n = 2, no eigen rules or cap there).
+ * Non-manifold cages (an edge shared by more than two faces, two faces using an edge in the
+ * same direction, a vertex whose faces form more than one fan) are read as OpenSubdiv reads
+ * them: split into a manifold cage (topology/split.c) whose outputs are welded back through the
+ * representatives below. Ignored and counted: isolated vertices, knot or crease values given
+ * for vertex pairs that are not edges of any face (loose edges). Sharpness <= 0 is smooth,
+ * >= 10 (and +Inf) is stored as 10 (infinitely sharp), as OpenSubdiv does. Interior vertices
+ * of valence 2 are accepted (Catmull-Clark / NURSS rules at n = 2, no eigen rules or cap).
  */
 #include "topology/mesh.h"
 
 #include "base/error.h"
 #include "topology/knots.h"
+#include "topology/split.h"
 
 #include <math.h>
 #include <string.h>
@@ -50,6 +52,7 @@ void ccn_mesh_destroy(ccn_mesh *m) {
     free(m->pos); free(m->fstart); free(m->hvert); free(m->htwin); free(m->hedge);
     free(m->hface); free(m->everts); free(m->eknot); free(m->vfan_start); free(m->vfan);
     free(m->hfanpos); free(m->vlast_edge); free(m->vboundary); free(m->esharp); free(m->vsharp);
+    free(m->vrep); free(m->vweld); free(m->erep); free(m->eweld);
     free(m);
 }
 
@@ -134,7 +137,8 @@ void ccn__mesh_mark_face_ring(const ccn_mesh *m, const int32_t *list, int32_t n,
 
 void ccn__mesh_update_info(ccn_mesh *m) {
     ccn_mesh_info *in = &m->info;
-    in->num_verts = m->nv; in->num_faces = m->nf; in->num_edges = m->ne;
+    in->num_verts = m->vweld ? m->nvw : m->nv; in->num_faces = m->nf;
+    in->num_edges = m->eweld ? m->new_ : m->ne;
     in->num_face_verts = m->nh;
     in->num_boundary_edges = 0;
     for (int32_t h = 0; h < m->nh; h++) in->num_boundary_edges += m->htwin[h] < 0;
@@ -149,6 +153,61 @@ void ccn__mesh_update_info(ccn_mesh *m) {
         if (val > in->max_valence) in->max_valence = val;
         if (!m->vboundary[v] && val != 4) in->num_extraordinary++;
     }
+}
+
+/* ---- welded view of a split cage ------------------------------------------------- */
+
+typedef struct { int32_t a, b, e; } wkey;
+
+static int wkey_cmp(const void *x, const void *y) {
+    const wkey *p = x, *q = y;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    return (p->e > q->e) - (p->e < q->e);
+}
+
+int ccn__mesh_weld(ccn_mesh *m) {
+    if (!m->vrep) return 0;
+    free(m->vweld); free(m->erep); free(m->eweld);
+    m->vweld = malloc(sizeof(int32_t) * (size_t)(m->nv ? m->nv : 1));
+    m->erep = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
+    m->eweld = malloc(sizeof(int32_t) * (size_t)(m->ne ? m->ne : 1));
+    wkey *k = malloc(sizeof(wkey) * (size_t)(m->ne ? m->ne : 1));
+    if (!m->vweld || !m->erep || !m->eweld || !k) { free(k); return -1; }
+    int32_t n = 0;
+    for (int32_t v = 0; v < m->nv; v++)
+        if (m->vrep[v] == v) m->vweld[v] = n++;
+    for (int32_t v = 0; v < m->nv; v++) m->vweld[v] = m->vweld[m->vrep[v]];
+    m->nvw = n;
+    for (int32_t e = 0; e < m->ne; e++) {
+        int32_t a = m->vrep[m->everts[2 * e]], b = m->vrep[m->everts[2 * e + 1]];
+        k[e] = (wkey){a < b ? a : b, a < b ? b : a, e};
+    }
+    qsort(k, (size_t)m->ne, sizeof *k, wkey_cmp);
+    for (int32_t i = 0; i < m->ne;) { /* the smallest edge of each group represents it */
+        int32_t j = i + 1;
+        while (j < m->ne && k[j].a == k[i].a && k[j].b == k[i].b) j++;
+        for (int32_t q = i; q < j; q++) m->erep[k[q].e] = k[i].e;
+        i = j;
+    }
+    free(k);
+    n = 0;
+    for (int32_t e = 0; e < m->ne; e++)
+        if (m->erep[e] == e) m->eweld[e] = n++;
+    for (int32_t e = 0; e < m->ne; e++) m->eweld[e] = m->eweld[m->erep[e]];
+    m->new_ = n;
+    return 0;
+}
+
+int ccn__mesh_weld_child(const ccn_mesh *m, ccn_mesh *r) {
+    if (!m->vrep) return 0;
+    free(r->vrep);
+    r->vrep = malloc(sizeof(int32_t) * (size_t)(r->nv ? r->nv : 1));
+    if (!r->vrep) return -1;
+    for (int32_t f = 0; f < m->nf; f++) r->vrep[f] = f;
+    for (int32_t e = 0; e < m->ne; e++) r->vrep[m->nf + e] = m->nf + m->erep[e];
+    for (int32_t v = 0; v < m->nv; v++) r->vrep[m->nf + m->ne + v] = m->nf + m->ne + m->vrep[v];
+    return ccn__mesh_weld(r);
 }
 
 /* ---- building from a polygon soup ----------------------------------------------- */
@@ -258,7 +317,8 @@ static ccn_status fill_faces(ccn_mesh *m, const ccn_cage *c, ccn_error *err) {
 
 /* Pairs half-edges into edges (sorted keys, left sorted for find_edge), numbering edges by
  * first appearance; grp and gmap: nh ints of scratch each. */
-static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, int32_t *gmap, ccn_error *err) {
+static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, int32_t *gmap, int *nonmanifold,
+                             ccn_error *err) {
     int32_t nh = m->nh;
     if (sorted_keys(m, keys))
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory for %d corners", (int)nh);
@@ -271,6 +331,7 @@ static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, int32_t *gma
         if (j - i == 2) {
             int32_t h0 = keys[i].h, h1 = keys[i + 1].h;
             if (m->hvert[h0] == m->hvert[h1]) {
+                *nonmanifold = 1;
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, m->hface[h1],
                                  "edge %d-%d is used in the same direction by faces %d and %d "
                                  "(inconsistent orientation)", (int)keys[i].a, (int)keys[i].b,
@@ -279,6 +340,7 @@ static ccn_status pair_edges(ccn_mesh *m, hkey *keys, int32_t *grp, int32_t *gma
             m->htwin[h0] = h1;
             m->htwin[h1] = h0;
         } else if (j - i > 2) {
+            *nonmanifold = 1;
             return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_EDGE, ng,
                              "edge %d-%d is shared by %d faces (faces %d, %d, %d): non-manifold",
                              (int)keys[i].a, (int)keys[i].b, (int)(j - i),
@@ -369,6 +431,9 @@ static ccn_status apply_creases(ccn_mesh *m, const ccn_cage *c, const hkey *keys
     return CCN_OK;
 }
 
+static ccn_status mesh_create(const ccn_cage *cage, int64_t nh, ccn_mesh **out, int *nonmanifold,
+                              ccn_error *err);
+
 ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err) {
     ccn__ok(err);
     if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
@@ -376,6 +441,44 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
     int64_t nh = 0;
     ccn_status st = check_args(cage, &nh, err);
     if (st) return st;
+    /* a manifold cage is built directly; one that is not (an edge with more than two faces or
+     * used twice in one direction, a vertex with several fans) is split into a manifold cage
+     * (topology/split.c) and built from that, at no cost to manifold cages */
+    int nonmanifold = 0;
+    st = mesh_create(cage, nh, out, &nonmanifold, err);
+    if (!st || !nonmanifold) return st;
+    ccn__ok(err);
+    ccn__split sp;
+    if ((st = ccn__split_cage(cage, (int32_t)nh, &sp, err))) return st;
+    if (!sp.split) /* cannot happen: mesh_create found what the split finds */
+        return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "non-manifold cage not split");
+    ccn_cage c2 = *cage;
+    c2.num_verts = sp.num_verts, c2.positions = sp.positions, c2.face_verts = sp.face_verts;
+    c2.num_edges = sp.num_edges, c2.edge_verts = sp.edge_verts, c2.edge_knots = sp.edge_knots;
+    c2.edge_creases = sp.edge_creases, c2.vertex_creases = sp.vertex_creases;
+    nonmanifold = 0;
+    st = mesh_create(&c2, nh, out, &nonmanifold, err);
+    if (!st) {
+        ccn_mesh *m = *out;
+        m->vrep = sp.vorig; /* at level 0 the cage vertex is the representative */
+        sp.vorig = NULL;
+        if (ccn__mesh_weld(m)) {
+            ccn_mesh_destroy(m);
+            *out = NULL;
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (weld)");
+        } else {
+            ccn__mesh_update_info(m);
+            m->info.num_ignored_edges = sp.ignored_edges;
+            m->info.level = 0;
+        }
+    }
+    ccn__split_free(&sp);
+    return st;
+}
+
+static ccn_status mesh_create(const ccn_cage *cage, int64_t nh, ccn_mesh **out, int *nonmanifold,
+                              ccn_error *err) {
+    ccn_status st = CCN_OK;
     ccn_mesh *m = ccn__mesh_alloc(cage->num_verts, cage->num_faces, (int32_t)nh, (int32_t)nh);
     hkey *keys = malloc(sizeof(hkey) * (size_t)nh);
     int32_t *grp = malloc(sizeof(int32_t) * 2 * (size_t)nh);
@@ -386,9 +489,10 @@ ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err)
     }
     memcpy(m->pos, cage->positions, sizeof(double) * 3 * (size_t)m->nv);
     if ((st = fill_faces(m, cage, err))) goto done;
-    if ((st = pair_edges(m, keys, grp, grp + nh, err))) goto done;
+    if ((st = pair_edges(m, keys, grp, grp + nh, nonmanifold, err))) goto done;
     int32_t bad = ccn__mesh_build_fans(m);
     if (bad) {
+        *nonmanifold = 1;
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, bad - 1,
                        "vertex %d is non-manifold: its faces form more than one fan",
                        (int)(bad - 1));
@@ -416,6 +520,19 @@ ccn_status ccn_mesh_info_get(const ccn_mesh *m, ccn_mesh_info *info) {
 ccn_status ccn_mesh_copy(const ccn_mesh *m, double *positions, int32_t *face_sizes,
                          int32_t *face_verts, int32_t *edge_verts, double *edge_knots) {
     if (!m) return CCN_ERR_ARGUMENT;
+    if (m->vweld) { /* a split cage's mesh: its welded view */
+        for (int32_t v = 0; positions && v < m->nv; v++)
+            if (m->vrep[v] == v) memcpy(positions + 3 * (size_t)m->vweld[v], m->pos + 3 * (size_t)v, sizeof(double) * 3);
+        for (int32_t f = 0; face_sizes && f < m->nf; f++) face_sizes[f] = ccn__fsize(m, f);
+        for (int32_t h = 0; face_verts && h < m->nh; h++) face_verts[h] = m->vweld[m->hvert[h]];
+        for (int32_t e = 0; e < m->ne; e++) {
+            if (m->erep[e] != e) continue;
+            int32_t w = m->eweld[e];
+            if (edge_verts) edge_verts[2 * w] = m->vweld[m->everts[2 * e]], edge_verts[2 * w + 1] = m->vweld[m->everts[2 * e + 1]];
+            if (edge_knots) edge_knots[w] = m->eknot[e] * m->knot_scale;
+        }
+        return CCN_OK;
+    }
     if (positions) memcpy(positions, m->pos, sizeof(double) * 3 * (size_t)m->nv);
     if (face_sizes)
         for (int32_t f = 0; f < m->nf; f++) face_sizes[f] = ccn__fsize(m, f);
@@ -428,6 +545,13 @@ ccn_status ccn_mesh_copy(const ccn_mesh *m, double *positions, int32_t *face_siz
 
 ccn_status ccn_mesh_creases(const ccn_mesh *m, double *edge_sharpness, double *vertex_sharpness) {
     if (!m) return CCN_ERR_ARGUMENT;
+    if (m->vweld) { /* welded view: the representatives' */
+        for (int32_t e = 0; edge_sharpness && e < m->ne; e++)
+            if (m->erep[e] == e) edge_sharpness[m->eweld[e]] = m->esharp ? m->esharp[e] : 0.0;
+        for (int32_t v = 0; vertex_sharpness && v < m->nv; v++)
+            if (m->vrep[v] == v) vertex_sharpness[m->vweld[v]] = m->vsharp ? m->vsharp[v] : 0.0;
+        return CCN_OK;
+    }
     for (int32_t e = 0; edge_sharpness && e < m->ne; e++)
         edge_sharpness[e] = m->esharp ? m->esharp[e] : 0.0;
     for (int32_t v = 0; vertex_sharpness && v < m->nv; v++)
@@ -439,7 +563,8 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_erro
     ccn__ok(err);
     if (!m || !positions)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "mesh or positions is NULL");
-    for (int32_t i = 0; i < 3 * m->nv; i++) {
+    int32_t nv = m->vweld ? m->nvw : m->nv; /* a split cage: one position per welded vertex */
+    for (int32_t i = 0; i < 3 * nv; i++) {
         if (!isfinite(positions[i]))
             return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
                              "vertex %d has a non-finite coordinate (NaN or Inf)", (int)(i / 3));
@@ -447,7 +572,11 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_erro
             return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
                              "vertex %d has a coordinate beyond +-%g", (int)(i / 3), CCN_COORD_MAX);
     }
-    memcpy(m->pos, positions, sizeof(double) * 3 * (size_t)m->nv);
+    if (m->vweld)
+        for (int32_t v = 0; v < m->nv; v++)
+            memcpy(m->pos + 3 * (size_t)v, positions + 3 * (size_t)m->vweld[v], sizeof(double) * 3);
+    else
+        memcpy(m->pos, positions, sizeof(double) * 3 * (size_t)m->nv);
     return CCN_OK;
 }
 

@@ -82,27 +82,21 @@ class TestSmallItems(AddonTestCase):
         self.assertIn("no faces", lines[1])
 
     def test_status_when_there_never_was_a_limit(self):
+        def nan_at(ob, v):
+            co = np.zeros(3 * len(ob.data.vertices), np.float32)
+            ob.data.vertices.foreach_get("co", co)
+            co[3 * v + 2] = np.nan
+            ob.data.vertices.foreach_set("co", co)
+            ob.data.update()
+
         ob = grid(1, "NeverValid")
-        bm = bmesh.new()
-        bm.from_mesh(ob.data)
-        bm.verts.ensure_lookup_table()
-        v0, v1 = bm.verts[0], bm.verts[1]
-        bm.faces.new((v1, v0, bm.verts.new((0.5, -0.5, 1.0))))
-        bm.faces.new((v0, v1, bm.verts.new((0.5, 0.5, -1.0))))
-        bm.to_mesh(ob.data)
-        bm.free()
+        nan_at(ob, 0)
         add_modifier(ob)
         lines = ccn.ui.status_lines(ob)
         self.assertIn("showing the cage (no valid limit yet)", lines[0])
         self.assertNotIn("last valid", lines[0])
         ok = add_modifier(grid(2, "WasValid"))
-        bm = bmesh.new()
-        bm.from_mesh(ok.data)
-        bm.verts.ensure_lookup_table()
-        bm.faces.new((bm.verts[1], bm.verts[4], bm.verts.new((1.0, 0.5, 1.0))))
-        bm.to_mesh(ok.data)
-        bm.free()
-        ok.data.update()
+        nan_at(ok, 4)
         update()
         self.assertIn("showing the last valid limit", ccn.ui.status_lines(ok)[0])
 

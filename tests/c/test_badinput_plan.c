@@ -174,11 +174,11 @@ static void row_interval_ratio_1e9(void) {
 static void row_topology_errors(void) {
     static const double p[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
     int32_t fs[3] = {3, 3, 3}, fv[9] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
-    ccn_cage c = cage_of(5, 3, p, fs, fv);
-    expect_plan_err(&c, NULL, CCN_ERR_TOPOLOGY, "edge 0-1 is shared by 3 faces");
+    ccn_cage c = cage_of(5, 3, p, fs, fv); /* non-manifold edge: accepted as OpenSubdiv */
+    accept_plan(&c, 2);
     int32_t fvb[6] = {0, 1, 2, 0, 3, 4};
-    ccn_cage b = cage_of(5, 2, p, fs, fvb);
-    expect_plan_err(&b, NULL, CCN_ERR_TOPOLOGY, "vertex 0 is non-manifold");
+    ccn_cage b = cage_of(5, 2, p, fs, fvb); /* bowtie vertex: accepted */
+    accept_plan(&b, 2);
     int32_t fsr[1] = {4}, fvr[4] = {0, 1, 2, 1};
     ccn_cage r = cage_of(4, 1, SQ, fsr, fvr);
     expect_plan_err(&r, NULL, CCN_ERR_TOPOLOGY, "face 0 repeats vertex 1");
@@ -186,8 +186,8 @@ static void row_topology_errors(void) {
     ccn_cage g = cage_of(4, 2, SQ, fs2, fv2);
     expect_plan_err(&g, NULL, CCN_ERR_TOPOLOGY, "face 1 has 2 vertices");
     int32_t fsd[2] = {4, 4}, fvd[8] = {0, 1, 2, 3, 0, 1, 2, 3};
-    ccn_cage d = cage_of(4, 2, SQ, fsd, fvd);
-    expect_plan_err(&d, NULL, CCN_ERR_TOPOLOGY, "inconsistent orientation");
+    ccn_cage d = cage_of(4, 2, SQ, fsd, fvd); /* a face twice, same orientation: accepted */
+    accept_plan(&d, 2);
     ccn_cage e = cage_of(0, 0, SQ, SQ_FS, SQ_FV);
     expect_plan_err(&e, NULL, CCN_ERR_ARGUMENT, "cage has no faces");
 }

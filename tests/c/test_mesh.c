@@ -49,14 +49,66 @@ static void expect_err(int nv, int nf, const int32_t *fs, const int32_t *fv, con
     ccn_mesh_destroy(m);
 }
 
-static void test_edge_three_faces(void) {
-    int32_t fs[3] = {3, 3, 3}, fv[9] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
-    expect_err(5, 3, fs, fv, P8, CCN_ERR_TOPOLOGY, CCN_ELEM_EDGE, -1, "edge 0-1 is shared by 3 faces");
+/* A non-manifold cage is accepted as OpenSubdiv reads it: the mesh reports the cage's own
+ * vertices and edges (the fans it is split into are welded back), every non-manifold edge is
+ * infinitely sharp (sharpness 10) and its ends are corners. */
+static void expect_nonmanifold(int nv, int nf, const int32_t *fs, const int32_t *fv,
+                               int32_t ne, int32_t a, int32_t b, int32_t corner) {
+    ccn_error err;
+    ccn_mesh *m = NULL;
+    ccn_status st = create(nv, nf, fs, fv, P8, &err, &m);
+    CHECK(st == CCN_OK, "accepted: %s", err.message);
+    if (!m) return;
+    ccn_mesh_info in;
+    ccn_mesh_info_get(m, &in);
+    CHECK(in.num_verts == nv && in.num_faces == nf && in.num_edges == ne,
+          "counts %d %d %d, expected %d %d %d", in.num_verts, in.num_faces, in.num_edges, nv, nf, ne);
+    int32_t ev[64];
+    double es[32], vs[8];
+    ccn_mesh_copy(m, NULL, NULL, NULL, ev, NULL);
+    ccn_mesh_creases(m, es, vs);
+    int found = a < 0;
+    for (int32_t e = 0; e < in.num_edges && a >= 0; e++) {
+        int hit = (ev[2 * e] == a && ev[2 * e + 1] == b) || (ev[2 * e] == b && ev[2 * e + 1] == a);
+        if (hit) found = 1;
+        CHECK(hit ? es[e] == 10.0 : es[e] == 0.0, "edge %d-%d sharpness %g", ev[2 * e], ev[2 * e + 1], es[e]);
+    }
+    CHECK(found, "edge %d-%d not listed once", a, b);
+    for (int32_t v = 0; v < nv; v++) {
+        int c = v == corner || (a >= 0 && (v == a || v == b));
+        CHECK(c ? vs[v] == 10.0 : vs[v] == 0.0, "vertex %d sharpness %g", v, vs[v]);
+    }
+    /* refined once: V + E + F welded vertices; the corners stay where they are */
+    ccn_mesh *r = NULL;
+    CHECK(ccn_refine(m, 1, NULL, &r, &err) == CCN_OK, "refine: %s", err.message);
+    if (r) {
+        ccn_mesh_info ri;
+        ccn_mesh_info_get(r, &ri);
+        CHECK(ri.num_verts == nv + ne + nf, "level 1: %d vertices, expected %d", ri.num_verts, nv + ne + nf);
+        double *p = malloc(sizeof(double) * 3 * (size_t)ri.num_verts);
+        ccn_mesh_copy(r, p, NULL, NULL, NULL, NULL);
+        for (int32_t v = 0; v < nv; v++) {
+            int c = v == corner || (a >= 0 && (v == a || v == b));
+            const double *q = p + 3 * (size_t)(nf + ne + v);
+            if (c) CHECK(q[0] == P8[3 * v] && q[1] == P8[3 * v + 1] && q[2] == P8[3 * v + 2],
+                         "corner %d moved to %g %g %g", v, q[0], q[1], q[2]);
+        }
+        free(p);
+        ccn_mesh_destroy(r);
+    }
+    ccn_mesh_destroy(m);
 }
 
+/* Three triangles on edge 0-1. */
+static void test_edge_three_faces(void) {
+    int32_t fs[3] = {3, 3, 3}, fv[9] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
+    expect_nonmanifold(5, 3, fs, fv, 7, 0, 1, -1);
+}
+
+/* Two triangles meeting only at vertex 0 (a bowtie): vertex 0 is a corner. */
 static void test_bowtie_vertex(void) {
-    int32_t fs[2] = {3, 3}, fv[6] = {0, 1, 2, 0, 6, 7};
-    expect_err(8, 2, fs, fv, P8, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, 0, "vertex 0 is non-manifold");
+    int32_t fs[2] = {3, 3}, fv[6] = {0, 1, 2, 0, 3, 4};
+    expect_nonmanifold(5, 2, fs, fv, 6, -1, -1, 0);
 }
 
 static void test_two_gon(void) {
@@ -76,9 +128,10 @@ static void test_index_out_of_range(void) {
     expect_err(3, 1, fs, fv2, P8, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, 0, "vertex index -1");
 }
 
+/* Two quads using edge 0-1 in the same direction (one is flipped): edge 0-1 is non-manifold. */
 static void test_orientation(void) {
     int32_t fs[2] = {4, 4}, fv[8] = {0, 1, 2, 3, 0, 1, 5, 4};
-    expect_err(6, 2, fs, fv, P8, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, 1, "inconsistent orientation");
+    expect_nonmanifold(6, 2, fs, fv, 7, 0, 1, -1);
 }
 
 static void test_nonfinite(void) {

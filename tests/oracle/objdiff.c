@@ -1,6 +1,6 @@
 /* objdiff: compares two OBJ meshes whose vertex and face order may differ (test oracle).
  *
- *   objdiff [--tol-rel T] [--normals T] [--uv T] a.obj b.obj
+ *   objdiff [--tol-rel T] [--normals T] [--uv T] [--ignore-loose] a.obj b.obj
  *
  * Needs equal vertex and face counts. Every vertex of a is matched to the nearest vertex of
  * b (k-d tree); the match must be a bijection. The error is max |a_i - b_match(i)| divided
@@ -26,6 +26,8 @@
  * bounding box of a's `vt` values (1 if that is 0) must be <= T. Among faces that are equal as
  * cycles (coincident vertex groups), each face of a is paired with the face of b whose values
  * are nearest.
+ * With --ignore-loose, vertices no face uses (and their `vn` lines) are dropped from both files
+ * first: a limit mesh has no point for a loose vertex, a refined one may keep it.
  */
 #include <errno.h>
 #include <math.h>
@@ -359,6 +361,25 @@ static void check_uvs(const Mesh *m) {
 }
 
 /* Unit vector of n (3 doubles) into u; returns 0 for a zero vector. */
+/* Drops the vertices no face uses (and their normals), renumbering the faces. */
+static void drop_loose(Mesh *m) {
+    int *to = xrealloc(NULL, sizeof(int) * (size_t)(m->nv ? m->nv : 1));
+    for (int i = 0; i < m->nv; i++) to[i] = -1;
+    for (long k = 0; k < m->nfv; k++) to[m->fverts[k]] = 0;
+    int n = 0;
+    for (int i = 0; i < m->nv; i++) {
+        if (to[i] < 0) continue;
+        to[i] = n;
+        memmove(m->pos + 3 * n, m->pos + 3 * i, sizeof(double) * 3);
+        if (m->nn == m->nv) memmove(m->nrm + 3 * n, m->nrm + 3 * i, sizeof(double) * 3);
+        n++;
+    }
+    for (long k = 0; k < m->nfv; k++) m->fverts[k] = to[m->fverts[k]];
+    if (m->nn == m->nv) m->nn = n;
+    m->nv = n;
+    free(to);
+}
+
 static int unit(const double *n, double *u) {
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 0)) return 0;
@@ -368,6 +389,7 @@ static int unit(const double *n, double *u) {
 
 int main(int argc, char **argv) {
     double tol = 1e-9, ntol = -1.0, utol = -1.0;
+    int loose = 0;
     const char *pa = NULL, *pb = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--tol-rel") && i + 1 < argc) {
@@ -382,6 +404,8 @@ int main(int argc, char **argv) {
             char *end;
             ntol = strtod(argv[++i], &end);
             if (*end || !(ntol >= 0)) die("bad --normals '%s'", argv[i]);
+        } else if (!strcmp(argv[i], "--ignore-loose")) {
+            loose = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             die("usage: objdiff [--tol-rel T] [--normals T] a.obj b.obj (unknown option %s)", argv[i]);
         } else if (!pa) pa = argv[i];
@@ -393,6 +417,7 @@ int main(int argc, char **argv) {
     Mesh a, b;
     parse_obj(pa, &a);
     parse_obj(pb, &b);
+    if (loose) drop_loose(&a), drop_loose(&b);
     if (ntol >= 0 && (a.nn != a.nv || b.nn != b.nv)) {
         printf("FAIL: --normals needs one vn per v: %s has %d v %d vn, %s has %d v %d vn\n", pa, a.nv,
                a.nn, pb, b.nv, b.nn);

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Face-varying channels (UV maps) of OpenSubdiv's regression shapes vs OpenSubdiv (issue 16).
 #
-# Every in-scope catmark_* shape (tests/data/osd/extract_shapes.py --scope: hole-free, manifold)
+# Every in-scope catmark_* shape (tests/data/osd/extract_shapes.py --scope: no degenerate face)
 # that has a UV map (`vt` lines, `f v/vt` corners): the catmark_fvar_* shapes, cube, car, bishop,
 # pawn, rook, helmet, the gregory tests and the rest. build/fvar_oracle checks, per shape, level
 # 1..3, scheme cc and eigen (the shapes' equal intervals) and each of OpenSubdiv's six
@@ -14,6 +14,13 @@
 # tests/oracle/run_osd_shapes.sh (OSD_SHAPES, or the cache tests/oracle/osd_shapes_deps.sh fills).
 # Environment (optional): OSD_SHAPES, OSD_SHAPES_ONLY (names), FVAR_LEVELS (default "1 2 3"),
 # FVAR_SCHEMES (default cc,eigen), ORACLE_TIMEOUT (seconds per shape, default 120).
+# Two non-manifold shapes are left out: catmark_nonman_edge100, whose limit OpenSubdiv 3.5
+# cannot compute (PrimvarRefiner::Limit writes past its weight buffer at an edge of 100 faces;
+# run_osd_shapes.sh compares its refinement), and catmark_fan, whose UVs differ across its
+# non-manifold edges: OpenSubdiv makes every value at a non-manifold vertex a corner once the
+# values differ across any of its edges (Vtr::FVarLevel, gatherValueSpans), also at the
+# vertices inside a non-manifold crease and at the points refinement puts on such edges, where
+# ccnurbs applies the crease rule of each fan (docs/creases.md, "Non-manifold cages").
 cd "$(dirname "$0")/../.." || exit 2
 
 TOOL=build/fvar_oracle
@@ -62,6 +69,7 @@ oracle_run() {
 }
 
 for name in $scope; do
+  case $name in catmark_nonman_edge100|catmark_fan) continue ;; esac
   in="$dir/$name.obj"
   grep -q '^vt' "$in" 2>/dev/null || continue
   shapes=$((shapes + 1))

@@ -2,7 +2,8 @@
 # OpenSubdiv's catmark_* regression shapes vs the OpenSubdiv oracle (issue 12).
 #
 # For every in-scope shape (tests/data/osd/extract_shapes.py --scope: tags only crease, corner,
-# interpolateboundary, creasemethod, facevaryinginterpolateboundary; manifold), levels 1..3,
+# interpolateboundary, creasemethod, facevaryinginterpolateboundary; no degenerate face;
+# non-manifold edges and vertices included), levels 1..3,
 # schemes cc and eigen (equal intervals: the shapes have no "# knot" lines):
 #   refine   build/ccnurbs refine --scheme S --levels K in.obj out.obj
 #            vs build/osd_refine --levels K in.obj ref.obj
@@ -12,7 +13,9 @@
 #            those, as in run_limit.sh)
 #   normals  the same two files, vn lines, where osd_refine defines the normal (not 0 0 0)
 # compared by build/objdiff --tol-rel 1e-9 (positions, relative to the bounding-box diagonal;
-# vertex and face order free, faces must match) and --normals 1e-9 (unit normals).
+# vertex and face order free, faces must match) and --normals 1e-9 (unit normals); the limit
+# files are compared without the vertices no face uses (--ignore-loose: the limit mesh has
+# no point for a loose cage vertex).
 # No --corners is passed: the files' interpolateboundary tags must decide (osd_refine
 # applies them; ccnurbs has to read them too). One line per comparison, then
 # "N passed, N failed"; exit 0 only if everything passed.
@@ -26,8 +29,14 @@
 # Normals are not compared on catmark_val2_back2back: a flat two-sided sheet whose limit
 # surface folds back onto itself at the rim, where the normal's sign is undefined (ccnurbs
 # orients it by the 1-ring's characteristic map, OpenSubdiv by its tangent masks; they differ
-# there). Its positions are compared. The shapes out of scope (extract_shapes.py --scope) that
-# are non-manifold must get ccnurbs' topology error.
+# there). Its positions are compared. Nor on catmark_val2_nonman: two of its faces use an
+# edge in the same direction, so the points on that edge belong to two oppositely oriented
+# sheets, and each tool takes its normal from another one (3 points at level 2 differ by
+# sign only). Limits are not compared on catmark_nonman_edge100:
+# OpenSubdiv 3.5's PrimvarRefiner::Limit writes past its weight buffer at the ends of an edge
+# with 100 faces (valgrind: ComputeVertexLimitMask into a StackBuffer sized from the largest
+# edge count) and aborts; its refinement is compared. The shapes with a face that repeats a
+# vertex (extract_shapes.py --refused) must get ccnurbs' topology error.
 # Environment (optional): CCNURBS (default build/ccnurbs), OSD_SHAPES, OSD_SHAPES_LEVELS
 # (default "1 2 3"), OSD_SHAPES_SCHEMES (default "cc eigen"), OSD_SHAPES_ONLY (shape names,
 # e.g. "catmark_cube catmark_car"), ORACLE_TIMEOUT (seconds per command, default 120).
@@ -120,21 +129,23 @@ for name in $scope; do
       fi
       lout="$tmp/lout.obj"
       rm -f "$lout"
-      if [ "$lrefok" != 1 ]; then
+      if [ "$name" = catmark_nonman_edge100 ]; then
+        :
+      elif [ "$lrefok" != 1 ]; then
         report FAIL "$label limit" "osd_refine --limit-normals failed: $lrefmsg"
         report FAIL "$label normals" "osd_refine --limit-normals failed"
       elif $TO "$CCN" limit --cap refine --scheme "$s" --levels "$level" "$in" "$lout" \
              >"$tmp/ccnl.log" 2>&1 && [ -s "$lout" ]; then
-        if msg=$("$DIFF" --tol-rel "$TOL" "$lout" "$lref" 2>&1); then
+        if msg=$("$DIFF" --ignore-loose --tol-rel "$TOL" "$lout" "$lref" 2>&1); then
           report ok "$label limit" "$msg"
         else
           report FAIL "$label limit" "$(echo "$msg" | tr '\n' ' ')"
         fi
         # normals: positions are matched with a loose tolerance so that a position failure
         # (reported above) does not hide what the normals do
-        if [ "$name" = catmark_val2_back2back ]; then
+        if [ "$name" = catmark_val2_back2back ] || [ "$name" = catmark_val2_nonman ]; then
           :
-        elif msg=$("$DIFF" --tol-rel 1e-3 --normals "$TOL" "$lout" "$lref" 2>&1); then
+        elif msg=$("$DIFF" --ignore-loose --tol-rel 1e-3 --normals "$TOL" "$lout" "$lref" 2>&1); then
           report ok "$label normals" "$msg"
         else
           report FAIL "$label normals" "$(echo "$msg" | tr '\n' ' ')"
@@ -147,15 +158,15 @@ for name in $scope; do
   done
 done
 
-# Out of scope and non-manifold: the clear topology error (exit 2, message, no output file).
-for name in $(python3 tests/data/osd/extract_shapes.py --nonmanifold "$dir" 2>/dev/null); do
+# A face that repeats a vertex: the clear topology error (exit 2, message, no output file).
+[ -n "${OSD_SHAPES_ONLY:-}" ] || for name in $(python3 tests/data/osd/extract_shapes.py --refused "$dir" 2>/dev/null); do
   in="$dir/$name.obj"; out="$tmp/nm.obj"; rm -f "$out"
   if $TO "$CCN" refine --levels 1 "$in" "$out" >"$tmp/nm.log" 2>&1; then
-    report FAIL "$name non-manifold" "accepted"
+    report FAIL "$name degenerate" "accepted"
   elif [ -e "$out" ] || ! grep -q "topology error" "$tmp/nm.log"; then
-    report FAIL "$name non-manifold" "$(oneline "$tmp/nm.log")"
+    report FAIL "$name degenerate" "$(oneline "$tmp/nm.log")"
   else
-    report ok "$name non-manifold" "$(oneline "$tmp/nm.log")"
+    report ok "$name degenerate" "$(oneline "$tmp/nm.log")"
   fi
 done
 

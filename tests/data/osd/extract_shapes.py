@@ -4,9 +4,9 @@
     extract_shapes.py SRC OUTDIR        write OUTDIR/catmark_*.obj (+ LICENSE.txt)
     extract_shapes.py --table SRC       print the README table (markdown) to stdout
     extract_shapes.py --scope SRC       print the in-scope shape names, one a line
-    extract_shapes.py --nonmanifold SRC print the shapes ccnurbs must refuse as non-manifold
-                                        (topology problems other than unused vertices only,
-                                        which ccnurbs accepts and counts as isolated)
+    extract_shapes.py --refused SRC     print the shapes ccnurbs must refuse: a face that
+                                        repeats a vertex (a degenerate face, which no mesh
+                                        editor keeps)
 
 SRC is either OpenSubdiv's regression/shapes directory (catmark_*.h, each a C/C++ string
 literal holding the OBJ text, possibly split into std::string(...) + std::string(...)
@@ -17,11 +17,11 @@ decoded), after one header comment naming the source and licence; nothing is dro
 `v`, `vt`, `vn`, `f a/b/c` and the `t name nints/nfloats/nstrings ...` tag lines are as in
 OpenSubdiv. LICENSE.txt is copied from SRC/../../LICENSE.txt when it is there.
 
-Scope (issue 12): a shape is in scope when its tags are only crease, corner,
-interpolateboundary, creasemethod (facevaryinginterpolateboundary is allowed too: it changes
-face-varying data only) and its topology is manifold: every edge has one or two faces, the
-two faces of an interior edge use it in opposite directions, no face repeats a vertex,
-every vertex is used by a face and the faces around each vertex form one fan.
+Scope: a shape is in scope when its tags are only crease, corner, interpolateboundary,
+creasemethod (facevaryinginterpolateboundary is allowed too: it changes face-varying data
+only) and no face repeats a vertex. Non-manifold topology is in scope (ccnurbs reads it as
+OpenSubdiv does: edges with more than two faces or used twice in one direction, bowtie
+vertices, vertices no face uses); the table names it.
 """
 import os
 import re
@@ -187,8 +187,9 @@ def classify(name, text):
     if other:
         reasons.append("tags " + ", ".join(other))
     probs = topology_problems(nv, faces)
-    if probs:
-        reasons.append("non-manifold: " + "; ".join(probs))
+    degenerate = [p for p in probs if "repeating a vertex" in p]
+    if degenerate:
+        reasons.append("degenerate: " + "; ".join(probs))
     info = {
         "nv": nv, "nf": len(faces), "nvt": nvt,
         "forms": sorted(forms, key=len),
@@ -196,6 +197,7 @@ def classify(name, text):
         "val2": len(interior_valence2(nv, faces)),
         "tags": tags,
         "reasons": reasons,
+        "nonmanifold": [] if degenerate else probs,
     }
     return info
 
@@ -225,7 +227,7 @@ def tag_summary(tags):
 
 def main(argv):
     mode = "write"
-    if argv and argv[0] in ("--table", "--scope", "--nonmanifold"):
+    if argv and argv[0] in ("--table", "--scope", "--refused"):
         mode = argv.pop(0)
     if (mode == "write" and len(argv) != 2) or (mode != "write" and len(argv) != 1):
         sys.stderr.write(__doc__)
@@ -256,17 +258,18 @@ def main(argv):
             if not r["reasons"]:
                 print(name)
         return 0
-    if mode == "--nonmanifold":
+    if mode == "--refused":
         for name, text in shapes.items():
             nv, nvt, faces, forms, tags = parse(text)
-            probs = [p for p in topology_problems(nv, faces) if "used by no face" not in p]
-            if probs:
+            if any("repeating a vertex" in p for p in topology_problems(nv, faces)):
                 print(name)
         return 0
     print("| shape | verts | faces | face sizes | `f` forms | vt | interior val-2 | tags | in scope |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, r in rows.items():
         scope = "yes" if not r["reasons"] else "no: " + "; ".join(r["reasons"])
+        if not r["reasons"] and r["nonmanifold"]:
+            scope += " (non-manifold: " + "; ".join(r["nonmanifold"]) + ")"
         print(f"| {name} | {r['nv']} | {r['nf']} | {','.join(map(str, r['sizes']))} | "
               f"{' '.join(r['forms'])} | {r['nvt']} | {r['val2'] or '-'} | "
               f"{tag_summary(r['tags'])} | {scope} |")
