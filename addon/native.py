@@ -1,4 +1,5 @@
-"""ctypes binding to libccnurbs.so, shipped inside this package.
+"""ctypes binding to the CCNURBS library shipped inside this package: one package per platform
+(libccnurbs.so / ccnurbs.dll / libccnurbs.dylib, OpenBLAS beside it; see blender_manifest.toml).
 
 Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) or, after
 an edit, ccn_plan_recreate (from the plan it replaces) / ccn_plan_sizes / ccn_plan_evaluate (the first
@@ -9,10 +10,13 @@ buffers passed by pointer; a failing call raises CCNError carrying the library's
 """
 import ctypes
 import os
+import platform
+import re
+import sys
 
 import numpy as np
 
-LIB_NAME = "libccnurbs.so"
+LIB_NAME = {"win32": "ccnurbs.dll", "darwin": "libccnurbs.dylib"}.get(sys.platform, "libccnurbs.so")
 
 c_int32_p = ctypes.POINTER(ctypes.c_int32)
 c_double_p = ctypes.POINTER(ctypes.c_double)
@@ -118,10 +122,29 @@ class ccn_fvar_sizes(ctypes.Structure):
 
 _lib = None
 _load_error = None
+_dll_directory = None  # Windows: keeps the package folder on the DLL search path
 
 
 def library_path():
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), LIB_NAME)
+
+
+def platform_name():
+    """This machine as Blender names extension platforms: linux-x64, windows-x64, macos-arm64..."""
+    system = {"win32": "windows", "darwin": "macos"}.get(sys.platform, sys.platform)
+    machine = platform.machine().lower()
+    return "%s-%s" % (system, {"x86_64": "x64", "amd64": "x64", "aarch64": "arm64"}.get(machine,
+                                                                                     machine))
+
+
+def package_platforms():
+    """The platforms this package was built for (its manifest's `platforms`), [] if unknown."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_manifest.toml")
+    try:
+        with open(path, encoding="utf-8") as f:
+            return next((re.findall(r'"([^"]+)"', ln) for ln in f if ln.startswith("platforms")), [])
+    except OSError:
+        return []
 
 
 def _bind(lib):
@@ -180,17 +203,24 @@ def _cache(lib):
 
 def load():
     """Returns the loaded library; raises CCNError('CCN_ERR_LOAD', ...) if it cannot be used."""
-    global _lib, _load_error
+    global _lib, _load_error, _dll_directory
     if _lib is not None:
         return _lib
     if _load_error is not None:
         raise CCNError("CCN_ERR_LOAD", _load_error)
     path = library_path()
+    here, built = platform_name(), package_platforms()
+    wrong = ("this CCNURBS package is for %s, this Blender runs on %s: install the package made "
+             "for %s" % (", ".join(built), here, here)) if built and here not in built else ""
     try:
+        if not os.path.isfile(path):
+            raise OSError("%s is not in the package" % LIB_NAME)
+        if hasattr(os, "add_dll_directory") and _dll_directory is None:  # OpenBLAS beside it
+            _dll_directory = os.add_dll_directory(os.path.dirname(path))
         lib = ctypes.CDLL(path)
         _bind(lib)
     except (OSError, AttributeError) as e:
-        _load_error = "cannot load the CCNURBS library: %s" % (e,)
+        _load_error = "cannot load the CCNURBS library: %s%s" % (wrong + "; " if wrong else "", e)
         raise CCNError("CCN_ERR_LOAD", _load_error) from None
     _lib = lib
     return lib

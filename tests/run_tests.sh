@@ -11,7 +11,7 @@ LOG=build/test-logs
 HEAVY="tests/asan/run_asan.sh tests/experiments/run_experiments.sh tests/oracle/run_export.sh
        tests/blender/run_blender.sh tests/fuzz/run_fuzz.sh build/tests/test_cap build/tests/test_cap_fair
        build/tests/test_creases build/tests/test_normals_fd build/tests/test_continuity
-       tests/oracle/run_osd_shapes.sh"
+       tests/oracle/run_osd_shapes.sh tests/package/run_wine.sh"
 rm -rf "$LOG" && mkdir -p "$LOG" || exit 2
 pass=0; fail=0; failed=""; running=""; pids=""
 trap 'for p in $pids; do kill "$p" 2>/dev/null; done; exit 130' INT TERM

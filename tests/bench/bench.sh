@@ -121,7 +121,7 @@ if command -v blender > /dev/null; then
     --python tests/blender/bench_blender.py -- "$D" build/ccnurbs.zip > "$tmp/b34.log" 2>&1
   blender_rows "$v" 1.0 "$tmp/b34.log"
 fi
-for line in 4.5 5; do
+for line in ${BENCH_BPY_LINES:-4.5 5.3}; do
   py=$CACHE/venv-bpy-$line/bin/python
   [ -x "$py" ] && [ -f "$CACHE/venv-bpy-$line/.ok" ] || { echo "Blender $line: no bpy venv at $CACHE (make deps)"; continue; }
   d="$tmp/b$line"; mkdir -p "$d"

@@ -123,6 +123,13 @@ class TestFileHygiene(AddonTestCase):
                 bpy.ops.wm.save_as_mainfile(filepath=raw, copy=True, compress=False)
                 raws[kind] = os.path.getsize(raw)
             n = len(ob.data.vertices)
+            # the applied limit keeps its exact normals: encoded custom normals before 4.5
+            # (2 int16 per face corner), which Subdivision Surface's mesh does not have
+            if kind == "CCNURBS" and not ccn.compat.FREE_NORMALS and \
+                    ccn.compat.has_custom_normals(ob.data):
+                normal_bytes = 4 * len(ob.data.loops)
+            elif kind == "CCNURBS":
+                normal_bytes = 0
         print("measure apply-file: Subsurf %d bytes, CCNURBS %d bytes (%.3f), %d vertices"
               % (sizes["SUBSURF"], sizes["CCNURBS"], sizes["CCNURBS"] / sizes["SUBSURF"], n))
         if raws:
@@ -135,7 +142,7 @@ class TestFileHygiene(AddonTestCase):
             self.assertLessEqual(raws["CCNURBS"], 1.10 * raws["SUBSURF"])
             self.assertLessEqual(sizes["CCNURBS"], 1.25 * sizes["SUBSURF"])
         else:
-            self.assertLessEqual(sizes["CCNURBS"], 1.10 * sizes["SUBSURF"])
+            self.assertLessEqual(sizes["CCNURBS"], 1.10 * sizes["SUBSURF"] + normal_bytes)
 
     def test_rename_keeps_proxies_and_status(self):
         ob = add_modifier(grid(3, "Old"))

@@ -155,7 +155,11 @@ class TestModifier(AddonTestCase):
                 self.assertEqual(ccn.sync.pending_normals, {ob.name_full})
                 self.assertTrue(key.endswith(ccn.sync.PENDING), key)
                 me = ccn.modifier.proxy(ob, 'VIEW').data
-                self.assertIs(me.use_auto_smooth, False, "custom normals still shown")
+                # < 4.1: custom normals are shown only with auto smooth, which is turned off;
+                # 4.1-4.4 have no cheap way to drop them (the last exact ones stay shown until
+                # the pending ones are written, below)
+                if hasattr(me, "use_auto_smooth"):
+                    self.assertIs(me.use_auto_smooth, False, "custom normals still shown")
             st = dict(ccn.sync.stats)
             h.write_pending_normals()
             update()

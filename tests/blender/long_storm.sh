@@ -6,8 +6,8 @@
 cd "$(dirname "$0")/../.." || exit 2
 export CCN_CASES=case_storm CCN_STORM_STEPS=${CCN_STORM_STEPS:-400}
 export CCN_BLENDER_TIMEOUT=${CCN_BLENDER_TIMEOUT:-7200}
-newest=${CCN_STORM_NEWEST:-5}
-others=${CCN_STORM_OTHERS:-4.5}
+newest=${CCN_STORM_NEWEST:-5.3}
+others=${CCN_STORM_OTHERS:-"4.2 4.5 5.2"}
 rc=0
 CCN_STORM_SEEDS=${CCN_STORM_SEEDS_NEWEST:-1,2,3,4,5,6,7,8,9,10} CCN_DEBIAN=0 CCN_BPY_LINES=$newest \
   sh tests/blender/run_blender.sh || rc=1

@@ -1,15 +1,22 @@
 #!/bin/sh
 # Headless Blender tests of the add-on (picked up by tests/run_tests.sh), on every Blender:
 #   3.4  Debian's `blender`:  blender --background --factory-startup --python-exit-code 1 --python
-#   4.5, 5.x  PyPI's `bpy` module in the venvs of tests/blender/deps_bpy.sh:  python test_addon.py
-# Each run installs build/ccnurbs.zip (3.x: legacy add-on; 4.2+: extension API) into throw-away
-# user dirs. One line per test, then "== Blender X.Y.Z (how): N passed, N failed" per version;
-# a version that is not installed counts as a failure. Last line: "N passed, N failed" in total.
+#   4.2, 4.5 (LTS), 5.2 (LTS), 5.3  PyPI's `bpy` module in the venvs of tests/blender/deps_bpy.sh:
+#        python test_addon.py
+# Each run installs build/ccnurbs.zip (the linux-x64 package of tests/package/package.mk; 3.x:
+# legacy add-on; 4.2+: extension API) into throw-away user dirs. 3.4, 4.5 and 5.3 run every case;
+# the lines in CCN_BPY_SUBSET_LINES (4.2, 5.2: `make test` stays short) run CCN_SUBSET_CASES, the
+# add-on suite without its four slowest cases. One line per test, then
+# "== Blender X.Y.Z (how): N passed, N failed" per version; a version that is not installed
+# counts as a failure. Last lines: the versions tested, "N passed, N failed" in total.
 cd "$(dirname "$0")/../.." || exit 2
 ZIP=${CCN_ZIP:-build/ccnurbs.zip}
 CLI=${CCN_CLI:-build/ccnurbs}
 CACHE=${CCN_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/ccnurbs}
-LINES=${CCN_BPY_LINES:-"4.5 5"}
+LINES=${CCN_BPY_LINES:-"4.2 4.5 5.2 5.3"}
+SUBSET_LINES=${CCN_BPY_SUBSET_LINES-"4.2 5.2"}
+SUBSET_CASES=${CCN_SUBSET_CASES:-case_package,case_knots,case_modifier,case_creases,case_stack,\
+case_animation,case_files,case_objio,case_values,case_zenable}
 TIMEOUT=${CCN_BLENDER_TIMEOUT:-300}
 for f in "$ZIP" "$CLI"; do
   [ -f "$f" ] || { echo "run_blender: $f missing (make package build)"; echo "0 passed, 1 failed"; exit 1; }
@@ -47,8 +54,9 @@ run() {
   p=${summary%% passed*}; f=${summary#*passed, }; f=${f%% failed*}
   if [ "$f" -eq 0 ] && { [ "$tb" -ne 0 ] || [ $rc -ne 0 ]; }; then f=1; fi
   total_p=$((total_p + p)); total_f=$((total_f + f))
-  versions="$versions ${ver:-?}"
-  echo "== Blender ${ver:-$label} ($label): $p passed, $f failed ($(( $(date +%s) - start ))s)"
+  versions="$versions ${ver:-?}${subset:+(subset)}"
+  echo "== Blender ${ver:-$label} ($label${subset:+, subset of $(echo "$CCN_CASES" | tr , '\n' |
+       wc -l) cases}): $p passed, $f failed ($(( $(date +%s) - start ))s)"
 }
 
 missing() {
@@ -56,6 +64,7 @@ missing() {
   total_f=$((total_f + 1)); versions="$versions $1(missing)"
 }
 
+subset=""
 if [ "${CCN_DEBIAN:-1}" = 0 ]; then
   : # (long_storm.sh: the bpy lines only)
 elif command -v blender >/dev/null 2>&1; then
@@ -67,7 +76,11 @@ fi
 for line in $LINES; do
   env="$CACHE/venv-bpy-$line"
   if [ -f "$env/.ok" ] && [ -x "$env/bin/python" ]; then
+    subset=""
+    case " $SUBSET_LINES " in *" $line "*) [ -z "${CCN_CASES:-}" ] && subset=1 ;; esac
+    [ -n "$subset" ] && export CCN_CASES="$SUBSET_CASES"
     run "bpy-$line" "$env/bin/python" tests/blender/test_addon.py
+    [ -n "$subset" ] && unset CCN_CASES
   else
     why=$(cat "$env.failed" 2>/dev/null | tr '\n' ' ')
     missing "$line (bpy wheel)" "${why:-no venv at $env (make deps creates it)}"

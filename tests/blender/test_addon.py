@@ -94,10 +94,16 @@ def main():
                  {t.id() for t, _ in result.failures + result.errors})
     print("%d passed, %d failed" % (result.testsRun - min(failed, result.testsRun), failed))
     sys.stdout.flush()
-    if failed:
-        if bpy.app.binary_path:
+    sys.stderr.flush()
+    if bpy.app.binary_path:
+        if failed:
             raise SystemExit(1)
-        os._exit(1)  # the module: no Blender exit code to set
+        return
+    # the module: no Blender exit code to set; and bpy 4.2 frees the UI classes add-ons
+    # registered in its C++ exit handlers, after Python is finalized (bpy_class_free ->
+    # PyGILState_Ensure on no interpreter: SIGSEGV, with any add-on that has a panel), which
+    # os._exit skips
+    os._exit(1 if failed else 0)
 
 
 main()

@@ -485,7 +485,7 @@ static void test_semisharp_levels(void) {
     for (int rep = 0; rep < 3; rep++)
         for (int k = 1; k <= 3; k++) {
             grid g = grid_make(6, 5, rep == 1, 3, 10.0);
-            double size;
+            double size = 1.0;
             ccn_mesh *a = refine_grid(&g, k, k, CCN_CREASE_UNIFORM), *b = refine_grid(&g, 10, k, CCN_CREASE_UNIFORM);
             double e1 = a && b ? max_diff(a, b, 1, &size) : 1e300;
             CHECK(e1 <= 1e-15 * size, "s = %d: %d levels differ from the sharp crease by %.3g", k, k, e1);

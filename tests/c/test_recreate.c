@@ -184,6 +184,7 @@ static void chain(const char *name, int random_knots, int random_creases, int le
         prev = next; /* the old plan was consumed (destroyed) by the call */
         if (!fresh || !next) { ccn_plan_destroy(fresh); break; }
         result a, b, k;
+        memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&k, 0, sizeof k);
         const double *at = step == 5 ? moved : NULL;
         /* the recreated plan's first evaluation keeps what the edit did not change of the
          * earlier plan's last output (ccn_plan_evaluate_changed); a second one computes all

@@ -32,7 +32,7 @@ done
 run run_cli sh tests/cli/run_cli.sh & run run_limit sh tests/oracle/run_limit.sh; wait
 for n in run_cli run_limit; do read -r rc secs <"$LOG/$n.rc"; result "$n" "$rc" "$secs"; done
 py=""
-for line in 5.3 5 5.2 4.5; do
+for line in 5.3 5.2 4.5; do
   if [ -f "$CACHE/venv-bpy-$line/.ok" ]; then py="$CACHE/venv-bpy-$line/bin/python"; break; fi
 done
 if [ -n "$py" ]; then
