@@ -296,12 +296,13 @@ ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);
  * (face_verts, face_origin) are the same on every call. */
 ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
                              ccn_error *err);
-/* ccn_plan_evaluate for the first evaluation of a plan made by ccn_plan_recreate, when out
- * holds (in each array it names) what the last ccn_plan_evaluate of prev wrote there: if the
- * positions are those of that evaluation (an interval edit), only the output values the edit
- * changed are computed and written, the rest of out is kept; the result is byte-identical to
- * ccn_plan_evaluate's. Otherwise (other positions, prev never evaluated, a plan not recreated,
- * a later call) it is ccn_plan_evaluate. */
+/* ccn_plan_evaluate for the first evaluation of a plan made by ccn_plan_recreate: when out
+ * names the arrays the last evaluation of prev wrote (the same positions, normals and
+ * corner_normals pointers, their contents untouched since) and the cage positions are those of
+ * that evaluation (an interval edit), only the output values the edit changed are computed and
+ * written, the rest of out is kept; the result is byte-identical to ccn_plan_evaluate's. In
+ * every other case (another buffer, other positions, prev never evaluated, a plan not
+ * recreated, a later call) it is ccn_plan_evaluate. */
 ccn_status ccn_plan_evaluate_changed(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
                                      ccn_error *err);
 void ccn_plan_destroy(ccn_plan *plan);

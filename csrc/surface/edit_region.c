@@ -102,6 +102,7 @@ int ccn__edit_region_begin(ccn_plan *p) {
     memcpy(r->pos0, q->lev[0]->pos, n0);
     memcpy(r->centre, q->centre, sizeof r->centre);
     r->scale = q->scale;
+    memcpy(r->out, q->last_out, sizeof r->out);
     uint8_t *D = NULL, *DL = NULL; /* level l's changed points; level L's */
     for (int32_t l = 0; l < p->R; l++) {
         uint8_t *child = NULL;

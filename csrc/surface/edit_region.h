@@ -16,6 +16,7 @@ struct ccn__edit_region {
     uint8_t *redo;          /* per output vertex: its stencil row was made again (tessellate.c) */
     int32_t nrows, *rows;   /* the output rows to apply again */
     uint8_t *written;       /* evaluate's scratch: per output vertex, written by this call */
+    const double *out[3];   /* the arrays the earlier plan's last evaluation wrote (its last_out) */
 };
 
 /* During ccn_plan_recreate, after the levels are built (before setup_level_s): when the earlier

@@ -365,6 +365,14 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         ccn__edit_region_free(r); /* the cage moved too: everything changes */
         r = NULL;
     }
+    /* only the arrays the earlier plan wrote last hold what the edit did not change: any other
+     * buffer (or one it did not write) is evaluated in full */
+    const double *given[3] = {out->positions, out->normals, out->corner_normals};
+    for (int k = 0; r && k < 3; k++)
+        if (given[k] && given[k] != r->out[k]) {
+            ccn__edit_region_free(r);
+            r = NULL;
+        }
     for (int32_t l = 0; l < p->R; l++) {
         if (r)
             ccn__level_points_lists(&p->prep[l], r->lists[l].f, r->lists[l].nf, r->lists[l].e,
@@ -412,6 +420,8 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         memcpy(out->corner_edge_origin, p->out_eorigin, sizeof(int32_t) * 4 * (size_t)p->nout_f);
     if (out->edge_verts) memcpy(out->edge_verts, p->out_ev, sizeof(int32_t) * 2 * (size_t)p->nout_e);
     if (out->corner_edges) memcpy(out->corner_edges, p->out_ce, sizeof(int32_t) * 4 * (size_t)p->nout_f);
+    p->last_out[0] = out->positions, p->last_out[1] = out->normals;
+    p->last_out[2] = out->corner_normals;
     p->evaluated = 1;
     return CCN_OK;
 }

@@ -107,6 +107,10 @@ struct ccn_plan {
     /* 1 after a successful ccn_plan_evaluate: the levels' points are those of lev[0]->pos
      * (normalised by centre, scale) */
     int evaluated;
+    /* the output arrays the last evaluation wrote (its ccn_limit_mesh's positions, normals,
+     * corner_normals): a plan recreated from this one evaluates only what the edit changed
+     * when it is given these same arrays again, and everything otherwise */
+    const double *last_out[3];
     /* made by ccn_plan_recreate from an evaluated earlier plan, used and dropped by the next
      * evaluation: the earlier plan's level points (moved into lev[]) and what the edit changed */
     struct ccn__edit_region *region;

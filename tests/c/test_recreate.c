@@ -91,15 +91,20 @@ static void unload(edit_cage *c) {
 typedef struct { ccn_sizes s; double *x; int32_t *fv; } result;
 
 /* r: p's output (positions: NULL for the cage's). from: NULL, or the earlier plan's last
- * output, which r starts as, evaluated by ccn_plan_evaluate_changed. */
-static int evaluate_at(ccn_plan *p, const double *positions, const result *from, result *r) {
+ * output, whose buffers r takes over (from is left empty) and which ccn_plan_evaluate_changed
+ * updates in place. */
+static int evaluate_at(ccn_plan *p, const double *positions, result *from, result *r) {
     ccn_error err;
     ccn_plan_sizes(p, &r->s);
     size_t nv = (size_t)r->s.num_verts, nf = (size_t)r->s.num_faces;
-    r->x = malloc(sizeof(double) * (6 * nv + 12 * nf));
-    r->fv = malloc(sizeof(int32_t) * 4 * nf);
+    if (from) {
+        r->x = from->x, r->fv = from->fv;
+        from->x = NULL, from->fv = NULL;
+    } else {
+        r->x = malloc(sizeof(double) * (6 * nv + 12 * nf));
+        r->fv = malloc(sizeof(int32_t) * 4 * nf);
+    }
     if (!r->x || !r->fv) return 0;
-    if (from) memcpy(r->x, from->x, sizeof(double) * (6 * nv + 12 * nf));
     ccn_limit_mesh out = {.positions = r->x, .normals = r->x + 3 * nv,
                           .corner_normals = r->x + 6 * nv, .face_verts = r->fv};
     return (from ? ccn_plan_evaluate_changed(p, positions, &out, &err)
@@ -233,6 +238,43 @@ static void test_interval_edits(void) {
     CHECK(runs >= 150, "only %d plans compared", runs);
 }
 
+/* ccn_plan_evaluate_changed into buffers other than those the earlier plan wrote (a fresh
+ * array, or a copy of its output) evaluates everything: byte-identical to a new plan's output. */
+static void test_foreign_buffer(void) {
+    edit_cage c;
+    if (!load("tests/data/suzanne.obj", 1, 0, &c)) return;
+    ccn_options o = {0};
+    o.scheme = CCN_SCHEME_EIGEN;
+    o.levels = 2;
+    ccn_error err;
+    for (int copy = 0; copy < 2; copy++) {
+        ccn_plan *prev = NULL, *next = NULL, *fresh = NULL;
+        CHECK(ccn_plan_create(&c.cage, &o, &prev, &err) == CCN_OK, "%s", err.message);
+        result last = {0}, a = {0}, k = {0};
+        CHECK(prev && evaluate(prev, &last), "evaluate failed");
+        c.knots[3] = 4.5; /* an interval edit */
+        CHECK(ccn_plan_create(&c.cage, &o, &fresh, &err) == CCN_OK, "%s", err.message);
+        CHECK(ccn_plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+        CHECK(fresh && next && evaluate(fresh, &a), "evaluate failed");
+        /* the foreign buffer: garbage, or a copy of the earlier plan's last output */
+        size_t nv = (size_t)last.s.num_verts, nf = (size_t)last.s.num_faces;
+        result other = last;
+        other.x = malloc(sizeof(double) * (6 * nv + 12 * nf));
+        other.fv = malloc(sizeof(int32_t) * 4 * nf);
+        if (copy) memcpy(other.x, last.x, sizeof(double) * (6 * nv + 12 * nf));
+        else memset(other.x, 0x7f, sizeof(double) * (6 * nv + 12 * nf));
+        CHECK(evaluate_at(next, NULL, &other, &k), "evaluate_changed failed");
+        double nrm, d = compare(&a, &k, cage_size(&c.cage), &nrm);
+        CHECK(d == 0 && nrm == 0, "%s buffer: positions %.3g, normals %.3g from a new plan's",
+              copy ? "a copied" : "a fresh", d, nrm);
+        free(last.x); free(last.fv); free(a.x); free(a.fv); free(k.x); free(k.fv);
+        ccn_plan_destroy(fresh);
+        ccn_plan_destroy(next);
+        c.knots[3] = 1.0;
+    }
+    unload(&c);
+}
+
 /* Another topology, other creases or other options: the previous plan is ignored (the result
  * is byte-identical to a new plan's). */
 static void test_hint_ignored(void) {
@@ -316,6 +358,7 @@ static void test_channels_and_unevaluated(void) {
 int main(void) {
     RUN(test_interval_edits);
     RUN(test_hint_ignored);
+    RUN(test_foreign_buffer);
     RUN(test_channels_and_unevaluated);
     return TEST_SUMMARY();
 }
