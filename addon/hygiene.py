@@ -59,7 +59,8 @@ def suspicious(obj):
         return obj.ccnurbs.role == 'CAGE'
     group = mod.node_group
     return (obj.ccnurbs.role != 'CAGE' or not modifier.is_group(group) or group.users > 1
-            or modifier.owner_of(group) != obj.name_full)
+            or modifier.owner_of(group) != obj.name_full
+            or group.get(modifier.GROUP_TAG) != modifier.GROUP_VERSION)
 
 
 def _copy_settings(src, dst):
@@ -138,6 +139,9 @@ def collect():
         keepers[group] = keeper
         fresh += [(o, keeper) for o in objs if o is not keeper]
     claimed = {}
+    for group, keeper in keepers.items():
+        if group.get(modifier.GROUP_TAG) != modifier.GROUP_VERSION:
+            fresh.append((keeper, keeper))  # a group an older add-on built: built again
     for group, keeper in keepers.items():  # a proxy named by two live groups
         for p in modifier.group_proxies(group):
             if p is None:

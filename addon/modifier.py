@@ -22,7 +22,8 @@ Python cannot define modifier types, so `object.ccnurbs_add` adds a Nodes modifi
 * **The output.** The viewport proxy (`levels`) in the viewport; in a render the render proxy
   (`render_levels`), written per frame during the render (handlers.py); each falls back to the
   other when empty (files keep at most the render mesh); the input mesh itself while there is
-  no valid limit (e.g. a file opened without the add-on).
+  no valid limit (e.g. a file opened without the add-on), and at Levels 0 (a proxy of one point
+  and no face), as Subdivision Surface shows its input at Levels 0.
 
 Rejected designs (measured or tried headless on 3.4, 4.5 and 5.0; README "Design notes"):
 reading `obj.data` (ignores the stack); toggling the modifier off to evaluate the stack (a second
@@ -43,6 +44,7 @@ from . import compat
 MOD_NAME = "CCNURBS"
 GROUP_TAG = "ccnurbs_group"
 OWNER_PROP = "ccnurbs_owner"
+GROUP_VERSION = 2  # the GROUP_TAG value; 2: a proxy without faces shows the input (Levels 0)
 TAP_ATTR = "ccn_co"
 VIEW_NODE, RENDER_NODE = "Viewport Proxy", "Render Proxy"
 FALLBACK_NODE, PROXY_SWITCH = "Limit or Cage", "Proxy"
@@ -209,7 +211,7 @@ def _first_nonempty(nodes, links, first, second, location):
 
 def build_group(owner_name, view, render):
     group = bpy.data.node_groups.new("CCNURBS " + owner_name, 'GeometryNodeTree')
-    group[GROUP_TAG] = 1
+    group[GROUP_TAG] = GROUP_VERSION
     group[OWNER_PROP] = owner_name
     compat.new_group_socket(group, "Geometry", 'INPUT', 'NodeSocketGeometry')
     compat.new_group_socket(group, "Geometry", 'OUTPUT', 'NodeSocketGeometry')
@@ -264,6 +266,8 @@ def build_group(owner_name, view, render):
     _link(links, isview.outputs[0], s)
     _link(links, render_or_view, f_in)
     _link(links, view_or_render, t_in)
+    # a proxy without faces shows the input mesh: no limit yet (empty), or Levels 0 (one point,
+    # proxies.show_cage; not empty, so the other proxy is not taken instead)
     size = nodes.new('GeometryNodeAttributeDomainSize')
     size.location = (500, 200)
     _link(links, proxy_out, size.inputs[0])
@@ -271,7 +275,7 @@ def build_group(owner_name, view, render):
     nonempty.operation = 'GREATER_THAN'
     nonempty.inputs[1].default_value = 0.5
     nonempty.location = (650, 200)
-    _link(links, size.outputs['Point Count'], nonempty.inputs[0])
+    _link(links, size.outputs['Face Count'], nonempty.inputs[0])
     fallback = nodes.new('GeometryNodeSwitch')
     fallback.name = fallback.label = FALLBACK_NODE
     fallback.location = (800, 50)
@@ -412,7 +416,7 @@ def ensure(obj, fresh=False):
     group = mod.node_group if mod is not None else None
     view, render = group_proxies(group)
     if (fresh or not is_group(group) or view is None or render is None
-            or owner_of(group) != obj.name_full):
+            or owner_of(group) != obj.name_full or group.get(GROUP_TAG) != GROUP_VERSION):
         group = new_group_and_proxies(obj)  # hygiene.collect() deletes the old one if unused
     created = mod is None
     if created:

@@ -82,6 +82,28 @@ def write_positions(me, res, exact=True):
     write_normals(me, res, exact)
 
 
+CAGE_KEY = "cage"  # KEY_PROP of a proxy that shows the cage itself (Levels 0)
+
+
+def show_cage(p):
+    """Levels 0, as Subdivision Surface: the modifier shows its input. The proxy becomes one
+    point and no face, which the group reads as "show the input mesh" (modifier.build_group);
+    an empty proxy would mean "no limit of this kind: show the other one"."""
+    me = p.data
+    if me is not None and me.get(KEY_PROP) == CAGE_KEY and len(me.vertices) == 1 \
+            and not len(me.polygons):
+        return False
+    me = own_mesh(p)
+    me.clear_geometry()
+    me.vertices.add(1)
+    for k in (TOPO_PROP, PLAN_PROP, attrs.KEY_PROP):
+        if k in me:
+            del me[k]
+    me[KEY_PROP] = CAGE_KEY
+    me.update()
+    return True
+
+
 def clear(p):
     """Empties a proxy (the modifier then shows its input, or the viewport proxy in renders)."""
     if p is None or p.data is None or not len(p.data.vertices) and KEY_PROP not in p.data:

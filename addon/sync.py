@@ -166,6 +166,19 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         p = modifier.proxy(obj, kind)
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
+        if levels == 0:  # as Subdivision Surface at Levels 0: the cage itself, no limit
+            if proxies.show_cage(p):
+                stats["syncs"] += 1
+            entry = _plans.pop(key_name, None)
+            if entry is not None:
+                entry[1].close()
+            st.num_verts, st.num_faces = len(cage.positions), len(cage.face_sizes)
+            st.sizes = {}
+            st.showing = "cage"
+            st.key = proxies.CAGE_KEY
+            st.seconds = time.perf_counter() - t0
+            _status[key_name] = st
+            return st
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
         key = topo + ":" + cage.position_key() + ":" + ekey
         proxies.sync_materials(obj.data, p)

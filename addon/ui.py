@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import errors, hygiene, modifier, native, sync, tap, values
+from . import errors, hygiene, modifier, native, proxies, sync, tap, values
 
 
 def active_edge_interval(obj):
@@ -64,6 +64,10 @@ def _draw_status(layout, obj):
                 col.label(text=line, icon='QUESTION' if i == 0 else 'BLANK1')
         if errors.selectable(st):
             box.operator("object.ccnurbs_select_error", text="Select", icon='RESTRICT_SELECT_OFF')
+        return
+    if st.key == proxies.CAGE_KEY:  # Levels 0
+        box.label(text="Levels 0: the cage, %d vertices, %d faces" % (st.num_verts, st.num_faces),
+                  icon='MESH_DATA')
         return
     box.label(text="Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces), icon='MESH_DATA')
     z = dict(st.sizes)
@@ -133,6 +137,8 @@ def status_lines(obj):
         return []
     if st.error:
         return [error_heading(st), st.error]
+    if st.key == proxies.CAGE_KEY:
+        return ["Levels 0: the cage, %d vertices, %d faces" % (st.num_verts, st.num_faces)]
     return ["Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces)]
 
 
@@ -144,6 +150,8 @@ def render_mesh_line(obj):
     me = p.data if p is not None else None
     if me is None or not len(me.vertices):
         return "Render mesh in file: not computed yet"
+    if me.get(proxies.KEY_PROP) == proxies.CAGE_KEY:
+        return "Render levels 0: renders the cage"
     return "Render mesh in file: %d vertices, %.1f MB" % (len(me.vertices),
                                                           sync.render_bytes(obj) / 1e6)
 

@@ -426,6 +426,51 @@ class TestModifier(AddonTestCase):
         self.assertIsNone(st.error, st.error)
         self.assertEqual(len(P2), len(case_creases.subsurf_positions(ob2, ob2.ccnurbs.levels)))
 
+    def test_levels_zero_shows_the_cage(self):
+        """Levels 0 shows the cage itself, as Subdivision Surface does (not the limit of the
+        cage's vertices, not one level of the split of its triangles and n-gons): positions,
+        faces and UVs as the cage's, in the viewport, after Apply and after save and reopen;
+        Levels 1 brings the limit back."""
+        V = np.array([(0, 0, 0), (1, 0, 0.2), (2, 0, 0), (0, 1, 0.1), (1, 1, 0.5), (2, 1, 0),
+                      (1, 2, 0.3), (2.5, 0.5, 0)], float)
+        F = [(0, 1, 4, 3), (1, 2, 5, 4), (3, 4, 6), (2, 7, 5)]  # quads and triangles
+        ob = load_cage("Zero", V=V, F=F, K={})
+        bpy.ops.mesh.primitive_circle_add(vertices=7, fill_type='NGON', location=(4, 0, 0))
+        ng = bpy.context.object
+        for o in (ob, ng):
+            o.data.uv_layers.new(name="UVMap")
+            uv = np.random.default_rng(1).random(2 * len(o.data.loops)).astype(np.float32)
+            o.data.uv_layers[0].data.foreach_set("uv", uv)
+            add_modifier(o, levels=0, render_levels=2)
+            me = o.evaluated_get(update()).data
+            self.assertEqual(len(me.vertices), len(o.data.vertices))
+            self.assertEqual(len(me.polygons), len(o.data.polygons))
+            np.testing.assert_array_equal(cagelib.mesh_positions(me), cagelib.mesh_positions(o.data))
+            got = np.zeros(2 * len(me.loops), np.float32)
+            me.uv_layers[0].data.foreach_get("uv", got)
+            np.testing.assert_array_equal(got, uv)
+            st = ccn.sync.status(o)
+            self.assertIsNone(st.error, st.error)
+            self.assertIn("Levels 0: the cage", ccn.ui.status_lines(o)[0])
+            # Subdivision Surface at Levels 0 shows the same
+            np.testing.assert_array_equal(evaluated_positions(o),
+                                          case_creases.subsurf_positions(o, 0))
+            o.ccnurbs.levels = 1
+            self.assertMatchesCLI(o)
+            o.ccnurbs.levels = 0
+            np.testing.assert_array_equal(evaluated_positions(o), cagelib.mesh_positions(o.data))
+        path = os.path.join(TMP, "levels0.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        bpy.ops.wm.open_mainfile(filepath=path)
+        ob = bpy.data.objects["Zero"]
+        np.testing.assert_array_equal(evaluated_positions(ob), cagelib.mesh_positions(ob.data))
+        for o in bpy.context.view_layer.objects:
+            o.select_set(o == ob)
+        bpy.context.view_layer.objects.active = ob
+        bpy.ops.object.modifier_apply(modifier=ccn.modifier.get_modifier(ob).name)
+        self.assertEqual(len(ob.data.polygons), len(F))
+        np.testing.assert_array_equal(cagelib.mesh_positions(ob.data), V.astype(np.float32))
+
     def test_levels_that_do_not_fit_are_refused(self):
         """A Levels value whose limit mesh would not fit in the free memory is refused before
         anything is allocated (addon/memory.py), the last limit stays, nothing crashes."""

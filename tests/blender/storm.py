@@ -220,7 +220,7 @@ class Storm:
         s = ob.ccnurbs
         what = r.choice(["levels", "scheme", "cap", "boundary_smooth", "use_creases"])
         if what == "levels":
-            s.levels = r.choice([1, 2])
+            s.levels = r.choice([0, 1, 2])
         elif what == "scheme":
             s.scheme = r.choice(['EIGEN', 'NURSS', 'CATMULL_CLARK'])
         elif what == "cap":
@@ -345,6 +345,10 @@ class Storm:
             s = ob.ccnurbs
             C = cagelib.mesh_positions(cage)
             size = float(np.linalg.norm(C.max(0) - C.min(0))) if len(C) else 1.0
+            if s.levels == 0:  # Levels 0 shows the cage, as Subdivision Surface
+                assert P.shape == C.shape and np.array_equal(P, C), \
+                    "%s: Levels 0 does not show the cage" % ob.name
+                return
             try:
                 R, _ = cagelib.cli_limit(self.cli, cage, s.levels, s.scheme, s.cap, s.boundary_smooth,
                                          creases=s.use_creases)
