@@ -10,8 +10,10 @@
   viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
   them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
   then `depsgraph.update()` so the engine renders them (headless included).
+* render_init: Cycles' Persistent Data off for the render (it would keep the first frame's
+  surface; _before_render).
 * render_complete / render_cancel: render proxies emptied and render plans freed (unless the
-  cage stores its render mesh in the file).
+  cage stores its render mesh in the file); Persistent Data restored.
 * save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write
   (proxies.py): nothing is rebuilt; the proxies are evaluated again at the next redraw.
 * load_post, undo_post, redo_post: hygiene, then every cage re-read.
@@ -237,7 +239,34 @@ def on_frame_change_post(scene, depsgraph=None):
     _guarded(_on_frame, depsgraph)
 
 
+_persistent_off = []  # scenes whose Persistent Data this render turned off (restored after it)
+
+
+def _before_render(scene):
+    """Cycles with Persistent Data syncs again only what a frame's evaluation reports as updated,
+    and the render proxies are written after that evaluation (frame_change_post, then
+    `depsgraph.update()`, which clears those reports): every frame would show the surface of the
+    first one it synced. So a Cycles render of a file with a cage runs without Persistent Data,
+    which is restored when the render ends, and the console says so."""
+    r = scene.render if scene is not None else None
+    if r is None or not r.use_persistent_data or r.engine != 'CYCLES' or not modifier.cages():
+        return
+    r.use_persistent_data = False
+    _persistent_off.append(scene.name_full)
+    print("CCNURBS: %s: Persistent Data is off during this render (each frame's limit surface "
+          "must be synced again); it is turned back on when the render ends" % scene.name_full)
+
+
+@persistent
+def on_render_init(scene=None, *args):
+    _guarded(_before_render, scene)
+
+
 def _after_render():
+    while _persistent_off:
+        scene = bpy.data.scenes.get(_persistent_off.pop())
+        if scene is not None:
+            scene.render.use_persistent_data = True
     for obj in modifier.cages():
         if not obj.ccnurbs.store_render_mesh and obj.library is None:
             proxies.clear(modifier.proxy(obj, 'RENDER'))
@@ -293,6 +322,7 @@ def on_undo_redo(*args):
 HANDLERS = (("depsgraph_update_post", on_depsgraph_update_post),
             ("frame_change_post", on_frame_change_post), ("load_post", on_load_post),
             ("undo_post", on_undo_redo), ("redo_post", on_undo_redo),
+            ("render_init", on_render_init),
             ("render_complete", on_render_done), ("render_cancel", on_render_done),
             ("save_pre", on_save_pre), ("save_post", on_save_post)) + \
     ((("save_post_fail", on_save_post),) if hasattr(bpy.app.handlers, "save_post_fail") else ())

@@ -25,7 +25,7 @@ POS_TOL = 1e-5
 # its step exactly as a button or menu does (and only if the operator has the UNDO flag).
 UNDO = ('EXEC_DEFAULT', True)
 HANDLER_EVENTS = ("depsgraph_update_post", "frame_change_post", "load_post", "undo_post",
-                  "redo_post", "render_complete", "render_cancel", "save_pre", "save_post") + \
+                  "redo_post", "render_init", "render_complete", "render_cancel", "save_pre", "save_post") + \
     (("save_post_fail",) if hasattr(bpy.app.handlers, "save_post_fail") else ())
 
 
