@@ -43,6 +43,16 @@ class Cage:
         used_e[self.loop_edges] = True
         return int((~used_v).sum()), int((~used_e).sum())
 
+    def loose_edge_ends(self):
+        """Vertices at an end of an edge in no face: Subdivision Surface makes them infinitely
+        sharp (Blender's subdiv_converter_mesh.cc, infinite_sharp_vertices_map), whatever Use
+        Creases says, so a face vertex with a loose edge is a corner of the surface."""
+        used_e = np.zeros(self.num_edges, bool)
+        used_e[self.loop_edges] = True
+        ends = np.zeros(self.num_verts, bool)
+        ends[self.edge_verts[~used_e].ravel()] = True
+        return ends
+
     def topology_keys(self, *settings, creases=False, memo=None):
         """(plan key, faces key): hashes of everything a plan depends on except positions
         (polygons, edges, intervals, material indices, settings and, with Use Creases,

@@ -21,6 +21,7 @@ import time
 import traceback
 
 import bpy
+import numpy as np
 
 from . import attrs, memory, modifier, native, proxies
 from . import cage as cagemod
@@ -109,6 +110,10 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
             raise native.CCNError("CCN_ERR_MEMORY", why)
         sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
         vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
+        ends = cage.loose_edge_ends()
+        if ends.any():  # corners, as Subdivision Surface makes them
+            vsharp = np.zeros(cage.num_verts) if vsharp is None else np.array(vsharp, np.float64)
+            vsharp[ends] = 10.0
         # the old plan gives its topology and unchanged stencils to an interval edit's plan
         # (ccn_plan_recreate, which consumes it; only freed when topology, creases or options
         # differ)

@@ -119,6 +119,14 @@ def write_cage_obj(me, path, creases=False):
             for i, c in enumerate(vc):
                 if c > 0:
                     fh.write("# corner %d %.17g\n" % (i + 1, 10 * float(c) ** 2))
+        # Subdivision Surface's rule, which the add-on follows: the ends of an edge in no face
+        # are infinitely sharp (corners), with or without creases
+        le = np.empty(len(me.loops), np.int32)
+        me.loops.foreach_get("edge_index", le)
+        loose = np.ones(len(me.edges), bool)
+        loose[le] = False
+        for i in np.unique(np.array(edge_keys(me), np.int64).reshape(-1, 2)[loose].ravel()):
+            fh.write("# corner %d 10\n" % (int(i) + 1))
 
 
 def read_limit_obj(path):

@@ -20,7 +20,7 @@ import tempfile
 
 from bltest import *  # noqa: F401,F403
 
-from mathutils import kdtree
+from mathutils import Vector, kdtree
 
 TOL = 1e-5             # CCNURBS vs Blender's Subdivision Surface
 QUALITY = 10           # Subdivision Surface's Quality = OpenSubdiv's isolation level
@@ -307,3 +307,48 @@ class TestCreases(AddonTestCase):
         self.assertEqual(ob.mode, 'EDIT')
         bpy.ops.object.mode_set(mode='OBJECT')
         self.assertEqual([v.index for v in ob.data.vertices if v.select], [4])
+
+    def test_loose_edge_ends_are_corners_as_in_subsurf(self):
+        """Subdivision Surface makes the ends of an edge in no face infinitely sharp: a cube
+        corner with a loose edge stays where it is, and the surface around it follows."""
+        bpy.ops.mesh.primitive_cube_add()
+        ob = bpy.context.object
+        bm = bmesh.new()
+        bm.from_mesh(ob.data)
+        bm.verts.ensure_lookup_table()
+        v0 = bm.verts[0]
+        a = bm.verts.new(v0.co + Vector((-1.0, -1.0, -1.0)))
+        b = bm.verts.new(v0.co + Vector((-2.0, -1.5, -1.0)))
+        bm.edges.new((v0, a))
+        bm.edges.new((a, b))
+        bm.verts.new((5.0, 5.0, 5.0))  # an isolated vertex
+        bm.to_mesh(ob.data)
+        bm.free()
+        corner = np.array(ob.data.vertices[0].co[:], np.float32)
+        for use_creases in (True, False):
+            add_modifier(ob, scheme='CATMULL_CLARK', cap='REFINE', levels=2)
+            ob.ccnurbs.use_creases = use_creases
+            ours = evaluated_positions(ob)
+            self.assertIsNone(ccn.sync.status(ob).error)
+            self.assertTrue((ours == corner).all(axis=1).any(), "the corner moved")
+            cp = ob.copy()
+            cp.data = ob.data.copy()
+            bpy.context.scene.collection.objects.link(cp)
+            cp.modifiers.remove(ccn.modifier.get_modifier(cp))
+            cp.ccnurbs.role = 'NONE'
+            m = cp.modifiers.new("Subsurf", 'SUBSURF')
+            m.levels, m.use_limit_surface, m.quality = 2, True, QUALITY
+            m.use_creases = use_creases
+            me = cp.evaluated_get(update()).data
+            on_faces = np.zeros(len(me.vertices), bool)
+            lv = np.empty(len(me.loops), np.int32)
+            me.loops.foreach_get("vertex_index", lv)
+            on_faces[lv] = True
+            ref = cagelib.mesh_positions(me)[on_faces]
+            bpy.data.objects.remove(cp)
+            size = float(np.linalg.norm(ref.max(0) - ref.min(0)))
+            self.assertEqual(len(ours), len(ref))
+            d = set_distance(ours, ref) / size
+            self.assertLessEqual(d, TOL, "use_creases %s" % use_creases)
+            print("measure creases: cube corner with a loose edge vs Subdivision Surface, "
+                  "level 2: %.2e of size" % d)
