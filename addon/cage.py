@@ -44,14 +44,16 @@ class Cage:
         return int((~used_v).sum()), int((~used_e).sum())
 
     def loose_edge_ends(self):
-        """Vertices at an end of an edge in no face: Subdivision Surface makes them infinitely
+        """Face vertices at an end of an edge in no face: Subdivision Surface makes them infinitely
         sharp (Blender's subdiv_converter_mesh.cc, infinite_sharp_vertices_map), whatever Use
         Creases says, so a face vertex with a loose edge is a corner of the surface."""
         used_e = np.zeros(self.num_edges, bool)
         used_e[self.loop_edges] = True
         ends = np.zeros(self.num_verts, bool)
         ends[self.edge_verts[~used_e].ravel()] = True
-        return ends
+        on_face = np.zeros(self.num_verts, bool)
+        on_face[self.face_verts] = True
+        return ends & on_face  # (the others are loose.py's: no surface there to sharpen)
 
     def topology_keys(self, *settings, creases=False, memo=None):
         """(plan key, faces key): hashes of everything a plan depends on except positions

@@ -72,6 +72,12 @@ def write_topology(me, res, cage, exact=True):
         compat.set_material_index(me, cage.material_index[origin])
     me.attributes.new(LIMIT_ATTR, 'BOOLEAN', 'FACE').data.foreach_set("value", np.ones(nf, bool))
     me.update(calc_edges=not edges)
+    if not edges and "loose_edges" in res:  # edges Blender computed from the faces: add the loose
+        ev = np.empty(2 * len(me.edges), np.int32)
+        me.edges.foreach_get("vertices", ev)
+        me.edges.add(len(res["loose_edges"]))
+        me.edges.foreach_set("vertices", np.concatenate([ev, res["loose_edges"].ravel()]))
+        me.update()
     write_creases(me, res, cage)
     write_normals(me, res, exact)
 

@@ -23,7 +23,7 @@ import traceback
 import bpy
 import numpy as np
 
-from . import attrs, memory, modifier, native, proxies
+from . import attrs, loose, memory, modifier, native, proxies
 from . import cage as cagemod
 
 # Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
@@ -120,10 +120,13 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
         plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
                            cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,
                            levels=levels, edge_sharpness=sharp, vertex_sharpness=vsharp,
-                           previous=old)
+                           previous=loose.unwrap(old))
     finally:
         if old is not None:
             old.close()
+    part = loose.Loose(cage, levels)
+    if not part.empty:  # loose vertices and edges, carried as Subdivision Surface carries them
+        plan = loose.WithLoose(plan, cage, part)
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
     plan.corner_channels = attrs.add_corner_channels(plan, cage.extras)
     plan.face_origin = plan.corner_edge_origin = None

@@ -98,8 +98,8 @@ def _draw_status(layout, obj):
         for name in modifier.vertex_groups_below(obj):
             notes.append(modifier.VGROUP_NOTE % name)
         if z.get("num_ignored_verts") or z.get("num_ignored_edges"):
-            notes.append("ignored: %d loose verts, %d loose edges"
-                         % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))
+            notes.append("loose: %d vertices, %d edges (carried as Subdivision Surface carries "
+                         "them)" % (z.get("num_ignored_verts", 0), z.get("num_ignored_edges", 0)))
         for n in notes:
             lines = _wrap(n, 48)
             box.label(text=lines[0], icon='INFO')

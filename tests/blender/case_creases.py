@@ -308,9 +308,11 @@ class TestCreases(AddonTestCase):
         bpy.ops.object.mode_set(mode='OBJECT')
         self.assertEqual([v.index for v in ob.data.vertices if v.select], [4])
 
-    def test_loose_edge_ends_are_corners_as_in_subsurf(self):
-        """Subdivision Surface makes the ends of an edge in no face infinitely sharp: a cube
-        corner with a loose edge stays where it is, and the surface around it follows."""
+    def test_loose_geometry_as_in_subsurf(self):
+        """Loose vertices and edges as Subdivision Surface carries them: a chain of two loose
+        edges from a cube corner (Subsurf makes the corner infinitely sharp and smooths the
+        chain as a cubic B-spline), a loose edge between two cube vertices, an isolated vertex;
+        with and without Use Creases, levels 1 and 2: the same vertices and edge count."""
         bpy.ops.mesh.primitive_cube_add()
         ob = bpy.context.object
         bm = bmesh.new()
@@ -321,34 +323,37 @@ class TestCreases(AddonTestCase):
         b = bm.verts.new(v0.co + Vector((-2.0, -1.5, -1.0)))
         bm.edges.new((v0, a))
         bm.edges.new((a, b))
+        far = max(bm.verts[:8], key=lambda v: (v.co - v0.co).length)
+        bm.edges.new((v0, far))  # through the cube: both ends on faces
         bm.verts.new((5.0, 5.0, 5.0))  # an isolated vertex
         bm.to_mesh(ob.data)
         bm.free()
         corner = np.array(ob.data.vertices[0].co[:], np.float32)
+        add_modifier(ob, scheme='CATMULL_CLARK', cap='REFINE', levels=2)
         for use_creases in (True, False):
-            add_modifier(ob, scheme='CATMULL_CLARK', cap='REFINE', levels=2)
-            ob.ccnurbs.use_creases = use_creases
-            ours = evaluated_positions(ob)
-            self.assertIsNone(ccn.sync.status(ob).error)
-            self.assertTrue((ours == corner).all(axis=1).any(), "the corner moved")
-            cp = ob.copy()
-            cp.data = ob.data.copy()
-            bpy.context.scene.collection.objects.link(cp)
-            cp.modifiers.remove(ccn.modifier.get_modifier(cp))
-            cp.ccnurbs.role = 'NONE'
-            m = cp.modifiers.new("Subsurf", 'SUBSURF')
-            m.levels, m.use_limit_surface, m.quality = 2, True, QUALITY
-            m.use_creases = use_creases
-            me = cp.evaluated_get(update()).data
-            on_faces = np.zeros(len(me.vertices), bool)
-            lv = np.empty(len(me.loops), np.int32)
-            me.loops.foreach_get("vertex_index", lv)
-            on_faces[lv] = True
-            ref = cagelib.mesh_positions(me)[on_faces]
-            bpy.data.objects.remove(cp)
-            size = float(np.linalg.norm(ref.max(0) - ref.min(0)))
-            self.assertEqual(len(ours), len(ref))
-            d = set_distance(ours, ref) / size
-            self.assertLessEqual(d, TOL, "use_creases %s" % use_creases)
-            print("measure creases: cube corner with a loose edge vs Subdivision Surface, "
-                  "level 2: %.2e of size" % d)
+            for L in (1, 2):
+                ob.ccnurbs.use_creases = use_creases
+                ob.ccnurbs.levels = L
+                me_ours = ob.evaluated_get(update()).data
+                ours = cagelib.mesh_positions(me_ours)
+                self.assertIsNone(ccn.sync.status(ob).error)
+                self.assertTrue((ours == corner).all(axis=1).any(), "the corner moved")
+                cp = ob.copy()
+                cp.data = ob.data.copy()
+                bpy.context.scene.collection.objects.link(cp)
+                cp.modifiers.remove(ccn.modifier.get_modifier(cp))
+                cp.ccnurbs.role = 'NONE'
+                m = cp.modifiers.new("Subsurf", 'SUBSURF')
+                m.levels, m.use_limit_surface, m.quality = L, True, QUALITY
+                m.use_creases = use_creases
+                me = cp.evaluated_get(update()).data
+                ref = cagelib.mesh_positions(me)
+                n_edges = len(me.edges)
+                bpy.data.objects.remove(cp)
+                size = float(np.linalg.norm(ref.max(0) - ref.min(0)))
+                self.assertEqual(len(ours), len(ref), "vertex count, level %d" % L)
+                self.assertEqual(len(me_ours.edges), n_edges, "edge count, level %d" % L)
+                d = set_distance(ours, ref) / size
+                self.assertLessEqual(d, TOL, "use_creases %s, level %d" % (use_creases, L))
+        print("measure creases: cube with loose edges and vertices vs Subdivision Surface, "
+              "levels 1-2: %.2e of size" % d)

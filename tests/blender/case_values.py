@@ -65,7 +65,9 @@ class TestSmallItems(AddonTestCase):
         self.assertEqual(ccn.sync.status(ob).loose, (3, 1))  # a, b, c in no face; 1 edge
         bpy.context.view_layer.objects.active = ob
         shown = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))
-        self.assertIn("ignored: 3 loose verts, 1 loose edges", shown)
+        self.assertIn("loose: 3 vertices, 1 edges (carried as Subdivision Surface carries them)",
+                      shown)
+        self.assertNotIn("sharp vertices", shown)  # loose ends in no face: nothing to sharpen
 
     def test_deleting_all_faces_shows_the_cage(self):
         ob = add_modifier(grid(2, "NoFaces"))
