@@ -5,8 +5,6 @@ The library names the element by its index in the cage it was given: the mesh af
 above CCNURBS. Without such modifiers (or with deform-only ones) that is the object's own mesh, and
 the element is selected there; otherwise the panel says to apply or disable them first.
 """
-import re
-
 import bmesh
 import bpy
 
@@ -14,31 +12,29 @@ from . import modifier, sync
 
 ELEM_VERTEX, ELEM_EDGE, ELEM_FACE = 1, 2, 3
 
-# (pattern in the library's message, what to do)
-_ADVICE = (
-    ("repeats vertex", "Merge by Distance or Mesh > Clean Up > Degenerate Dissolve."),
-    ("vertices (at least 3 needed)", "Delete this face (it has fewer than 3 corners)."),
-    ("non-finite coordinate", "Move this vertex to a finite position or delete it."),
-    ("coordinate beyond", "Scale the mesh down: coordinates must stay below 1e300."),
-    ("NaN crease", "Set this element's crease to a number (Shift+E)."),
-    ("valence", "Split this vertex's fan (dissolve some of its edges): at most 1024 edges "
-                "can meet at a vertex."),
-    ("sides; the limit surface", "Split this face (Knife, or Poke Faces)."),
-    ("cage has no faces", "Add faces: only faces are subdivided."),
-    ("the add-on cannot write the limit surface into linked data",
-     "Append the object instead of linking it (File > Append), or make it local (Object > "
-     "Relations > Make Local)."),
-    ("of memory is free", "Each level needs four times the memory of the one below: lower the "
-                          "levels, or close programs that hold memory."),
-    ("out of memory", "Lower the levels: the limit mesh did not fit in memory."),
-)
+# what to do, by the failure's reason (native.REASONS: the library's ccn_reason; the add-on's own)
+_ADVICE = {
+    "face_repeats_vertex": "Merge by Distance or Mesh > Clean Up > Degenerate Dissolve.",
+    "face_too_few_vertices": "Delete this face (it has fewer than 3 corners).",
+    "index_out_of_range": "The mesh is inconsistent: Mesh > Clean Up, or re-import it.",
+    "nonfinite_coordinate": "Move this vertex to a finite position or delete it.",
+    "coordinate_range": "Scale the mesh down: coordinates must stay below 1e300.",
+    "nan_sharpness": "Set this element's crease to a number (Shift+E).",
+    "valence_limit": "Split this vertex's fan (dissolve some of its edges): at most 1024 edges "
+                     "can meet at a vertex.",
+    "face_size_limit": "Split this face (Knife, or Poke Faces).",
+    "no_faces": "Add faces: only faces are subdivided.",
+    "linked_data": "Append the object instead of linking it (File > Append), or make it local "
+                   "(Object > Relations > Make Local).",
+    "levels_refused": "Each level needs four times the memory of the one below: lower the "
+                      "levels, or close programs that hold memory.",
+    "out_of_memory": "Lower the levels: the limit mesh did not fit in memory.",
+}
 
 
-def advice(message):
-    for pat, what in _ADVICE:
-        if pat in message:
-            return what
-    return ""
+def advice(st):
+    """What to do about the status' failure ("" if there is nothing to advise)."""
+    return _ADVICE.get(getattr(st, "reason", None) or "", "") if st is not None else ""
 
 
 def selectable(st):
@@ -47,11 +43,10 @@ def selectable(st):
         return None
     kind, index = st.element
     pair = None
-    if kind == ELEM_EDGE:  # edges are named by their vertices: "edge 7-8 ..."
-        m = re.search(r"edge (\d+)-(\d+)", st.error) or re.search(r"vertices (\d+)-(\d+)", st.error)
-        if not m:
+    if kind == ELEM_EDGE:  # an edge is selected by its two vertices
+        pair = getattr(st, "element_verts", None)
+        if not pair:
             return None
-        pair = (int(m.group(1)), int(m.group(2)))
     elif kind not in (ELEM_VERTEX, ELEM_FACE) or index < 0:
         return None
     return kind, index, pair
@@ -105,7 +100,7 @@ class OBJECT_OT_ccnurbs_select_error(bpy.types.Operator):
         if what is None:
             self.report({'WARNING'}, "The element the error names is not in this mesh")
             return {'CANCELLED'}
-        self.report({'INFO'}, "Selected %s: %s" % (what, advice(sync.status(obj, 'VIEW').error)
+        self.report({'INFO'}, "Selected %s: %s" % (what, advice(sync.status(obj, 'VIEW'))
                                                    or "see the panel"))
         return {'FINISHED'}
 

@@ -31,21 +31,34 @@ FVAR_LINEAR = {"SMOOTH_ALL": 0, "PRESERVE_CORNERS": 1, "PRESERVE_CORNERS_AND_JUN
                "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": 3, "PRESERVE_BOUNDARIES": 4, "NONE": 5}
 
 
-class CCNError(Exception):
-    """A library call failed. `status` is the ccn_status name, str(e) the library's message."""
+# ccn_reason (ccnurbs.h), by name; the add-on's own failures have names of their own
+# ("levels_refused", "linked_data")
+REASONS = ("none", "other", "no_faces", "nonfinite_coordinate", "coordinate_range",
+           "nan_sharpness", "face_too_few_vertices", "face_repeats_vertex", "index_out_of_range",
+           "valence_limit", "face_size_limit", "out_of_memory")
 
-    def __init__(self, status, message, element_kind=0, element=-1):
+
+class CCNError(Exception):
+    """A library call failed. `status` is the ccn_status name, str(e) the library's message,
+    `reason` a REASONS name (what the advice keys on), `element_verts` an edge's two vertices."""
+
+    def __init__(self, status, message, element_kind=0, element=-1, reason="other",
+                 element_verts=None):
         super().__init__(message)
         self.status = status
         self.element_kind = element_kind
         self.element = element
+        self.reason = reason
+        self.element_verts = element_verts
 
 
 class ccn_error(ctypes.Structure):
     _fields_ = [("status", ctypes.c_int),
                 ("element_kind", ctypes.c_int32),
                 ("element", ctypes.c_int32),
-                ("message", ctypes.c_char * 256)]
+                ("message", ctypes.c_char * 256),
+                ("reason", ctypes.c_int32),
+                ("element_verts", ctypes.c_int32 * 2)]
 
 
 class ccn_cage(ctypes.Structure):
@@ -248,7 +261,9 @@ def status_name(status):
 
 def _raise(status, err):
     msg = err.message.decode("utf-8", "replace").strip() or status_name(status)
-    raise CCNError(status_name(status), msg, err.element_kind, err.element)
+    reason = REASONS[err.reason] if 0 <= err.reason < len(REASONS) else "other"
+    verts = tuple(err.element_verts) if err.element_verts[0] >= 0 else None
+    raise CCNError(status_name(status), msg, err.element_kind, err.element, reason, verts)
 
 
 def _ptr(arr, ctype):

@@ -46,7 +46,7 @@ pending_normals = set()  # names of cages whose viewport proxy waits for its exa
 
 class Status:
     __slots__ = ("error", "num_verts", "num_faces", "sizes", "seconds", "kind", "levels",
-                 "showing", "loose", "element", "key")
+                 "showing", "loose", "element", "key", "reason", "element_verts")
 
     def __init__(self, kind, levels=0, error=None):
         self.kind, self.levels, self.error = kind, levels, error
@@ -56,6 +56,8 @@ class Status:
         self.showing = "limit"   # limit | last valid limit | cage
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
         self.element = None      # (ccn_element_kind, index) an error names (errors.py)
+        self.reason = None       # the error's reason (native.REASONS; errors.advice keys on it)
+        self.element_verts = None  # an edge element's two vertices
         self.key = None          # the proxy key it describes (sync_object)
 
 
@@ -107,7 +109,7 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
         why = memory.refusal(cage.face_sizes, levels,
                              "Levels Viewport" if key_name[1] == 'VIEW' else "Render levels")
         if why:  # before anything is allocated (memory.py)
-            raise native.CCNError("CCN_ERR_MEMORY", why)
+            raise native.CCNError("CCN_ERR_MEMORY", why, reason="levels_refused")
         sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
         vsharp = cagemod.sharpness(cage.vertex_creases) if s.use_creases else None
         ends = cage.loose_edge_ends()
@@ -244,6 +246,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     except native.CCNError as e:
         st.error = str(e)
         st.element = (e.element_kind, e.element) if e.element >= 0 else None
+        st.reason, st.element_verts = e.reason, e.element_verts
         stats["errors"] += 1
         if not len(cage.face_sizes) and p is not None:  # nothing to show but the cage itself
             proxies.clear(p)
@@ -283,6 +286,7 @@ def linked_cage(obj, kind):
     lib = obj.library.filepath if obj.library is not None else ""
     st = Status(kind, error="linked from %s: the add-on cannot write the limit surface into "
                 "linked data, so the cage is shown" % (bpy.path.basename(lib) or "a library"))
+    st.reason = "linked_data"
     st.showing = "cage"
     _status[(obj.name_full, kind)] = st
     return st

@@ -57,7 +57,7 @@ def _draw_status(layout, obj):
         col.label(text=error_heading(st), icon='ERROR')
         for line in _wrap(st.error, 48):
             col.label(text=line)
-        what = errors.advice(st.error)
+        what = errors.advice(st)
         if what:
             col = box.column()
             for i, line in enumerate(_wrap(what, 48)):

@@ -15,7 +15,15 @@ ccn_status ccn__fail(ccn_error *err, ccn_status st, int32_t kind, int32_t elemen
         err->status = st;
         err->element_kind = kind;
         err->element = element;
+        err->reason = st == CCN_OK ? CCN_REASON_NONE
+                    : st == CCN_ERR_MEMORY ? CCN_REASON_OUT_OF_MEMORY : CCN_REASON_OTHER;
+        err->element_verts[0] = err->element_verts[1] = -1;
     }
+    return st;
+}
+
+ccn_status ccn__because(ccn_error *err, ccn_reason reason, ccn_status st) {
+    if (err) err->reason = (int32_t)reason;
     return st;
 }
 
@@ -25,6 +33,8 @@ void ccn__ok(ccn_error *err) {
         err->element_kind = CCN_ELEM_NONE;
         err->element = -1;
         err->message[0] = '\0';
+        err->reason = CCN_REASON_NONE;
+        err->element_verts[0] = err->element_verts[1] = -1;
     }
 }
 

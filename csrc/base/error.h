@@ -5,6 +5,9 @@
 
 #include "ccnurbs.h"
 
+/* ccn__because(err, CCN_REASON_X, ccn__fail(err, ...)): the failure's reason (ccn__fail sets
+ * CCN_REASON_OTHER, or CCN_REASON_OUT_OF_MEMORY for CCN_ERR_MEMORY). */
+ccn_status ccn__because(ccn_error *err, ccn_reason reason, ccn_status st);
 ccn_status ccn__fail(ccn_error *err, ccn_status st, int32_t kind, int32_t element,
                      const char *fmt, ...)
 #if defined(__GNUC__)

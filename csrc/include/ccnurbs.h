@@ -47,11 +47,30 @@ typedef enum {
     CCN_ELEM_VALUE /* a value of a face-varying channel (or of per-vertex data) */
 } ccn_element_kind;
 
+/* What failed, for the failures an application can act on (ccn_error.reason): applications
+ * key their advice on these, never on the message text. */
+typedef enum {
+    CCN_REASON_NONE = 0,                /* no failure */
+    CCN_REASON_OTHER,                   /* see status and message */
+    CCN_REASON_NO_FACES,                /* the cage has no face */
+    CCN_REASON_NONFINITE_COORDINATE,    /* a vertex at NaN or Inf (element: the vertex) */
+    CCN_REASON_COORDINATE_RANGE,        /* a coordinate beyond +-CCN_COORD_MAX */
+    CCN_REASON_NAN_SHARPNESS,           /* a NaN crease (element: the edge or vertex) */
+    CCN_REASON_FACE_TOO_FEW_VERTICES,   /* a face of fewer than 3 vertices */
+    CCN_REASON_FACE_REPEATS_VERTEX,     /* a face uses a vertex twice */
+    CCN_REASON_INDEX_OUT_OF_RANGE,      /* a face names a vertex the cage does not have */
+    CCN_REASON_VALENCE_LIMIT,           /* a vertex of more edges than the limit surface supports */
+    CCN_REASON_FACE_SIZE_LIMIT,         /* a face of more sides than the limit surface supports */
+    CCN_REASON_OUT_OF_MEMORY            /* an allocation failed or the result would be too large */
+} ccn_reason;
+
 typedef struct {
     ccn_status status;
     int32_t element_kind; /* ccn_element_kind */
     int32_t element;      /* 0-based index of the offending element, -1 if none */
     char message[256];    /* human-readable, names the element ("face 12 has ...") */
+    int32_t reason;       /* ccn_reason */
+    int32_t element_verts[2]; /* an edge element's two vertices, else -1 -1 */
 } ccn_error;
 
 /* A polygon soup cage. Knot intervals and creases are given per edge, an edge being identified

@@ -196,15 +196,17 @@ static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cach
     for (int32_t v = 0; v < cage_mesh->nv && !st; v++)
         if (cage_mesh->vfan_start[v + 1] > cage_mesh->vfan_start[v] &&
             ccn__valence(cage_mesh, v) > CCN_EV_MATRIX_MAX_VALENCE)
-            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cage_mesh->vrep ? cage_mesh->vrep[v] : v,
-                           "vertex %d has valence %d; the limit surface supports at most %d",
-                           (int)(cage_mesh->vrep ? cage_mesh->vrep[v] : v),
-                           (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE);
+            st = ccn__because(err, CCN_REASON_VALENCE_LIMIT,
+                              ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cage_mesh->vrep ? cage_mesh->vrep[v] : v,
+                                        "vertex %d has valence %d; the limit surface supports at most %d",
+                                        (int)(cage_mesh->vrep ? cage_mesh->vrep[v] : v),
+                                        (int)ccn__valence(cage_mesh, v), CCN_EV_MATRIX_MAX_VALENCE));
     for (int32_t f = 0; f < cage_mesh->nf && !st; f++)
         if (ccn__fsize(cage_mesh, f) > CCN_EV_MATRIX_MAX_VALENCE)
-            st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
-                           "face %d has %d sides; the limit surface supports at most %d",
-                           (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE);
+            st = ccn__because(err, CCN_REASON_FACE_SIZE_LIMIT,
+                              ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                        "face %d has %d sides; the limit surface supports at most %d",
+                                        (int)f, (int)ccn__fsize(cage_mesh, f), CCN_EV_MATRIX_MAX_VALENCE));
     if (st) goto fail;
     if (prev && prev->R >= 1 && same_plan_topology(prev, &o, cage_mesh)) p->hint = prev;
     if (prev && prev->ev_cache && ccn__ev_cache_count(prev->ev_cache) <= CCN_EV_CACHE_CARRY) {

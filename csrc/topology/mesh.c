@@ -251,7 +251,8 @@ static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err)
                          "negative count (verts %d, faces %d, edges %d)", (int)c->num_verts,
                          (int)c->num_faces, (int)c->num_edges);
     if (c->num_faces == 0)
-        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "cage has no faces");
+        return ccn__because(err, CCN_REASON_NO_FACES,
+                            ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "cage has no faces"));
     if (!c->positions || !c->face_sizes || !c->face_verts)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "cage positions, face_sizes or face_verts is NULL");
@@ -262,27 +263,34 @@ static ccn_status check_args(const ccn_cage *c, int64_t *nh_out, ccn_error *err)
         for (int k = 0; k < 3; k++) {
             double x = c->positions[3 * (size_t)v + k];
             if (!isfinite(x))
-                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
-                                 "vertex %d has a non-finite coordinate (NaN or Inf)", (int)v);
+                return ccn__because(err, CCN_REASON_NONFINITE_COORDINATE,
+                                    ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                              "vertex %d has a non-finite coordinate (NaN or Inf)", (int)v));
             if (fabs(x) > CCN_COORD_MAX)
-                return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
-                                 "vertex %d has a coordinate beyond +-%g", (int)v, CCN_COORD_MAX);
+                return ccn__because(err, CCN_REASON_COORDINATE_RANGE,
+                                    ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                              "vertex %d has a coordinate beyond +-%g", (int)v, CCN_COORD_MAX));
         }
     for (int32_t i = 0; c->edge_creases && i < c->num_edges; i++)
-        if (isnan(c->edge_creases[i]))
-            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_EDGE, i,
-                             "edge %d (vertices %d-%d) has a NaN crease sharpness", (int)i,
-                             (int)c->edge_verts[2 * i], (int)c->edge_verts[2 * i + 1]);
+        if (isnan(c->edge_creases[i])) {
+            ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_EDGE, i,
+                      "edge %d (vertices %d-%d) has a NaN crease sharpness", (int)i,
+                      (int)c->edge_verts[2 * i], (int)c->edge_verts[2 * i + 1]);
+            if (err) err->element_verts[0] = c->edge_verts[2 * i], err->element_verts[1] = c->edge_verts[2 * i + 1];
+            return ccn__because(err, CCN_REASON_NAN_SHARPNESS, CCN_ERR_ARGUMENT);
+        }
     for (int32_t v = 0; c->vertex_creases && v < c->num_verts; v++)
         if (isnan(c->vertex_creases[v]))
-            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
-                             "vertex %d has a NaN crease sharpness", (int)v);
+            return ccn__because(err, CCN_REASON_NAN_SHARPNESS,
+                                ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, v,
+                                          "vertex %d has a NaN crease sharpness", (int)v));
     int64_t nh = 0;
     for (int32_t f = 0; f < c->num_faces; f++) {
         int32_t s = c->face_sizes[f];
         if (s < 3)
-            return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
-                             "face %d has %d vertices (at least 3 needed)", (int)f, (int)s);
+            return ccn__because(err, CCN_REASON_FACE_TOO_FEW_VERTICES,
+                                ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                          "face %d has %d vertices (at least 3 needed)", (int)f, (int)s));
         nh += s;
         if (nh > INT32_MAX / 8)
             return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_FACE, f,
@@ -300,13 +308,15 @@ static ccn_status fill_faces(ccn_mesh *m, const ccn_cage *c, ccn_error *err) {
         for (int32_t k = 0; k < s; k++, h++) {
             int32_t v = c->face_verts[h];
             if (v < 0 || v >= m->nv)
-                return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
-                                 "face %d uses vertex index %d, out of range [0, %d)", (int)f,
-                                 (int)v, (int)m->nv);
+                return ccn__because(err, CCN_REASON_INDEX_OUT_OF_RANGE,
+                                    ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                              "face %d uses vertex index %d, out of range [0, %d)",
+                                              (int)f, (int)v, (int)m->nv));
             for (int32_t j = 0; j < k; j++)
                 if (c->face_verts[m->fstart[f] + j] == v)
-                    return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
-                                     "face %d repeats vertex %d", (int)f, (int)v);
+                    return ccn__because(err, CCN_REASON_FACE_REPEATS_VERTEX,
+                                        ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, f,
+                                                  "face %d repeats vertex %d", (int)f, (int)v));
             m->hvert[h] = v;
             m->hface[h] = f;
         }
@@ -566,11 +576,13 @@ ccn_status ccn_mesh_set_positions(ccn_mesh *m, const double *positions, ccn_erro
     int32_t nv = m->vweld ? m->nvw : m->nv; /* a split cage: one position per welded vertex */
     for (int32_t i = 0; i < 3 * nv; i++) {
         if (!isfinite(positions[i]))
-            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
-                             "vertex %d has a non-finite coordinate (NaN or Inf)", (int)(i / 3));
+            return ccn__because(err, CCN_REASON_NONFINITE_COORDINATE,
+                                ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
+                                          "vertex %d has a non-finite coordinate (NaN or Inf)", (int)(i / 3)));
         if (fabs(positions[i]) > CCN_COORD_MAX)
-            return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
-                             "vertex %d has a coordinate beyond +-%g", (int)(i / 3), CCN_COORD_MAX);
+            return ccn__because(err, CCN_REASON_COORDINATE_RANGE,
+                                ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_VERTEX, i / 3,
+                                          "vertex %d has a coordinate beyond +-%g", (int)(i / 3), CCN_COORD_MAX));
     }
     if (m->vweld)
         for (int32_t v = 0; v < m->nv; v++)

@@ -297,7 +297,7 @@ class TestCreases(AddonTestCase):
         st = ccn.sync.status(ob, 'VIEW')
         self.assertIsNotNone(st.error)
         self.assertIn("vertex 4 has a non-finite coordinate", st.error)
-        self.assertTrue(ccn.errors.advice(st.error))
+        self.assertTrue(ccn.errors.advice(st))
         self.assertIsNotNone(ccn.errors.selectable(st))
         bpy.context.view_layer.objects.active = ob
         text = labels(draw_panel(ccn.ui.DATA_PT_ccnurbs_modifier))

@@ -489,7 +489,7 @@ class TestModifier(AddonTestCase):
         self.assertIn("of memory is free: lower Levels Viewport", st.error)
         self.assertEqual(st.showing, "last valid limit")
         np.testing.assert_array_equal(P, good)  # the last limit stays
-        self.assertIn("lower the levels", ccn.errors.advice(st.error))
+        self.assertIn("lower the levels", ccn.errors.advice(st))
         # with 50 MB free, levels 3 (32k faces, ~51 MB) is refused, and built once it fits
         free = ccn.memory.free_bytes
         try:

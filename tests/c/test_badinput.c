@@ -268,6 +268,58 @@ static void row_two_gon(void) {
     expect_err(&cn, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, 1, "face 1 has -3 vertices");
 }
 
+/* Each failure an application acts on has its reason code (ccn_error.reason), so advice never
+ * reads the message; an edge names its two vertices (element_verts). */
+static ccn_reason reason_of(const ccn_cage *c, ccn_error *err) {
+    ccn_mesh *m = NULL;
+    memset(err, 0x5A, sizeof *err);
+    ccn_status st = ccn_mesh_create(c, &m, err);
+    ccn_mesh_destroy(m);
+    return st == CCN_OK ? CCN_REASON_NONE : (ccn_reason)err->reason;
+}
+
+static void row_reason_codes(void) {
+    ccn_error err;
+    ccn_cage ok = cage_of(4, 1, SQ, SQ_FS, SQ_FV);
+    CHECK(reason_of(&ok, &err) == CCN_REASON_NONE && err.reason == CCN_REASON_NONE, "ok: %d", err.reason);
+    double p[12];
+    memcpy(p, SQ, sizeof p);
+    p[4] = NAN;
+    ccn_cage nan = cage_of(4, 1, p, SQ_FS, SQ_FV);
+    CHECK(reason_of(&nan, &err) == CCN_REASON_NONFINITE_COORDINATE, "NaN: %d", err.reason);
+    p[4] = 1e305;
+    CHECK(reason_of(&nan, &err) == CCN_REASON_COORDINATE_RANGE, "range: %d", err.reason);
+    int32_t ev[2] = {1, 2};
+    double cr[1] = {NAN};
+    ccn_cage nc = cage_of(4, 1, SQ, SQ_FS, SQ_FV);
+    nc.num_edges = 1, nc.edge_verts = ev, nc.edge_creases = cr;
+    CHECK(reason_of(&nc, &err) == CCN_REASON_NAN_SHARPNESS, "NaN crease: %d", err.reason);
+    CHECK(err.element_kind == CCN_ELEM_EDGE && err.element_verts[0] == 1 && err.element_verts[1] == 2,
+          "edge vertices %d-%d", err.element_verts[0], err.element_verts[1]);
+    int32_t fs2[2] = {4, 2}, fv2[6] = {0, 1, 2, 3, 1, 0};
+    ccn_cage two = cage_of(4, 2, SQ, fs2, fv2);
+    CHECK(reason_of(&two, &err) == CCN_REASON_FACE_TOO_FEW_VERTICES, "2-gon: %d", err.reason);
+    CHECK(err.element_verts[0] == -1, "no edge: %d", err.element_verts[0]);
+    int32_t fvr[4] = {0, 1, 2, 1};
+    ccn_cage rep = cage_of(4, 1, SQ, SQ_FS, fvr);
+    CHECK(reason_of(&rep, &err) == CCN_REASON_FACE_REPEATS_VERTEX, "repeat: %d", err.reason);
+    int32_t fvo[4] = {0, 1, 2, 9};
+    ccn_cage out = cage_of(4, 1, SQ, SQ_FS, fvo);
+    CHECK(reason_of(&out, &err) == CCN_REASON_INDEX_OUT_OF_RANGE, "range: %d", err.reason);
+    ccn_cage none = cage_of(4, 0, SQ, SQ_FS, SQ_FV);
+    CHECK(reason_of(&none, &err) == CCN_REASON_NO_FACES, "no faces: %d", err.reason);
+    /* the plan's limits */
+    soup s = fan(1100);
+    ccn_cage big = soup_cage(&s);
+    ccn_plan *pl = NULL;
+    ccn_options o = {0};
+    o.levels = 1;
+    CHECK(ccn_plan_create(&big, &o, &pl, &err) != CCN_OK && err.reason == CCN_REASON_VALENCE_LIMIT,
+          "valence: %d (%s)", err.reason, err.message);
+    ccn_plan_destroy(pl);
+    soup_free(&s);
+}
+
 /* The same face twice (same orientation: its edges are used twice in one direction) and three
  * times (edges shared by three faces): non-manifold, accepted. A reversed duplicate is a closed
  * two-face "pillow" of interior valence-2 vertices (row_interior_valence2, test_fixed_bugs.c). */
@@ -594,6 +646,7 @@ int main(void) {
     RUN(row_bowtie_vertex);
     RUN(row_repeated_vertex);
     RUN(row_two_gon);
+    RUN(row_reason_codes);
     RUN(row_duplicate_faces);
     RUN(row_valence_200);
     RUN(row_empty_mesh);
