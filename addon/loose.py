@@ -160,5 +160,5 @@ class WithLoose:
 
 
 def unwrap(plan):
-    """The native plan inside (ccn_plan_recreate consumes the plan itself, not a wrapper)."""
+    """The native plan inside (a plan made with options.previous consumes the plan itself, not a wrapper)."""
     return plan._plan if isinstance(plan, WithLoose) else plan

@@ -1,8 +1,8 @@
 """ctypes binding to the CCNURBS library shipped inside this package: one package per platform
 (libccnurbs.so / ccnurbs.dll / libccnurbs.dylib, OpenBLAS beside it; see blender_manifest.toml).
 
-Only the plan API is bound: ccn_plan_create_cached (with the session's ccn_cache) or, after
-an edit, ccn_plan_recreate (from the plan it replaces) / ccn_plan_sizes / ccn_plan_evaluate (the first
+Only the plan API is bound: ccn_plan_create (with the session's ccn_cache and, after an edit,
+the plan it replaces, in its options) / ccn_plan_sizes / ccn_plan_evaluate (the first
 evaluation after an edit: ccn_plan_evaluate_changed) / ccn_plan_destroy, and its face-varying channels and
 per-vertex data (ccn_plan_add_fvar / ccn_plan_fvar_sizes / ccn_plan_evaluate_fvar /
 ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
@@ -81,7 +81,9 @@ class ccn_options(ctypes.Structure):
                 ("boundary_corners", ctypes.c_int32),
                 ("threads", ctypes.c_int32),
                 ("crease_method", ctypes.c_int32),
-                ("ev_polyhedron", ctypes.c_int32)]
+                ("ev_polyhedron", ctypes.c_int32),
+                ("cache", ctypes.c_void_p),
+                ("previous", ctypes.c_void_p)]
 
 
 class ccn_sizes(ctypes.Structure):
@@ -166,12 +168,6 @@ def _bind(lib):
     lib.ccn_plan_create.argtypes = [ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
                                     ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
     lib.ccn_plan_create.restype = ctypes.c_int
-    lib.ccn_plan_create_cached.argtypes = [ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
-                                           P, ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
-    lib.ccn_plan_create_cached.restype = ctypes.c_int
-    lib.ccn_plan_recreate.argtypes = [P, ctypes.POINTER(ccn_cage), ctypes.POINTER(ccn_options),
-                                      P, ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
-    lib.ccn_plan_recreate.restype = ctypes.c_int
     lib.ccn_cache_create.argtypes = [ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
     lib.ccn_cache_create.restype = ctypes.c_int
     lib.ccn_plan_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
@@ -277,7 +273,7 @@ class Plan:
     edge_knots (E,) or None (<= 0, NaN, Inf: unset), edge_sharpness (E,) or None and
     vertex_sharpness (V,) or None (OpenSubdiv sharpness: ccn_cage.edge_creases / vertex_creases).
     options: scheme/cap/boundary/crease_method (enum identifiers), levels.
-    previous: the open Plan this one replaces after an edit, given up (ccn_plan_recreate: where
+    previous: the open Plan this one replaces after an edit, given up (options.previous: where
     topology, creases and options are the same, e.g. an interval edit, its topology moves over
     and its unchanged stencils are reused; otherwise it is only freed). It is closed by the
     call, also when the call fails.
@@ -331,14 +327,16 @@ class Plan:
                            crease_method=CREASE_METHODS[crease_method])
         handle = ctypes.c_void_p()
         err = ccn_error()
+        # the session's operators, and the plan this one replaces (consumed by the call,
+        # whatever it returns)
+        cache = _cache(lib)
+        opts.cache = cache.value if cache is not None else None
         prev = previous._handle if previous is not None else None
         if prev is not None:
-            previous._handle = None  # consumed by the call, whatever it returns
-            st = lib.ccn_plan_recreate(prev, ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
-                                       ctypes.byref(handle), ctypes.byref(err))
-        else:
-            st = lib.ccn_plan_create_cached(ctypes.byref(cage), ctypes.byref(opts), _cache(lib),
-                                            ctypes.byref(handle), ctypes.byref(err))
+            previous._handle = None
+            opts.previous = prev.value
+        st = lib.ccn_plan_create(ctypes.byref(cage), ctypes.byref(opts), ctypes.byref(handle),
+                                 ctypes.byref(err))
         if st != 0:
             _raise(st, err)
         self._handle = handle

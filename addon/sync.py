@@ -117,7 +117,7 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
             vsharp = np.zeros(cage.num_verts) if vsharp is None else np.array(vsharp, np.float64)
             vsharp[ends] = 10.0
         # the old plan gives its topology and unchanged stencils to an interval edit's plan
-        # (ccn_plan_recreate, which consumes it; only freed when topology, creases or options
+        # (ccn_plan_create with options.previous, which consumes it; only freed when topology, creases or options
         # differ)
         plan = native.Plan(cage.positions, cage.face_sizes, cage.face_verts, cage.edge_verts,
                            cage.knots, scheme=s.scheme, cap=s.cap, boundary=s.boundary_smooth,

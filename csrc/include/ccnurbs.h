@@ -90,6 +90,9 @@ typedef struct {
     const double *vertex_creases; /* num_verts vertex sharpness (corners), may be NULL */
 } ccn_cage;
 
+typedef struct ccn_plan ccn_plan;   /* opaque: topology, intervals, options, precomputed data */
+typedef struct ccn_cache ccn_cache; /* opaque: what plans can share (ccn_cache_create) */
+
 typedef struct {
     ccn_scheme scheme;        /* default EIGEN */
     ccn_cap cap;              /* default GUIDED_BI5 */
@@ -99,6 +102,10 @@ typedef struct {
     int32_t crease_method;    /* ccn_crease_method, default UNIFORM */
     int32_t ev_polyhedron;    /* scheme EIGEN: CCN_POLY_SELECT (default, the per-vertex choice
                                  of ccn_ev_matrix) or one fixed candidate CCN_POLY_PAPER.. */
+    ccn_cache *cache;         /* ccn_plan_create: operators shared between plans, NULL = the
+                                 plan's own (other calls ignore it) */
+    ccn_plan *previous;       /* ccn_plan_create: the plan this one replaces after an edit,
+                                 NULL = none; consumed (see ccn_plan_create) */
 } ccn_options;
 
 /* ---- control meshes ------------------------------------------------------------ */
@@ -233,7 +240,6 @@ ccn_status ccn_ev_matrix_polyhedron(int32_t n, const double *spoke_knots, ccn_sc
 
 /* ---- limit surface: plan once, evaluate many times ------------------------------ */
 
-typedef struct ccn_plan ccn_plan; /* opaque: topology, intervals, options, precomputed data */
 
 typedef struct {
     int32_t num_verts;        /* output mesh vertices */
@@ -288,34 +294,28 @@ typedef struct {
  * normals are exact (from derivatives). */
 ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
                            ccn_error *err);
-/* What plans can share: the guided bi-5 operator of each valence (built once, ~0.4 s at valence
- * 32, a few ms at 3-8). Owned by the caller; thread-safe (plans may be created with one cache
- * from several threads); destroy it after every plan created with it. */
-typedef struct ccn_cache ccn_cache;
+/* The plan's two optional inputs, in its options (as OpenSubdiv's Bfr carries its cache):
+ *  - opts->cache: the guided bi-5 operator of each valence, built once (~0.4 s at valence 32,
+ *    a few ms at 3-8) and shared: identical output. Owned by the caller; thread-safe (plans may
+ *    be created with one cache from several threads); the plan borrows it, so destroy the cache
+ *    after every plan created with it.
+ *  - opts->previous: the plan made for the cage before an edit, typically of its knot
+ *    intervals (an interval edit). Where the cage's topology (faces, edges), creases and options
+ *    (but threads) equal previous's, the levels' and output mesh's topology move over (no copy,
+ *    no new memory), and the limit stencils, rule weights and cap parameters (taus) that read no
+ *    changed interval (compared in the caller's units) are copied; everything else is made
+ *    anew. The output is byte-identical to a plan made without it (intervals are normalised by
+ *    powers of two, so the copies are exact). Otherwise previous is only freed. previous is
+ *    destroyed by the call whatever it returns: do not use or destroy it afterwards (clear the
+ *    options' pointer). Face-varying channels are not carried over: add them to the new plan. */
 ccn_status ccn_cache_create(ccn_cache **out, ccn_error *err);
 void ccn_cache_destroy(ccn_cache *cache);
-/* ccn_plan_create with a cache (NULL = ccn_plan_create): identical output, the operators taken
- * from the cache. The plan borrows them: the cache must outlive the plan. */
-ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
-                                  ccn_plan **out, ccn_error *err);
-/* ccn_plan_create_cached after an edit of the cage `prev` was made for, typically its knot
- * intervals (an interval edit), consuming prev: where the cage's topology (faces, edges),
- * creases and options (but threads) equal prev's, the levels' and output mesh's topology move
- * over from prev (no copy, no new memory), and the limit stencils, rule weights and cap
- * parameters (taus) that read no changed interval (compared in the caller's units) are copied;
- * everything else is made anew. The output is byte-identical to ccn_plan_create_cached's
- * (intervals are normalised by powers of two, so the copies are exact). Otherwise prev is
- * only freed. prev (may be NULL) is destroyed by the call whatever it returns: do not use or
- * destroy it afterwards. Face-varying channels are not carried over: add them to the new
- * plan. */
-ccn_status ccn_plan_recreate(ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
-                             ccn_cache *cache, ccn_plan **out, ccn_error *err);
 ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs
  * (face_verts, face_origin) are the same on every call. */
 ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
                              ccn_error *err);
-/* ccn_plan_evaluate for the first evaluation of a plan made by ccn_plan_recreate: when out
+/* ccn_plan_evaluate for the first evaluation of a plan made with options.previous: when out
  * names the arrays the last evaluation of prev wrote (the same positions, normals and
  * corner_normals pointers, their contents untouched since) and the cage positions are those of
  * that evaluation (an interval edit), only the output values the edit changed are computed and

@@ -269,7 +269,7 @@ static void tabulate(ccn__level *c) {
     c->tab_full = 1;
 }
 
-/* ccn_plan_recreate: the weights of q, a level of the same topology (an earlier plan's), for
+/* a plan made with options.previous: the weights of q, a level of the same topology (an earlier plan's), for
  * every element whose weights read no interval that changed; the first ccn__level_points
  * tabulates the others. An element's rule reads intervals of edges at its vertices only (the
  * face's sides and the transverse ones beyond them, the edge's neighbours along its curve, the

@@ -50,7 +50,7 @@ ccn_status ccn__level_prepare_ev(ccn__level *c, const ccn_mesh *m, int scheme, i
                                  int crease_method, int32_t ev_poly, ccn__ev_cache *cache,
                                  ccn_error *err);
 /* ccn__level_prepare_ev for a level of the same topology and sharpness as like's (an earlier
- * plan's, ccn_plan_recreate; may be NULL): its edge representatives are taken over (moved: NULL
+ * plan's, a plan made with options.previous; may be NULL): its edge representatives are taken over (moved: NULL
  * in like) and, from level 1 on, its EV list copied (both topology only); the EV matrices are
  * made anew (they read the intervals). */
 ccn_status ccn__level_prepare_like(ccn__level *c, const ccn_mesh *m, int scheme, int pinned,
@@ -64,7 +64,7 @@ void ccn__level_points_subset(const ccn__level *c, const int32_t *verts, int32_t
                               double *out);
 void ccn__level_tabulate_subset(ccn__level *c, const int32_t *verts, int32_t nverts);
 /* The tables of q (the same topology, other intervals: an earlier plan's level, evaluated)
- * for the elements whose rules read no changed interval (ccn_plan_recreate). */
+ * for the elements whose rules read no changed interval (ccn_plan_create with options.previous). */
 void ccn__level_tabulate_like(ccn__level *c, const ccn__level *q);
 /* The next-level points of the listed faces, edges and vertices only (each once; every EV's
  * red points too). A point is right when the old points its rule reads are. */

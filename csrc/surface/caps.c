@@ -142,7 +142,7 @@ static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *
            ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, c->taus, zero, NULL, c->patches, e2) == CCN_OK;
 }
 
-/* ccn_plan_recreate: the earlier plan's cap at EV ev of level K, if it has taus and the same
+/* a plan made with options.previous: the earlier plan's cap at EV ev of level K, if it has taus and the same
  * spoke intervals (in the caller's units; the taus depend on their ratios only, bi5.h [R11],
  * which the power-of-two normalisation keeps to the bit), else NULL. hint_caps: the earlier
  * cap per level-K vertex, or -1. */
@@ -290,7 +290,7 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     int32_t *stamp = malloc(sizeof(int32_t) * (size_t)m->nv), *q = malloc(sizeof(int32_t) * (size_t)m->nv);
     if (!p->caps || !stamp || !q) { free(stamp); free(q); return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); }
     for (int32_t v = 0; v < m->nv; v++) stamp[v] = -1;
-    int32_t *hint_caps = NULL; /* ccn_plan_recreate: the earlier plan's caps by EV */
+    int32_t *hint_caps = NULL; /* a plan made with options.previous: the earlier plan's caps by EV */
     if (p->hint && p->hint->K == K && p->hint->ncap && p->hint->lev[K]->nv == m->nv &&
         (hint_caps = malloc(sizeof(int32_t) * (size_t)m->nv))) {
         for (int32_t v = 0; v < m->nv; v++) hint_caps[v] = -1;

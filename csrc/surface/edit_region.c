@@ -1,4 +1,4 @@
-/* What an interval edit changes of the earlier plan's last evaluation (ccn_plan_recreate and
+/* What an interval edit changes of the earlier plan's last evaluation (a plan made with options.previous and
  * ccn_plan_evaluate_changed; surface/edit_region.h).
  *
  * After an interval edit the cage positions are usually those of the earlier plan's last

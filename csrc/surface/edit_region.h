@@ -19,7 +19,7 @@ struct ccn__edit_region {
     const double *out[3];   /* the arrays the earlier plan's last evaluation wrote (its last_out) */
 };
 
-/* During ccn_plan_recreate, after the levels are built (before setup_level_s): when the earlier
+/* During ccn_plan_create with options.previous, after the levels are built (before setup_level_s): when the earlier
  * plan p->hint was evaluated, its levels' points become p's (moved) and p->region records
  * which of them the edit changes; else p->region stays NULL. 0, or -1 when out of memory. */
 int ccn__edit_region_begin(ccn_plan *p);

@@ -121,9 +121,15 @@ static void fill_sizes(ccn_plan *p) {
     }
 }
 
+static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
+                         ccn_plan *prev, ccn_plan **out, ccn_error *err);
+
 ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_plan **out,
                            ccn_error *err) {
-    return ccn_plan_create_cached(cage, opts, NULL, out, err);
+    ccn_plan *prev = opts ? opts->previous : NULL;
+    ccn_status st = create(cage, opts, opts ? opts->cache : NULL, prev, out, err);
+    ccn_plan_destroy(prev); /* consumed: what the new plan took is NULL in it */
+    return st;
 }
 
 /* Does the earlier plan q have cage mesh m's topology and sharpness, and options o (but for
@@ -148,27 +154,13 @@ static int same_plan_topology(const ccn_plan *q, const ccn_options *o, const ccn
 }
 
 static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
-                         ccn_plan *prev, ccn_plan **out, ccn_error *err);
-
-ccn_status ccn_plan_create_cached(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
-                                  ccn_plan **out, ccn_error *err) {
-    return create(cage, opts, cache, NULL, out, err);
-}
-
-ccn_status ccn_plan_recreate(ccn_plan *prev, const ccn_cage *cage, const ccn_options *opts,
-                             ccn_cache *cache, ccn_plan **out, ccn_error *err) {
-    ccn_status st = create(cage, opts, cache, prev, out, err);
-    ccn_plan_destroy(prev); /* consumed: what the new plan took is NULL in it */
-    return st;
-}
-
-static ccn_status create(const ccn_cage *cage, const ccn_options *opts, ccn_cache *cache,
                          ccn_plan *prev, ccn_plan **out, ccn_error *err) {
     ccn__ok(err);
     if (!out) return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "out is NULL");
     *out = NULL;
     ccn_options o = {0};
     if (opts) o = *opts;
+    o.cache = NULL, o.previous = NULL; /* passed apart: the plan keeps no pointer to previous */
     ccn_status st = check_options(&o, err);
     if (st) return st;
     ccn_plan *p = calloc(1, sizeof *p);

@@ -97,9 +97,9 @@ struct ccn_plan {
      * L+1 when built) and of the level-(L+1) subset, allocated on first use */
     double *vd_buf;
     ccn__ev_cache *ev_cache; /* eigen polyhedron choices, shared by every level and limit */
-    ccn_cache *op_cache;     /* the caller's bi-5 operators (ccn_plan_create_cached), or NULL:
+    ccn_cache *op_cache;     /* the caller's bi-5 operators (options.cache), or NULL:
                                 then ops holds the plan's own */
-    /* during ccn_plan_recreate only (NULL otherwise): the earlier plan, of the same cage
+    /* during ccn_plan_create with options.previous only (NULL otherwise): the earlier plan, of the same cage
      * topology, creases and options, consumed by the call: its level topology and output mesh
      * arrays are taken over (moved, not copied), its unchanged limit stencils, rule weights and
      * cap taus copied; destroyed at the end */
@@ -111,7 +111,7 @@ struct ccn_plan {
      * corner_normals): a plan recreated from this one evaluates only what the edit changed
      * when it is given these same arrays again, and everything otherwise */
     const double *last_out[3];
-    /* made by ccn_plan_recreate from an evaluated earlier plan, used and dropped by the next
+    /* made with options.previous from an evaluated earlier plan, used and dropped by the next
      * evaluation: the earlier plan's level points (moved into lev[]) and what the edit changed */
     struct ccn__edit_region *region;
 };

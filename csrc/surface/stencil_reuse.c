@@ -1,5 +1,5 @@
 /* What a recreated plan keeps of the stencil table of the plan it replaces
- * (ccn_plan_recreate; surface/stencil_reuse.h): which rows may have changed, the earlier rows,
+ * (a plan made with options.previous; surface/stencil_reuse.h): which rows may have changed, the earlier rows,
  * the earlier table patched in place. Used by surface/tessellate.c. */
 #include "surface/stencil_reuse.h"
 
@@ -10,7 +10,7 @@
 
 #include <string.h>
 
-/* ccn_plan_recreate: the intervals of level L are q's but near the edges whose interval
+/* a plan made with options.previous: the intervals of level L are q's but near the edges whose interval
  * changed. A regular output vertex's stencil (surface/limit.c) reads the intervals of the
  * edges at its fan's vertices (its own and the ones beyond each neighbour), so it may change
  * where a vertex of one of its faces ends a changed edge: those vertices get 1 in the
@@ -52,7 +52,7 @@ int ccn__earlier_row(const ccn_plan *q, int32_t o, ccn__stencil *s) {
     return 1;
 }
 
-/* ccn_plan_recreate, the stencil table of the earlier plan q patched where intervals moved: the
+/* ccn_plan_create with options.previous, the stencil table of the earlier plan q patched where intervals moved: the
  * regular rows near a changed interval are made again (in threads) into scratch, and when every
  * one of them and every irregular row (made by the caller into ib) has q's row length, q's
  * table is taken over and those rows are written in place (own weights: over the old ones; a

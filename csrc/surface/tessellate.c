@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-/* The earlier plan's output mesh (ccn_plan_recreate: the same level-L topology), moved over. */
+/* The earlier plan's output mesh (a plan made with options.previous: the same level-L topology), moved over. */
 static ccn_status output_topology_like(ccn_plan *p, ccn_plan *q) {
     p->nout_v = q->nout_v;
     p->nout_f = q->nout_f;
@@ -200,8 +200,8 @@ typedef struct {
     uint64_t *hash;        /* per regular output vertex: a hash of its weights (ref < 0) */
     int32_t *ref;          /* per regular output vertex: an earlier one with the same weights,
                               or -1 (its weights are in the table), -2 (the same, not hashed),
-                              or -3 - k: the earlier plan's weight set k (ccn_plan_recreate) */
-    const uint8_t *moved;  /* ccn_plan_recreate: per level-L vertex, 1 where an interval its
+                              or -3 - k: the earlier plan's weight set k (ccn_plan_create with options.previous) */
+    const uint8_t *moved;  /* a plan made with options.previous: per level-L vertex, 1 where an interval its
                               regular stencil reads may have changed; else NULL */
 } stencil_job;
 
@@ -427,7 +427,7 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     stencil_job j = {p, mL, pinned, malloc((size_t)(mL->nv ? mL->nv : 1)), malloc(nslot), slot,
                      len, &ib, istart, &b, malloc(sizeof(uint64_t) * nslot), malloc(sizeof(int32_t) * nslot),
                      NULL};
-    uint8_t *moved = NULL; /* ccn_plan_recreate: the earlier plan's rows where nothing moved */
+    uint8_t *moved = NULL; /* a plan made with options.previous: the earlier plan's rows where nothing moved */
     if (p->hint && p->hint->L == p->L && p->hint->nout_v == nout && p->hint->st_start)
         j.moved = moved = ccn__moved_vertices(mL, p->hint->lev[p->L]);
     p->st_start = malloc(sizeof(int32_t) * ((size_t)nout + 1));
@@ -476,7 +476,7 @@ static ccn_status output_stencils(ccn_plan *p, ccn_error *err) {
     }
     if (moved && p->region && (p->region->redo = malloc(nslot))) /* the rows made again */
         for (int32_t o = 0; o < nout; o++) p->region->redo[o] = !j.fast[o] || moved[p->out_vL[o]];
-    if (moved) { /* ccn_plan_recreate: the earlier table patched in place, where it fits */
+    if (moved) { /* a plan made with options.previous: the earlier table patched in place, where it fits */
         ccn__reuse_rows in = {j.fast, moved, len, istart, ib.v, ib.wp, ib.wu, ib.wv, pinned};
         ccn__reuse_table t = {NULL, NULL, NULL, NULL, 0};
         int r = ccn__patch_stencils(p, &in, &t);

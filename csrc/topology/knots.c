@@ -10,7 +10,7 @@
  * dividing by it is exact: every rule is homogeneous in the intervals (ratios; an interval
  * weight scales with them), so two cages whose intervals differ by a factor give the same
  * weights to the bit, and a plan made after an edit that moves the largest interval can keep
- * the earlier plan's weights, rescaled exactly (ccn_plan_recreate).
+ * the earlier plan's weights, rescaled exactly (ccn_plan_create with options.previous).
  */
 #include "topology/knots.h"
 

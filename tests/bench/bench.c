@@ -12,6 +12,23 @@
 
 #include <sys/resource.h>
 
+/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
+ * options.cache and options.previous (prev is consumed). */
+static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
+                              ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = NULL;
+    return ccn_plan_create(c, &q, out, err);
+}
+static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
+                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = prev;
+    return ccn_plan_create(c, &q, out, err);
+}
+
 static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -58,7 +75,7 @@ int main(int argc, char **argv) {
     if (argc > 7 && strcmp(argv[7], "cached") == 0 && ccn_cache_create(&cache, &err)) return 2;
     for (int r = 0; r < reps; r++) {
         double t0 = now();
-        if (ccn_plan_create_cached(&cage, &o, cache, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+        if (plan_cached(&cage, &o, cache, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
         double t1 = now() - t0;
         if (r == 0) tfirst = t1;
         tplan = t1 < tplan ? t1 : tplan;
@@ -98,7 +115,7 @@ int main(int argc, char **argv) {
            cache ? " (one ccn_cache)" : "");
     /* an interval edit: one ring's interval changed (the cage's first edge, alternately 3 and
      * 1.5 times its interval), the plan made again and evaluated (the add-on's rebuild), by a
-     * new plan and by ccn_plan_recreate from the plan before */
+     * new plan and by ccn_plan_create with options.previous from the plan before */
     {
         int32_t ne = cage.num_edges > 0 ? cage.num_edges : 1;
         int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)ne);
@@ -119,15 +136,15 @@ int main(int argc, char **argv) {
                 ek[0] = base * (r % 2 ? 3.0 : 1.5);
                 ccn_plan *q = NULL;
                 double t0 = now();
-                ccn_status st = way ? ccn_plan_recreate(plan, &ec, &o, cache, &q, &err)
-                                    : ccn_plan_create_cached(&ec, &o, cache, &q, &err);
+                ccn_status st = way ? plan_recreate(plan, &ec, &o, cache, &q, &err)
+                                    : plan_cached(&ec, &o, cache, &q, &err);
                 if (st || (way == 2 ? ccn_plan_evaluate_changed(q, NULL, &lm, &err)
                                     : ccn_plan_evaluate(q, NULL, &lm, &err))) {
                     fprintf(stderr, "%s\n", err.message);
                     return 2;
                 }
                 double t1 = now() - t0;
-                if (!way) ccn_plan_destroy(plan); /* ccn_plan_recreate consumed it */
+                if (!way) ccn_plan_destroy(plan); /* ccn_plan_create with options.previous consumed it */
                 plan = q;
                 if (r == 0) continue; /* the first: from the cage's own intervals */
                 double *t = way == 2 ? &tchg : way ? &trec : &tnew;

@@ -38,7 +38,7 @@ for cl in sphere8k:2 sphere8k:3 sphere50k:2 carlike:2 carlike:3 carlike_knots:2 
   en=$(echo "$c2" | sed -n 's/.*new plan \([0-9.]*\) s.*/\1/p'); er=$(echo "$c2" | sed -n 's/.*recreated \([0-9.]*\) s,.*/\1/p')
   ek=$(echo "$c2" | sed -n 's/.*changed values only \([0-9.]*\) s.*/\1/p')
   os=$(awk -v a="$oc" -v b="$ou" 'BEGIN{printf "%.4f", a + b}')
-  row "interval edit, library, 2 threads: ccn_plan_recreate + evaluate_changed, $cage L$L (a new plan + evaluate: $en s; recreate + a full evaluate: $er s)" \
+  row "interval edit, library, 2 threads: options.previous + evaluate_changed, $cage L$L (a new plan + evaluate: $en s; recreate + a full evaluate: $er s)" \
       "$ek s" "$os s (OSD refiner + stencils + update: its topology change)" "$(ratio "$ek" "$os")" 1.0
   mc=$(echo "$c1" | kb); mo=$(echo "$o" | kb); tb=$(echo "$o" | sed -n 's/.*table \([0-9]*\) bytes.*/\1/p')
   row "peak memory per output vertex, $cage L$L (OSD table alone $(awk -v b="$tb" -v n="$ost" 'BEGIN{printf "%.0f", b/n}') B)" \

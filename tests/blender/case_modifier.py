@@ -115,7 +115,7 @@ class TestModifier(AddonTestCase):
         self.assertIs(ccn.modifier.proxy(ob, 'VIEW').data, proxy_me)
         ccn.modifier.proxy(ob, 'VIEW').data.loops.foreach_get("vertex_index", loops_after)
         np.testing.assert_array_equal(loops_before, loops_after)
-        # more interval edits, each plan made from the one before (ccn_plan_recreate): a new
+        # more interval edits, each plan made from the one before (options.previous): a new
         # largest interval, a small one, the largest back to 1: each equals `ccnurbs limit`,
         # and each wrote only what it changed into the outputs of the plan before
         # (ccn_plan_evaluate_changed: the previous edit's outputs are the plan's own arrays)

@@ -28,6 +28,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
+ * options.cache and options.previous (prev is consumed). */
+static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
+                              ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = NULL;
+    return ccn_plan_create(c, &q, out, err);
+}
+
 #define PI 3.14159265358979323846
 
 typedef struct {
@@ -120,7 +130,7 @@ static int limit_of(const ccn_cage *cage, ccn_cache *cache, double **out, int32_
     o.threads = 1;
     ccn_plan *p = NULL;
     ccn_error err;
-    if (ccn_plan_create_cached(cage, &o, cache, &p, &err) != CCN_OK) {
+    if (plan_cached(cage, &o, cache, &p, &err) != CCN_OK) {
         fprintf(stderr, "plan: %s\n", err.message);
         return -1;
     }

@@ -263,7 +263,7 @@ static void side_points(const grid *g, int r0, int rows, int L, int side, opoint
 static void check_two_sides(int M, int N, int torus, int c, int L, ccn_scheme scheme) {
     grid g = grid_make(M, N, torus, c, 10.0);
     ccn_cage cage = grid_cage(&g);
-    ccn_options o = {scheme, CCN_CAP_REFINE, L, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT};
+    ccn_options o = {scheme, CCN_CAP_REFINE, L, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT, NULL, NULL};
     lmesh lm;
     int ok = limit(&cage, &o, &lm) == 0;
     CHECK(ok, "plan");
@@ -353,7 +353,7 @@ static void check_crease_curve(int torus, int L) {
     ccn_cage cage = grid_cage(&g);
     ccn_mesh *m = NULL, *r = NULL;
     ccn_error err;
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, L, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT};
+    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, L, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT, NULL, NULL};
     CHECK(ccn_mesh_create(&cage, &m, &err) == CCN_OK, "mesh: %s", err.message);
     CHECK(m && ccn_refine(m, L, &o, &r, &err) == CCN_OK, "refine: %s", err.message);
     if (!r) { ccn_mesh_destroy(m); grid_free(&g); return; }
@@ -416,7 +416,7 @@ static ccn_mesh *refine_grid(const grid *g, double s, int levels, int method) {
     ccn_cage c = grid_cage(&h);
     ccn_mesh *m = NULL, *r = NULL;
     ccn_error err;
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, levels, CCN_CORNERS_PINNED, 1, method, CCN_POLY_SELECT};
+    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, levels, CCN_CORNERS_PINNED, 1, method, CCN_POLY_SELECT, NULL, NULL};
     if (ccn_mesh_create(&c, &m, &err) == CCN_OK) ccn_refine(m, levels, &o, &r, &err);
     ccn_mesh_destroy(m);
     free(cr);
@@ -430,7 +430,7 @@ static ccn_mesh *refine_data(const mdata *d, double s, int levels) {
     ccn_cage c = {d->nv, d->nf, d->ne, d->pos, d->fs, d->fv, d->ev, d->kn, cr, NULL};
     ccn_mesh *m = NULL, *r = NULL;
     ccn_error err;
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, levels, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT};
+    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, levels, CCN_CORNERS_PINNED, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT, NULL, NULL};
     if (ccn_mesh_create(&c, &m, &err) == CCN_OK) ccn_refine(m, levels, &o, &r, &err);
     else fprintf(stderr, "refine_data: %s\n", err.message);
     ccn_mesh_destroy(m);
@@ -530,7 +530,7 @@ static void test_random_sharpness(void) {
         for (int method = 0; method < 2; method++)
             for (int L = 1; L <= 2; L++) {
                 ccn_options o = {rep & 1 ? CCN_SCHEME_NURSS : CCN_SCHEME_EIGEN, CCN_CAP_REFINE, L,
-                                 CCN_CORNERS_SMOOTH, 1, method, CCN_POLY_SELECT};
+                                 CCN_CORNERS_SMOOTH, 1, method, CCN_POLY_SELECT, NULL, NULL};
                 lmesh a, b;
                 o.levels = L;
                 int ok = limit(&c, &o, &a) == 0;

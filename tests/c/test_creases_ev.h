@@ -40,7 +40,7 @@ static double corner_vs_fine(const lmesh *coarse, const lmesh *fine, int d, int 
 
 static void check_ev_case(const char *name, const ccn_cage *c, int expect_caps) {
     /* level 3: above the cap level K = 2 (at K >= L no cap is built, surface/caps.c) */
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_GUIDED_BI5, 3, CCN_CORNERS_SMOOTH, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT};
+    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_GUIDED_BI5, 3, CCN_CORNERS_SMOOTH, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT, NULL, NULL};
     lmesh a, f4, f5;
     int ok = limit(c, &o, &a) == 0;
     o.cap = CCN_CAP_REFINE;
@@ -85,7 +85,7 @@ static void test_crease_evs(void) {
     /* semi-sharp version with a vertex crease */
     double cr2[5] = {2.5, 2.5, 1.5, 2.5, 0.5}, vc[8] = {0, 0, 0, 0, 0, 0, 3, 0};
     ccn_cage cube2 = {8, 6, 5, cube_p, fs, cube_f, ev, NULL, cr2, vc};
-    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, 2, CCN_CORNERS_SMOOTH, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT};
+    ccn_options o = {CCN_SCHEME_EIGEN, CCN_CAP_REFINE, 2, CCN_CORNERS_SMOOTH, 1, CCN_CREASE_UNIFORM, CCN_POLY_SELECT, NULL, NULL};
     lmesh a, b;
     int ok = limit(&cube2, &o, &a) == 0;
     o.levels = 3;

@@ -1,5 +1,5 @@
-/* ccn_plan_recreate (issue 15, interval edits): a plan made from the previous plan of the same
- * cage topology equals a new ccn_plan_create_cached plan of the edited cage, output vertex by
+/* ccn_plan_create with options.previous (interval edits): a plan made from the previous plan of the same
+ * cage topology equals a new plan of the edited cage (same cache), output vertex by
  * output vertex (positions, normals, corner normals; same sizes and output mesh), along a
  * chain of edits (each plan made from the one before):
  * one ring's interval changed, the largest interval raised (every normalised interval
@@ -15,6 +15,23 @@
 
 #include <math.h>
 #include <string.h>
+
+/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
+ * options.cache and options.previous (prev is consumed). */
+static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
+                              ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = NULL;
+    return ccn_plan_create(c, &q, out, err);
+}
+static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
+                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = prev;
+    return ccn_plan_create(c, &q, out, err);
+}
 
 typedef struct {
     ccn_obj *obj;
@@ -164,7 +181,7 @@ static void chain(const char *name, int random_knots, int random_creases, int le
     ccn_options o = {0};
     o.levels = levels;
     ccn_plan *prev = NULL;
-    CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &prev, &err) == CCN_OK, "%s: %s", name, err.message);
+    CHECK(plan_cached(&c.cage, &o, cache, &prev, &err) == CCN_OK, "%s: %s", name, err.message);
     double size = cage_size(&c.cage), worst[2] = {0, 0};
     /* the cage's positions, and at step 5 moved (then ccn_plan_evaluate_changed has nothing
      * to keep and evaluates everything) */
@@ -184,8 +201,8 @@ static void chain(const char *name, int random_knots, int random_creases, int le
         else if (step == 3) c.knots[e] = 0.05;               /* a tiny interval */
         else c.knots[e] = 0.05 + 19.95 * tl_rand01();
         ccn_plan *fresh = NULL, *next = NULL;
-        CHECK(ccn_plan_create_cached(&c.cage, &o, cache, &fresh, &err) == CCN_OK, "%s", err.message);
-        CHECK(ccn_plan_recreate(prev, &c.cage, &o, cache, &next, &err) == CCN_OK, "%s", err.message);
+        CHECK(plan_cached(&c.cage, &o, cache, &fresh, &err) == CCN_OK, "%s", err.message);
+        CHECK(plan_recreate(prev, &c.cage, &o, cache, &next, &err) == CCN_OK, "%s", err.message);
         prev = next; /* the old plan was consumed (destroyed) by the call */
         if (!fresh || !next) { ccn_plan_destroy(fresh); break; }
         result a, b, k;
@@ -254,7 +271,7 @@ static void test_foreign_buffer(void) {
         CHECK(prev && evaluate(prev, &last), "evaluate failed");
         c.knots[3] = 4.5; /* an interval edit */
         CHECK(ccn_plan_create(&c.cage, &o, &fresh, &err) == CCN_OK, "%s", err.message);
-        CHECK(ccn_plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+        CHECK(plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
         CHECK(fresh && next && evaluate(fresh, &a), "evaluate failed");
         /* the foreign buffer: garbage, or a copy of the earlier plan's last output */
         size_t nv = (size_t)last.s.num_verts, nf = (size_t)last.s.num_faces;
@@ -289,7 +306,7 @@ static void test_hint_ignored(void) {
     o3.levels = 3;
     const char *what[3] = {"another topology", "other creases", "other options (levels)"};
     for (int i = 0; i < 3; i++) {
-        ccn_plan *hint = NULL; /* consumed by ccn_plan_recreate */
+        ccn_plan *hint = NULL; /* consumed by ccn_plan_create with options.previous */
         a.cage.edge_creases = NULL;
         CHECK(ccn_plan_create(i == 0 ? &b.cage : &a.cage, &o2, &hint, &err) == CCN_OK, "%s", err.message);
         if (i == 1) for (int k = 0; k < a.ne; k++) a.creases[k] = k % 7 == 0 ? 1.5 : 0;
@@ -297,7 +314,7 @@ static void test_hint_ignored(void) {
         const ccn_options *o = i == 2 ? &o3 : &o2;
         ccn_plan *fresh = NULL, *next = NULL;
         CHECK(ccn_plan_create(&a.cage, o, &fresh, &err) == CCN_OK, "%s", err.message);
-        CHECK(ccn_plan_recreate(hint, &a.cage, o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+        CHECK(plan_recreate(hint, &a.cage, o, NULL, &next, &err) == CCN_OK, "%s", err.message);
         result x, y;
         if (fresh && next && evaluate(fresh, &x) && evaluate(next, &y)) {
             double dn, d = compare(&x, &y, 1, &dn);
@@ -310,13 +327,13 @@ static void test_hint_ignored(void) {
         ccn_plan_destroy(next);
     }
     ccn_plan *none = NULL, *bad = NULL, *victim = NULL;
-    CHECK(ccn_plan_recreate(NULL, &b.cage, &o2, NULL, &none, &err) == CCN_OK, "prev NULL: %s", err.message);
+    CHECK(plan_recreate(NULL, &b.cage, &o2, NULL, &none, &err) == CCN_OK, "prev NULL: %s", err.message);
     ccn_plan_destroy(none);
     /* a failing call consumes prev too (ASan: no leak, no use after free) */
     CHECK(ccn_plan_create(&b.cage, &o2, &victim, &err) == CCN_OK, "%s", err.message);
     ccn_cage broken = b.cage;
     broken.num_faces = 0;
-    CHECK(ccn_plan_recreate(victim, &broken, &o2, NULL, &bad, &err) != CCN_OK && !bad,
+    CHECK(plan_recreate(victim, &broken, &o2, NULL, &bad, &err) != CCN_OK && !bad,
           "a cage without faces must fail");
     unload(&a);
     unload(&b);
@@ -338,7 +355,7 @@ static void test_channels_and_unevaluated(void) {
     CHECK(ccn_plan_create(&c.cage, &o, &prev, &err) == CCN_OK, "%s", err.message);
     CHECK(prev && ccn_plan_add_fvar(prev, &uv, &ch, &err) == CCN_OK, "%s", err.message);
     c.knots[0] *= 2.5;
-    CHECK(ccn_plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
+    CHECK(plan_recreate(prev, &c.cage, &o, NULL, &next, &err) == CCN_OK, "%s", err.message);
     CHECK(ccn_plan_create(&c.cage, &o, &fresh, &err) == CCN_OK, "%s", err.message);
     if (next && fresh) {
         result a = {0}, b = {0};

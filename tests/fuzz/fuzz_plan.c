@@ -5,13 +5,23 @@
  * sizes consistent, every position and normal finite (normals of unit length), indices in
  * range, topology outputs identical between calls; ccn_plan_patches: degree 3 or 5, finite
  * control points, cage face in range; a face-varying channel and per-vertex data from the
- * input (fvar_stage); an interval edit through ccn_plan_recreate and ccn_plan_evaluate_changed,
+ * input (fvar_stage); an interval edit through ccn_plan_create with options.previous and ccn_plan_evaluate_changed,
  * byte-identical to a new plan (edit_stage). Output buffers are allocated at exactly
  * the sizes ccn_plan_sizes gives, so ASan catches any write past them.
  * Input: byte 0 flags (as fuzz_mesh.c), the cage, then scheme, cap, levels, corners,
  * threads bytes, then positions for the second evaluation. Built only once the library
  * defines ccn_plan_evaluate (tests/fuzz/fuzz.mk). */
 #include "fuzz_cage.h"
+
+/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
+ * options.cache and options.previous (prev is consumed). */
+static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
+                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
+    ccn_options q = {0};
+    if (o) q = *o;
+    q.cache = cache, q.previous = prev;
+    return ccn_plan_create(c, &q, out, err);
+}
 
 static void check_outputs(const ccn_sizes *z, const ccn_limit_mesh *out, int32_t cage_faces) {
     fz_check_finite(out->positions, 3 * (size_t)z->num_verts, "limit position");
@@ -128,7 +138,7 @@ static void fvar_stage(ccn_plan *plan, const ccn_cage *c, const ccn_sizes *z, rd
 }
 
 /* 5: an interval edit (one edge's interval from the input): the plan recreated from this one
- * (ccn_plan_recreate) and evaluated by ccn_plan_evaluate_changed into this plan's last output
+ * (ccn_plan_create with options.previous) and evaluated by ccn_plan_evaluate_changed into this plan's last output
  * gives the same status as a new plan of the edited cage and, when both succeed, the same
  * bytes (positions, normals). *plan is consumed; the recreated plan (or NULL) replaces it. */
 static void edit_stage(ccn_plan **plan, const ccn_cage *c, const ccn_options *o, const ccn_sizes *z,
@@ -165,9 +175,9 @@ static void edit_stage(ccn_plan **plan, const ccn_cage *c, const ccn_options *o,
     ccn_status sf = ccn_plan_create(&c2, o, &fresh, &e);
     fz_check_status(sf, &e, "ccn_plan_create(edited)");
     fz_err_init(&e);
-    ccn_status sr = ccn_plan_recreate(*plan, &c2, o, NULL, &next_plan, &e);
+    ccn_status sr = plan_recreate(*plan, &c2, o, NULL, &next_plan, &e);
     *plan = next_plan;
-    fz_check_status(sr, &e, "ccn_plan_recreate");
+    fz_check_status(sr, &e, "ccn_plan_create with options.previous");
     FZ_CHECK(sr == sf || sr == CCN_ERR_MEMORY || sf == CCN_ERR_MEMORY,
              "recreate gave %d, a new plan %d", (int)sr, (int)sf);
     FZ_CHECK((sr == CCN_OK) == (next_plan != NULL), "recreate %d with plan %p", (int)sr, (void *)next_plan);

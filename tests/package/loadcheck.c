@@ -47,8 +47,8 @@ typedef void (*obj_destroy_fn)(ccn_obj *);
 typedef ccn_status (*obj_cage_fn)(const ccn_obj *, ccn_cage *);
 typedef ccn_status (*cache_create_fn)(ccn_cache **, ccn_error *);
 typedef void (*cache_destroy_fn)(ccn_cache *);
-typedef ccn_status (*plan_create_fn)(const ccn_cage *, const ccn_options *, ccn_cache *,
-                                     ccn_plan **, ccn_error *);
+typedef ccn_status (*plan_create_fn)(const ccn_cage *, const ccn_options *, ccn_plan **,
+                                     ccn_error *);
 typedef ccn_status (*plan_sizes_fn)(const ccn_plan *, ccn_sizes *);
 typedef ccn_status (*plan_evaluate_fn)(ccn_plan *, const double *, ccn_limit_mesh *, ccn_error *);
 typedef void (*plan_destroy_fn)(ccn_plan *);
@@ -99,7 +99,7 @@ int main(int argc, char **argv) {
     obj_cage_fn obj_cage = (obj_cage_fn)sym(h, "ccn_obj_cage");
     cache_create_fn cache_create = (cache_create_fn)sym(h, "ccn_cache_create");
     cache_destroy_fn cache_destroy = (cache_destroy_fn)sym(h, "ccn_cache_destroy");
-    plan_create_fn plan_create = (plan_create_fn)sym(h, "ccn_plan_create_cached");
+    plan_create_fn plan_create = (plan_create_fn)sym(h, "ccn_plan_create");
     plan_sizes_fn plan_sizes = (plan_sizes_fn)sym(h, "ccn_plan_sizes");
     plan_evaluate_fn plan_evaluate = (plan_evaluate_fn)sym(h, "ccn_plan_evaluate");
     plan_destroy_fn plan_destroy = (plan_destroy_fn)sym(h, "ccn_plan_destroy");
@@ -128,7 +128,7 @@ int main(int argc, char **argv) {
         fprintf(out, "# %s\n", argv[i]);
         if (!text || obj_parse(text, len, &obj, &err) != CCN_OK || obj_cage(obj, &cage) != CCN_OK) {
             fprintf(out, "# not read\n");
-        } else if (plan_create(&cage, &opts, cache, &plan, &err) != CCN_OK) {
+        } else if ((opts.cache = cache, plan_create(&cage, &opts, &plan, &err)) != CCN_OK) {
             fprintf(out, "# plan: %s\n", err.message);
         } else if (plan_sizes(plan, &sz) == CCN_OK) {
             double *P = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
