@@ -33,8 +33,8 @@ def switch_geometry_sockets(node):
 # corner vertices/edges and edge vertices 3.6+, face materials 4.0+, edge selection 4.0+): one
 # copy, where `vertices.foreach_set("co")`, `loops.foreach_get("vertex_index")` and the other
 # element properties walk every element (measured on 4.5 and 5.0, 131k vertices / faces:
-# positions 17 ms -> 0.1 ms, corner vertices 26-36 ms -> 0.2 ms, material 11-25 ms -> 0.2 ms;
-# issue 15). Not for a mesh evaluated from an edit mesh: its attribute API reads the edit
+# positions 17 ms -> 0.1 ms, corner vertices 26-36 ms -> 0.2 ms, material 11-25 ms -> 0.2 ms).
+# Not for a mesh evaluated from an edit mesh: its attribute API reads the edit
 # BMesh's layers (tap.py), so the element properties are used there.
 
 def _array_attr(mesh, name, domain, data_type, n):
@@ -142,7 +142,7 @@ def set_face_loops(mesh, loop_start, loop_total):
 # `custom_normal` attribute on the point or corner domain, shown and kept as they are. Writing
 # them is one foreach_set; the encoded custom normals of `normals_split_custom_set*` (and of
 # every version before) cost a loop-normal-space pass per write (measured on a 40k-vertex
-# grid: 0.07-0.10 s encoded, 0.0004 s free; issue 15).
+# grid: 0.07-0.10 s encoded, 0.0004 s free).
 FREE_NORMALS = VERSION >= (4, 5, 0)
 
 

@@ -37,7 +37,7 @@ _status = {}     # (object name, kind) -> Status
 _key_memo = {}   # (object name, kind) -> the last topology keys, their inputs (cage.py), and
 #                  "loose": the loose counts of that topology
 # Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
-# evaluation of the cage afterwards cost 5x the rest of an update, issue 15): with
+# evaluation of the cage afterwards cost 5x the rest of an update): with
 # defer_normals the proxy gets Blender's own normals and this key suffix, and its cage is listed
 # in `pending_normals`; handlers.py writes the exact normals once editing pauses.
 PENDING = "|normals pending"
@@ -212,7 +212,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         plan = _plan_for(key_name, topo, cage, s, levels, uv_chans)
         me = proxies.own_mesh(p)
         # an interval edit changes the plan, not the output faces: positions (and normals)
-        # are rewritten in place, the proxy keeps its topology (issue 15 item 4)
+        # are rewritten in place, the proxy keeps its topology
         same_topology = (me.get(proxies.TOPO_PROP) == faces
                          and len(me.vertices) == plan.sizes["num_verts"]
                          and len(me.polygons) == plan.sizes["num_faces"])

@@ -3,8 +3,7 @@
 # CCN_TEST_JOBS suites at a time (default 2: the 2-core reference machine; 1 = one after the
 # other). Each suite writes build/test-logs/NAME.log, printed when the suite ends, followed by
 # "== NAME: ok|FAILED (Ns)"; the last line is the total "suites: N passed, N failed".
-# The longest suites start first (HEAVY, measured: issue 15 "make test stays under 10 minutes
-# on 2 cores"), so the lanes finish together; every suite keeps its own timeouts.
+# The longest suites start first (HEAVY, measured), so the lanes finish together; every suite keeps its own timeouts.
 cd "$(dirname "$0")/.." || exit 2
 JOBS=${CCN_TEST_JOBS:-2}
 LOG=build/test-logs

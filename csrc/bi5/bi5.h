@@ -95,7 +95,7 @@
  *       coefficients b_510, b_501 at the centre are projected onto the plane through the centre
  *       point with that normal and the remaining parameters refitted with them fixed. The cap's
  *       centre jet is the guide's, so the cap's tangent plane at the EV is the exact limit's
- *       (issue 14: the plain fit left it 0.002-0.04 rad off for non-uniform intervals).
+ *       (the plain fit left it 0.002-0.04 rad off for non-uniform intervals).
  *  Numerics: tau's equality-constrained minimum by the SVD null space of the constraints
  *  (they are redundant) and Cholesky on the reduced normal equations of F_5.
  */

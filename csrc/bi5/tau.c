@@ -57,7 +57,7 @@ static double bern_deriv(int32_t d, int32_t k, double t, int32_t order) {
 /* The 6x6 Gauss-Legendre rule on [0,1]^2 of f5_vec, tabulated once per tau solve (f5_vec runs
  * 30 + ns times on the same nodes): D[a][p][k] = d^a/dx^a B^5_k at node p, and the row weights
  * sqrt(C(5,i) w_pa w_pb). Computed by the same expressions as before tabulation, so F_5 is
- * bit-identical (issue 15: the pow calls were 76 % of a non-uniform plan). */
+ * bit-identical (the pow calls were 76 % of a non-uniform plan). */
 typedef struct {
     double D[6][6][6];
     double sw[6][6][6];

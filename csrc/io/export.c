@@ -362,7 +362,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (st) return st;
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
-    if (sz.num_caps_deferred > 0) /* issue 14: no caps at L <= K; fills there would be needless */
+    if (sz.num_caps_deferred > 0) /* no caps at L <= K; fills there would be needless */
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "the plan (output level %d) has no bi-5 caps for its %d extraordinary vertices: "
                          "none is built below the output level; export a plan with more levels (%d or more)",

@@ -3,7 +3,7 @@
  * Li, Finnigan, Sederberg 2016 section 5 fixes one planar polyhedron per spoke-interval tuple
  * (equal angles 2 pi/n, spoke lengths l_i). The rules (27)-(38) turn any planar polyhedron
  * with V^0 = 0, spokes E_i^0 and face points F_i^0 = gamma (E_i^0 + E_{i+1}^0) into an M with
- * M P^0 = lambda P^0 + 1 T^0. Issue 14 ("Eigen rules: the decision") tries, for a vertex whose
+ * M P^0 = lambda P^0 + 1 T^0. The per-vertex choice tries, for a vertex whose
  * paper polyhedron fails the verification (rules/eigen_select.c), other polyhedra in a fixed
  * order; this file defines them (public numbering: ccnurbs.h CCN_POLY_*):
  *   1        the paper's lengths l_i;

@@ -21,7 +21,7 @@
 
 #define CCN_CAP_MAX_VALENCE 32
 /* Non-uniform spoke intervals get a cap only while every kappa_s = d_{s+1}/d_{s-1} is within
- * this factor of 1 (issue 14: beyond it the measured curvature of the cap fails the acceptance
+ * this factor of 1 (beyond it the measured curvature of the cap fails the acceptance
  * figures -- README "The guided bi-5 cap"); the others use the exact refined limit (counted as
  * cap fallbacks). kappa = 1 for every spoke (equal or alternating intervals) always qualifies. */
 #ifndef CCN_CAP_KAPPA_RANGE /* a research build may widen it (tests/experiments/cap_table.sh) */
@@ -245,7 +245,7 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
         ok = zero != NULL;
         /* Equal spoke intervals: the uniform operator on the level-K net, whose bicubic surround
          * is the limit itself. Any other intervals (kappa = 1 alternating and period 4 too, whose
-         * level-K surround is not the limit: issue 14 measured 5e-5 .. 6e-3 off): the exact
+         * level-K surround is not the limit: measured 5e-5 .. 6e-3 off): the exact
          * level-(K+1) surround and the exact centre normal (bi5.h [R13], [R14]). */
         if (ok && t->uni) ok = ccn__bi5_apply_cached(c->op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
         else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
@@ -257,8 +257,8 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
 
 /* Chooses K, builds the caps. A cap at level K >= L (the output level) changes nothing: every
  * output sample of its hole is the EV itself (the exact limit point; [R14] its exact normal) or
- * lies on the hole's border (the exact limit), so no cap is built then (issue 14 item 5:
- * measured equal to 4e-16 in position and 4e-12 rad in normal on the shipped cages). */
+ * lies on the hole's border (the exact limit), so no cap is built then (measured equal to
+ * 4e-16 in position and 4e-12 rad in normal on the shipped cages). */
 ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     p->K = -1;
     if (p->opts.cap != CCN_CAP_GUIDED_BI5) return CCN_OK;

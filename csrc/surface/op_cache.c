@@ -1,5 +1,5 @@
 /* ccn_cache: the guided bi-5 operators (one per valence and ring-speed set, bi5/bi5.h) kept
- * across plans (issue 15: creating the valence-32 operator is ~0.4 s of every rebuild of a
+ * across plans (creating the valence-32 operator is ~0.4 s of every rebuild of a
  * cage with a 32-gon). Operators are immutable once built, so plans share them; a mutex
  * guards the table, so plans may be created with one cache from several threads. */
 #include "surface/op_cache.h"

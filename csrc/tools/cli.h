@@ -16,7 +16,7 @@ char *ccn_cli_read_file(const char *path, size_t *len);
  * t creasemethod), else the defaults. Prints the error and returns 2 on failure. */
 int ccn_cli_load_plan(const char *path, ccn_options *o, ccn_plan **plan);
 /* The same, for the finite patch set (patches, export): the output level o->levels is raised
- * until the plan builds its bi-5 caps (none at levels not above the cap level, issue 14). */
+ * until the plan builds its bi-5 caps (none at levels not above the cap level). */
 int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan);
 /* Parses an OBJ (options as above) and views it as a cage and its UV map (uv->num_values = 0
  * when there is none); the UV map's mode is *fvar_linear, or when that is -1 the file's

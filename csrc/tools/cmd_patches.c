@@ -1,6 +1,6 @@
 /* ccnurbs patches: the finite patch set in BezierView format (type 4 = tensor patch of
  * degree d: a line "4", a line "d", then (d+1)^2 points), for public viewers. The output
- * level is raised until the bi-5 caps exist (issue 14: none at levels not above the cap level). */
+ * level is raised until the bi-5 caps exist (none at levels not above the cap level). */
 #include "cli.h"
 #include "commands.h"
 

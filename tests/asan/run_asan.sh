@@ -6,7 +6,7 @@
 # One line per suite, then "N passed, N failed".
 # Environment (optional): ASAN_ORACLE=0 skips the oracle, ASAN_ORACLE_MAX_LEVEL (default 3;
 # 4 = the full oracle, about 3x longer), ASAN_TIMEOUT (seconds per suite, default 900: 3x the
-# slowest suite measured under load -- test_cap took 462 s before issue 15 -- since `make test`
+# slowest suite measured under load -- test_cap once took 462 s -- since `make test`
 # runs two suites at a time).
 cd "$(dirname "$0")/../.." || exit 2
 LOGS=build/asan/logs

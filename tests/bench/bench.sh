@@ -4,7 +4,7 @@
 # one run on this machine. The library runs with the DEFAULT options (scheme eigen, cap guided
 # bi-5, per-vertex eigen polyhedron) unless a row says otherwise. Every time is the minimum over
 # BENCH_REPS runs (default 3); the machine is shared, so ratios are the figures to read.
-# Prints issue 15's targets table: one "target |" line per measured row, ratio = ours / theirs.
+# Prints the targets table: one "target |" line per measured row, ratio = ours / theirs.
 # Environment: BENCH_REPS, BENCH_BLENDER=0 (skip Blender), CCN_CACHE (the bpy venvs),
 # CCN_BENCH_BLENDER_CASES (tests/blender/bench_blender.py).
 cd "$(dirname "$0")/../.." || exit 2
@@ -72,7 +72,7 @@ for cage in sphere8k carlike carlike_knots; do
     echo "$cage L$L | $(echo "$c" | field plan) | $(echo "$r" | field plan) | $(echo "$c" | field evaluate) | $cr | $otp | $opl | $(ratio "$cr" "$otp")"
   done
 done
-# issue 14: the per-vertex eigen polyhedron choice (0 for spoke ratios <= 5)
+# the per-vertex eigen polyhedron choice (0 for spoke ratios <= 5)
 for cage in $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj tests/data/fig18_v8.obj; do
   s=$(build/bench/ccn_bench "$cage" 2 bi5 "$R" 0) || exit 2
   q=$(build/bench/ccn_bench "$cage" 2 bi5 "$R" 1) || exit 2
@@ -80,7 +80,7 @@ for cage in $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj
   per=$(awk -v a="$ts" -v b="$tq" -v n="$nv" 'BEGIN { printf "%.1f", (n > 0 ? 1000 * (a - b) / n : 0) }')
   echo "eigen polyhedron choice, $(basename "$cage" .obj) L2: plan $ts s (paper's polyhedron only: $tq s); $nv EVs verified (spoke ratio > 5), $per ms per verified EV, outside G1 $(echo "$s" | num "outside G1")"
 done
-echo "CAD export (ccn_plan_export, issue 17) of the production-like cages, into memory:"
+echo "CAD export (ccn_plan_export) of the production-like cages, into memory:"
 for cage in carlike carlike_knots; do build/bench/export_bench "$D/$cage.obj" 3 || exit 2; done
 echo "One UV channel (the cages' box unwrap, --cap refine; target: <= 1.5x the plan without):"
 echo "mesh level | plan | plan + uv | ratio | evaluate | evaluate + uv | ratio | memory MB | memory + uv MB | ratio"
@@ -107,7 +107,7 @@ blender_rows() { # label target-for-position-updates log: the target rows from b
     row "interval edit, $what, Blender $1" "$(get "$line" interval) s" "$(get "$sub" topo) s (Subsurf topology change)" "$(gr interval)" 1.0
     [ "$pos_t" = 0.5 ] && row "topology edit, $what, Blender $1" "$(get "$line" topo) s" "$(get "$sub" topo) s" "$(gr topo)" 1.5
   done
-  grep '^bench animation' "$3" | while read -r line; do  # issue 15 row 7 (target on 4.5/5.x)
+  grep '^bench animation' "$3" | while read -r line; do  # the playback row (target on 4.5/5.x)
     fps=$(echo "$line" | sed -n 's/.*ccnurbs \([0-9.]*\) fps.*/\1/p'); sfps=$(echo "$line" | sed -n 's/.*subsurf \([0-9.]*\) fps.*/\1/p')
     echo "target | animation playback, carlike L2 armature, Blender $1 | $fps fps | Subsurf $sfps fps | $(ratio 24 "$fps") | 1.0 (>= 24 fps) | $(verdict "$(ratio 24 "$fps")" 1.0)"
   done

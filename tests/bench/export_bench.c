@@ -1,4 +1,4 @@
-/* `make bench`: size and time of ccn_plan_export (issue 17) for one cage: STEP and IGES,
+/* `make bench`: size and time of ccn_plan_export for one cage: STEP and IGES,
  * packed and unpacked, into a counting sink (no disk), min over repeats; the time includes
  * the plan's evaluation that ccn_plan_export does first (printed apart). */
 #include "ccnurbs.h"
@@ -40,7 +40,7 @@ int main(int argc, char **argv) {
         ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
     ccn_sizes sz;
     ccn_plan_sizes(plan, &sz);
-    while (sz.num_caps_deferred > 0) { /* issue 14: the caps exist only above the cap level */
+    while (sz.num_caps_deferred > 0) { /* the caps exist only above the cap level */
         o.levels = sz.levels + 1;
         ccn_plan_destroy(plan);
         if (ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }

@@ -106,7 +106,7 @@ if __name__ == "__main__":
     V, F = car_like(); write(os.path.join(out, "carlike.obj"), V, F)
     write(os.path.join(out, "carlike_knots.obj"), V, F, nonuniform(V, F))
     V, F = cube_sphere(91); write(os.path.join(out, "sphere50k.obj"), V, F)
-    # issue 15's rebuild case: one ring of the default cylinder set to 3 -- the ring of the 32
+    # the rebuild case: one ring of the default cylinder set to 3 -- the ring of the 32
     # side edges (every rim vertex gets spoke ratio 3) and the ring of one rim edge pair (the
     # 32-gon centres get one spoke of 3)
     V, F = cylinder32()

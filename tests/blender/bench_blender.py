@@ -221,7 +221,7 @@ def time_playback(ob):
 
 
 def bench_animation(name, level):
-    """Issue 15 row 7: playback of an armature-deformed cage, CCNURBS vs Subdivision Surface."""
+    """Playback of an armature-deformed cage, CCNURBS vs Subdivision Surface."""
     bpy.ops.wm.read_homefile(use_empty=True)
     ob, _, _ = load(name)
     _rig(ob)

@@ -1,4 +1,4 @@
-"""CAD export (addon/cad_export.py, issue 17): File > Export > "CCNURBS Surface (.step, .iges)"
+"""CAD export (addon/cad_export.py): File > Export > "CCNURBS Surface (.step, .iges)"
 and the panel's "Export CAD" button. Every file is read back by OpenCASCADE (build/occt_read,
 the independent reader of tests/oracle): valid, one shell (closed for closed cages), and as many
 faces as `ccnurbs export` gives for the same cage and settings. The modifier's settings are

@@ -1,4 +1,4 @@
-"""Creases and every cage an artist has (issue 12): Suzanne as it comes (with its interior
+"""Creases and every cage an artist has: Suzanne as it comes (with its interior
 valence-2 vertices) and a cube with edge creases 0.5 and 1.0 and a vertex crease give, with equal
 intervals, scheme Catmull-Clark and cap Refine, the same limit as Blender's own Subdivision
 Surface (Use Creases, Use Limit Surface, quality 10) at levels 1-3 (<= 1e-5 of the bounding box,

@@ -417,7 +417,7 @@ class TestSaveCost(AddonTestCase):
                  times["CCNURBS"][2] / times["SUBSURF"][2], sizes["SUBSURF"], sizes["CCNURBS"]))
         if raws:
             # Blender 5.0's compressed size varies between runs with the same content (this
-            # cage: Subsurf 1.23-1.43 MB, CCNURBS 1.32-1.51 MB, measured in session 28), as in
+            # cage: Subsurf 1.23-1.43 MB, CCNURBS 1.32-1.51 MB), as in
             # test_apply_file_size_like_subsurf: the content is asserted uncompressed
             print("measure save50k uncompressed: Subsurf %d bytes, CCNURBS %d bytes (%.4f)"
                   % (raws["SUBSURF"], raws["CCNURBS"], raws["CCNURBS"] / raws["SUBSURF"]))

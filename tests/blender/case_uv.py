@@ -1,4 +1,4 @@
-"""UV maps and attributes on the limit mesh (issue 16): the CCNURBS modifier's UVs against
+"""UV maps and attributes on the limit mesh: the CCNURBS modifier's UVs against
 Blender's own Subdivision Surface for every UV Smooth option, the UV maps' names and active
 flags, point attributes interpolated like the positions, corner attributes (vertex colours) and
 edge attributes and UV seams as Subdivision Surface gives them, face attributes copied, Apply.

@@ -1,4 +1,4 @@
-/* Fairness of the guided bi-5 cap against the refined limit (issue 14 item 1), measured
+/* Fairness of the guided bi-5 cap against the refined limit, measured
  * independently of the library: the cap surface from its Bernstein-Bezier patches (power form
  * with exact first and second derivatives, tests/c/bi5_props.h), the refined limit from its
  * exact positions and normals (a least-squares shape operator over each output vertex's ring).
@@ -406,7 +406,7 @@ static void star_cage(int n, int m, const double *d, fcage *c) {
 #undef SV
 }
 
-/* Issue 14's tear box: a cube of 3 x 3 quads per side, x scaled by 1.4 and z by 0.8; the
+/* The tear box: a cube of 3 x 3 quads per side, x scaled by 1.4 and z by 0.8; the
  * x-parallel edges of the slab of largest x carry 0.25, the z-parallel edges of the middle z
  * slab 3, every other edge 1. */
 static void tear_box(fcage *c) {

@@ -1,4 +1,4 @@
-/* The bad-input table (issue 6; README "Bad input"): one RUN per row. Errors: the exact
+/* The bad-input table (README "Bad input"): one RUN per row. Errors: the exact
  * status, element and a message fragment. Accepted inputs: ccn_refine by 2 levels with every
  * scheme and both corner rules gives finite positions and intervals and the documented
  * counts. Fixed bugs keep their own regression tests in test_fixed_bugs.c.

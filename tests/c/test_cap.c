@@ -1,4 +1,4 @@
-/* The guided bi-5 cap inside the whole pipeline (issue 4), on cages rather than c-nets:
+/* The guided bi-5 cap inside the whole pipeline, on cages rather than c-nets:
  *  - uniform intervals: with cap = GUIDED_BI5 every output vertex outside the open holes,
  *    including the hole boundary, equals the exact limit (cap = REFINE, itself checked
  *    against OpenSubdiv in run_limit.sh) in position and normal: the bi-5 surface joins the
@@ -345,7 +345,7 @@ static ccn_plan *fan_plan(cage_buf *c, int n, const double *d) {
     return p;
 }
 
-/* Period-4 intervals (n = 8) with kappa within the cap's range (issue 14: 1.05): G1 holds. */
+/* Period-4 intervals (n = 8) with kappa within the cap's range (1.05): G1 holds. */
 static void test_nonuniform_period4(void) {
     cap_stats st = {0};
     for (int k = 0; k < 10; k++) {

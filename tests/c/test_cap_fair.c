@@ -1,4 +1,4 @@
-/* Fairness of the guided bi-5 cap (issue 14 item 1, acceptance), measured by tests/c/cap_fair.h
+/* Fairness of the guided bi-5 cap, measured by tests/c/cap_fair.h
  * (independent Bernstein-Bezier evaluation with second derivatives; the refined limit's
  * curvature from its exact normals): the tear box, star cages n = 3..12 with intervals in
  * [0.2, 2], the Fig. 16 / 18 patterns up to the fold limit (r = 1.5 .. 5), and, so that caps are
@@ -102,7 +102,7 @@ static void test_acceptance(void) {
     CHECK(t.all.caps >= (small ? 5 : 50), "caps measured: %d", t.all.caps);
 }
 
-/* Issue 14 item 5: at output levels L <= K the default cap costs nothing and changes nothing --
+/* At output levels L <= K the default cap costs nothing and changes nothing --
  * no cap is built, the output is the refine plan's bit for bit -- and from L = K + 1 on the caps
  * are there (the cube: eight valence-3 EVs, K = 2). */
 static void test_no_cap_work_at_low_levels(void) {

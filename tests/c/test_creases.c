@@ -1,4 +1,4 @@
-/* Creases with knot intervals (issue 12), against an oracle written here from first
+/* Creases with knot intervals, against an oracle written here from first
  * principles (cubic B-splines on explicit knots, de Boor evaluation, Boehm insertion, point
  * reflection at boundaries); no code or formula is shared with csrc/.
  *

@@ -544,7 +544,7 @@ static void test_large_valence(void) {
     free(M);
 }
 
-/* ---- candidate polyhedra and the per-vertex choice (issue 14) ------------------------------ */
+/* ---- candidate polyhedra and the per-vertex choice ------------------------------ */
 
 /* The candidate list as documented (ccnurbs.h CCN_POLY_*, rules/eigen_shape.h): lengths rule
  * (0 paper, 1 l^(1-e) d^e, 2 Greville least squares, then ^(1-e) d^e), angle exponent a and

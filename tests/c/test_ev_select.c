@@ -1,4 +1,4 @@
-/* Tests of the per-vertex choice of the eigen polyhedron (issue 14, rules/eigen_select.c) and
+/* Tests of the per-vertex choice of the eigen polyhedron (rules/eigen_select.c) and
  * of its verification on the structured fan (rules/eigen_fan.c).
  *
  * Oracles: the refinement engine itself through the public API (ccn_refine on a fan cage built

@@ -1,4 +1,4 @@
-/* ccn_plan_export (issue 17): the exported faces, evaluated here by an independent Cox-de Boor
+/* ccn_plan_export: the exported faces, evaluated here by an independent Cox-de Boor
  * recursion on the surfaces the face callback reports, against
  *   - the plan's own limit samples (ccn_plan_evaluate, level 3): every sample lies in some
  *     face (located by the cells' places, decoded here from the documented order of the
@@ -114,7 +114,7 @@ static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn
     if (ccn_obj_parse(text, len, obj, &err) || ccn_obj_cage(*obj, cage) || ccn_plan_create(cage, o, &p, &err))
         p = NULL;
     free(text);
-    ccn_sizes sz; /* issue 14: the bi-5 caps exist only above the cap level; raise the level */
+    ccn_sizes sz; /* the bi-5 caps exist only above the cap level; raise the level */
     while (p && ccn_plan_sizes(p, &sz) == CCN_OK && sz.num_caps_deferred > 0) {
         ccn_options o2 = {0};
         if (o) o2 = *o;
@@ -320,7 +320,7 @@ static void test_cages(void) {
     check_cage("lshape", 0, 6);
     check_cage("pole12", 0, 0);
     check_cage("flip35", 0, 4);
-    check_cage("fig18_v8", 0, 9); /* 8 boundary corners + the centre: a cap fallback since issue 14 (kappa) */
+    check_cage("fig18_v8", 0, 9); /* 8 boundary corners + the centre: a cap fallback (kappa) */
     check_cage("fig16_v6", 0, 7);
     check_cage("mixed_boundary", 0, 11);
 }
@@ -476,7 +476,7 @@ static void test_bad_input(void) {
     } while (0)
     memset(&eo, 0, sizeof eo);
     BAD(ccn_plan_export(NULL, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "NULL plan");
-    ccn_plan *p0 = NULL; /* output level 0: no caps are built (issue 14), none to export */
+    ccn_plan *p0 = NULL; /* output level 0: no caps are built, none to export */
     CHECK(ccn_plan_create(&cage, NULL, &p0, &err) == CCN_OK, "plan at level 0");
     if (p0) {
         BAD(ccn_plan_export(p0, NULL, &eo, sink_fn, &s, NULL, &err), CCN_ERR_ARGUMENT, "caps deferred");

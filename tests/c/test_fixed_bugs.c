@@ -1,4 +1,4 @@
-/* Regression tests for library bugs found by the fuzzers and the bad-input table (issue 6),
+/* Regression tests for library bugs found by the fuzzers and the bad-input table,
  * all fixed: KB1 interior valence-2 vertices are a topology error; KB2b coordinates beyond
  * +-1e300 are an argument error; KB3 evaluate(NULL) uses the cage given to create; KB4 the
  * unit box is an exact power-of-two scaling without a centre shift, ignoring isolated
@@ -82,7 +82,7 @@ static void plan_accepted_means_finite(const ccn_cage *c, ccn_status allowed_err
  * valence 2. It made ccn_refine with the eigen scheme fail with CCN_ERR_ARGUMENT
  * "extraordinary vertex 7: refinement matrix failed" (ccn_ev_matrix refuses n = 2; the message
  * named a level-1 vertex) and ccn_plan_create fail for every scheme. Interior valence 2 is
- * now supported (issue 12: Catmull-Clark / NURSS rules there, no eigen matrix, the limit from
+ * now supported (Catmull-Clark / NURSS rules there, no eigen matrix, the limit from
  * the 1-ring's stationary matrix), so the pillows must be accepted with finite output. */
 static void kb1_interior_valence2(void) {
     if (!enabled()) return;

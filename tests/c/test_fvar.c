@@ -1,4 +1,4 @@
-/* Face-varying channels (UV maps) and per-vertex data (issue 16), against an oracle written
+/* Face-varying channels (UV maps) and per-vertex data, against an oracle written
  * here from first principles (tests/c/bspline_oracle.h: cubic B-splines on explicit knots,
  * de Boor evaluation, point reflection at the ends); no code or formula is shared with csrc/.
  *

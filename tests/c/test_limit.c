@@ -1,4 +1,4 @@
-/* Limit mesh properties (issue 4): watertight, no duplicate vertices, normals agree with
+/* Limit mesh properties: watertight, no duplicate vertices, normals agree with
  * finite differences of positions (and converge), plan reuse equals a fresh plan, argument
  * errors. Positions themselves are checked against OpenSubdiv in tests/oracle/run_limit.sh. */
 #include "ccnurbs.h"

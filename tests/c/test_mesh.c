@@ -1,4 +1,4 @@
-/* Cage validation and knot-ring resolution (issue: refinement engine, items 2-3). */
+/* Cage validation and knot-ring resolution. */
 #include "ccnurbs.h"
 #include "testlib.h"
 

@@ -1,4 +1,4 @@
-/* Normals against finite differences of the limit surface (issue 14 items 3-4): at every output
+/* Normals against finite differences of the limit surface: at every output
  * vertex of levels 1-3, every scheme, both caps, on cages with log-uniform random ring intervals
  * (closed, open, with boundaries, smooth valence-2 and concave boundary corners, n-gons, EVs of
  * valence 3-6), the library's unit normal agrees with the normal of the limit surface measured

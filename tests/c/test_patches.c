@@ -1,5 +1,5 @@
 /* Bicubic patches of regular faces vs de Boor evaluation of the tensor-product B-spline,
- * written here independently (issue 4 acceptance: <= 1e-12 relative at random parameters). */
+ * written here independently (<= 1e-12 relative at random parameters). */
 #include "ccnurbs.h"
 #include "surface/patches.h"
 #include "testlib.h"

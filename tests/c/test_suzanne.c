@@ -1,4 +1,4 @@
-/* Issue 14 item 2: the Suzanne-like cage (tests/data/suzanne.obj: Blender 3.4's
+/* The Suzanne-like cage (tests/data/suzanne.obj: Blender 3.4's
  * primitive_monkey_add, its valence-2 vertex dissolved) with five edge rings through the
  * forehead set to 3 (the five longest rings with an edge in the forehead box x in (-0.45, 0.45),
  * y < -0.55, z in (0.45, 0.95): 41, 41, 36, 36 and 27 edges). At levels 3, 4, 5 the normal jump

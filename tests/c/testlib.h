@@ -31,7 +31,7 @@ static double tl_now(void) {
     timespec_get(&t, TIME_UTC);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
-/* runs one test; its wall time is printed so the slow ones can be found (issue 15) */
+/* runs one test; its wall time is printed so the slow ones can be found */
 static void tl_run(const char *name, void (*fn)(void)) {
     tl_cur_name = name;
     tl_cur_failed = 0;

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 14's long runs of `ccnurbs experiment` with the library's per-vertex eigen polyhedron
+# The long runs of `ccnurbs experiment` with the library's per-vertex eigen polyhedron
 # choice, one after the other, in the background-friendly form they were run (figures: README
 # "Experiments", tests/experiments/RESULTS.md). Chunked and resumable (long_run.sh): rerunning
 # the script skips finished chunks. Run it as

@@ -1,4 +1,4 @@
-# Writes tests/data/suzanne.obj (issue 14 item 2), run once with Blender 3.4:
+# Writes tests/data/suzanne.obj, run once with Blender 3.4:
 #   blender --background --factory-startup --python-exit-code 1 --python tests/experiments/make_suzanne.py
 # then move /tmp/q/suzanne.obj to tests/data/.
 import bpy, bmesh

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-# usage: make_tearbox.py [out.obj] -- issue 14 tear box (tests/c/cap_fair.h tear_box) as an OBJ
-# the tear box of issue 14 as an OBJ with knot intervals
+# usage: make_tearbox.py [out.obj] -- tear box (tests/c/cap_fair.h tear_box) as an OBJ
+# the tear box as an OBJ with knot intervals
 verts = {}; pos = []
 for x in range(4):
     for y in range(4):
@@ -33,7 +33,7 @@ for q in faces:
         edges[k] = d
 import sys
 with open(sys.argv[1] if len(sys.argv) > 1 else 'tear_box.obj', 'w') as f:
-    f.write('# issue 14 tear box: cube 3x3 quads per side, x*1.4, z*0.8; x-parallel ring of the largest-x slab 0.25, z-parallel ring of the middle z slab 3\n')
+    f.write('# tear box: cube 3x3 quads per side, x*1.4, z*0.8; x-parallel ring of the largest-x slab 0.25, z-parallel ring of the middle z slab 3\n')
     for p in pos: f.write('v %.17g %.17g %.17g\n' % p)
     for q in faces: f.write('f %s\n' % ' '.join(str(i + 1) for i in q))
     for (a, b), d in sorted(edges.items()):

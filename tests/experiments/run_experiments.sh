@@ -1,13 +1,12 @@
 #!/bin/sh
 # Li, Finnigan, Sederberg 2016 section 7 experiments through `ccnurbs experiment`
-# (DESIGN 4.3 acceptance; reference/eigen/SPEC.md section 3; issue 14 "Eigen rules: the
-# decision"). Figures: tests/experiments/RESULTS.md. The library chooses the eigen polyhedron
+# (DESIGN 4.3 acceptance; reference/eigen/SPEC.md section 3). Figures: tests/experiments/RESULTS.md. The library chooses the eigen polyhedron
 # per vertex (rules/eigen_select.c); the experiment measures that choice with its own machinery
 # (the engine's refinement, its own face-local maxima count, the 3-ring matrix from the engine,
 # LAPACK's eigenvectors, the exact Bezier test of det J).
 #
 #  (a) maxima, the per-vertex choice, uniform [1e-6, 1], level 5: every case has one maximum at
-#      level 5 and no errors (issue 14: 100 % of 10,000, which `make test` runs; EXP_MAXIMA_CASES
+#      level 5 and no errors (100 % of 10,000, which `make test` runs; EXP_MAXIMA_CASES
 #      sets another count for a quick local run). The 10,000 take 70-190 s on 2 cores.
 #  (a') the first 1,200 of those cases with the paper's polyhedron (--polyhedron 1): the known twin
 #      peaks (cases 332, 644, 704, 1118) are found, so (a) can fail.

@@ -34,7 +34,7 @@ typedef struct {
     double pos[3 * MAXV];
     int32_t fs[MAXF], fv[MAXFV], ev[2 * MAXE];
     double kn[MAXE];
-    double cr[MAXE];   /* edge sharpness (issue 12) */
+    double cr[MAXE];   /* edge sharpness */
     double vc[MAXV];   /* vertex sharpness */
 } soup;
 

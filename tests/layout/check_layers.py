@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The source tree's shape, checked (issue 11): layers, no dependency circles, file sizes.
+"""The source tree's shape, checked: layers, no dependency circles, file sizes.
 
 C (csrc/): a module is a stem inside a layer folder, X.c and X.h together ("surface/plan"); a
 header without a .c of its name is a module of its own. Module A depends on module B when a

@@ -1,6 +1,5 @@
 #!/bin/sh
-# Byte-identity of the CLI's output against another build (used for issue 11's restructuring;
-# reusable for any change that must not change output). Not part of `make test`.
+# Byte-identity of the CLI's output against another build (for any change that must not change output). Not part of `make test`.
 #
 #   tests/layout/compare_outputs.sh REV            build REV (a git revision) in a temporary
 #                                                  worktree and compare it with build/ccnurbs

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The source tree's shape (issue 11): tests/layout/check_layers.py on this checkout, after a
+# The source tree's shape: tests/layout/check_layers.py on this checkout, after a
 # self-test that shows each of its checks failing on a small tree built here that breaks it.
 cd "$(dirname "$0")/../.." || exit 2
 CHECK=tests/layout/check_layers.py

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The tear box (issue 17's test cage, from the surface-quality issue): the surface of a cube
+"""The tear box (a test cage of the CAD export and the cap fairness harness): the surface of a cube
 with 3 x 3 quads per side, x scaled by 1.4 and z by 0.8; the ring of x-parallel edges in the
 slab of largest x has interval 0.25, the ring of z-parallel edges of the middle z slab 3 (all
 others 1). Standard library only.   make_tearbox.py out.obj

@@ -1,5 +1,5 @@
 #!/bin/sh
-# `ccnurbs export` (ccn_plan_export) vs OpenCASCADE (build/occt_read), issue 17's acceptance:
+# `ccnurbs export` (ccn_plan_export) vs OpenCASCADE (build/occt_read), the acceptance:
 # cages: cube, torus, the Fig. 16-18 star cages (non-uniform intervals), the tear box
 # (make_tearbox.py), n-gons (ngon_prism), boundaries (lshape, mixed_boundary),
 # the 2.5k-face production-like cage (tests/bench/make_bench_cages.py), the cube with

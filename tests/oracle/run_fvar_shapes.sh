@@ -1,5 +1,5 @@
 #!/bin/sh
-# Face-varying channels (UV maps) of OpenSubdiv's regression shapes vs OpenSubdiv (issue 16).
+# Face-varying channels (UV maps) of OpenSubdiv's regression shapes vs OpenSubdiv.
 #
 # Every in-scope catmark_* shape (tests/data/osd/extract_shapes.py --scope: no degenerate face)
 # that has a UV map (`vt` lines, `f v/vt` corners): the catmark_fvar_* shapes, cube, car, bishop,

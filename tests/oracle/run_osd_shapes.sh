@@ -1,5 +1,5 @@
 #!/bin/sh
-# OpenSubdiv's catmark_* regression shapes vs the OpenSubdiv oracle (issue 12).
+# OpenSubdiv's catmark_* regression shapes vs the OpenSubdiv oracle.
 #
 # For every in-scope shape (tests/data/osd/extract_shapes.py --scope: tags only crease, corner,
 # interpolateboundary, creasemethod, facevaryinginterpolateboundary; no degenerate face;
