@@ -2,9 +2,9 @@
 (libccnurbs.so / ccnurbs.dll / libccnurbs.dylib, OpenBLAS beside it; see blender_manifest.toml).
 
 Only the plan API is bound: ccn_plan_create (with the session's ccn_cache and, after an edit,
-the plan it replaces, in its options) / ccn_plan_sizes / ccn_plan_evaluate (the first
+the plan it replaces, in its options) / ccn_plan_get_sizes / ccn_plan_evaluate (the first
 evaluation after an edit: ccn_plan_evaluate_changed) / ccn_plan_destroy, and its face-varying channels and
-per-vertex data (ccn_plan_add_fvar / ccn_plan_fvar_sizes / ccn_plan_evaluate_fvar /
+per-vertex data (ccn_plan_add_fvar / ccn_plan_get_fvar_sizes / ccn_plan_evaluate_fvar /
 ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
 buffers passed by pointer; a failing call raises CCNError carrying the library's message.
 """
@@ -170,8 +170,8 @@ def _bind(lib):
     lib.ccn_plan_create.restype = ctypes.c_int
     lib.ccn_cache_create.argtypes = [ctypes.POINTER(P), ctypes.POINTER(ccn_error)]
     lib.ccn_cache_create.restype = ctypes.c_int
-    lib.ccn_plan_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
-    lib.ccn_plan_sizes.restype = ctypes.c_int
+    lib.ccn_plan_get_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
+    lib.ccn_plan_get_sizes.restype = ctypes.c_int
     lib.ccn_plan_evaluate.argtypes = [P, c_double_p, ctypes.POINTER(ccn_limit_mesh),
                                       ctypes.POINTER(ccn_error)]
     lib.ccn_plan_evaluate.restype = ctypes.c_int
@@ -182,8 +182,8 @@ def _bind(lib):
     lib.ccn_plan_add_fvar.argtypes = [P, ctypes.POINTER(ccn_fvar_channel), c_int32_p,
                                       ctypes.POINTER(ccn_error)]
     lib.ccn_plan_add_fvar.restype = ctypes.c_int
-    lib.ccn_plan_fvar_sizes.argtypes = [P, ctypes.c_int32, ctypes.POINTER(ccn_fvar_sizes)]
-    lib.ccn_plan_fvar_sizes.restype = ctypes.c_int
+    lib.ccn_plan_get_fvar_sizes.argtypes = [P, ctypes.c_int32, ctypes.POINTER(ccn_fvar_sizes)]
+    lib.ccn_plan_get_fvar_sizes.restype = ctypes.c_int
     lib.ccn_plan_evaluate_fvar.argtypes = [P, ctypes.c_int32, c_double_p, c_double_p, c_int32_p,
                                            ctypes.POINTER(ccn_error)]
     lib.ccn_plan_evaluate_fvar.restype = ctypes.c_int
@@ -341,7 +341,7 @@ class Plan:
             _raise(st, err)
         self._handle = handle
         s = ccn_sizes()
-        st = lib.ccn_plan_sizes(handle, ctypes.byref(s))
+        st = lib.ccn_plan_get_sizes(handle, ctypes.byref(s))
         if st != 0:
             self.close()
             _raise(st, ccn_error())
@@ -427,7 +427,7 @@ class Plan:
 
     def fvar_sizes(self, channel):
         s = ccn_fvar_sizes()
-        st = self._lib.ccn_plan_fvar_sizes(self._handle, channel, ctypes.byref(s))
+        st = self._lib.ccn_plan_get_fvar_sizes(self._handle, channel, ctypes.byref(s))
         if st != 0:
             _raise(st, ccn_error())
         return {name: int(getattr(s, name)) for name, _ in ccn_fvar_sizes._fields_}

@@ -101,7 +101,8 @@ typedef struct {
     int32_t threads;          /* 0 = default */
     int32_t crease_method;    /* ccn_crease_method, default UNIFORM */
     int32_t ev_polyhedron;    /* scheme EIGEN: CCN_POLY_SELECT (default, the per-vertex choice
-                                 of ccn_ev_matrix) or one fixed candidate CCN_POLY_PAPER.. */
+                                 of ccn_ev_matrix); a fixed candidate CCN_POLY_PAPER.. is
+                                 EXPERIMENTAL (research) */
     ccn_cache *cache;         /* ccn_plan_create: operators shared between plans, NULL = the
                                  plan's own (other calls ignore it) */
     ccn_plan *previous;       /* ccn_plan_create: the plan this one replaces after an edit,
@@ -132,7 +133,7 @@ typedef struct {
  * (isolated vertices keep their slot but are counted in num_ignored_verts). */
 ccn_status ccn_mesh_create(const ccn_cage *cage, ccn_mesh **out, ccn_error *err);
 void ccn_mesh_destroy(ccn_mesh *mesh);
-ccn_status ccn_mesh_info_get(const ccn_mesh *mesh, ccn_mesh_info *info);
+ccn_status ccn_mesh_get_info(const ccn_mesh *mesh, ccn_mesh_info *info);
 /* Copies the mesh into caller-owned arrays; any pointer may be NULL.
  * positions: 3*num_verts, face_sizes: num_faces, face_verts: num_face_verts,
  * edge_verts: 2*num_edges, edge_knots: num_edges (the resolved ring interval). */
@@ -140,7 +141,7 @@ ccn_status ccn_mesh_copy(const ccn_mesh *mesh, double *positions, int32_t *face_
                          int32_t *face_verts, int32_t *edge_verts, double *edge_knots);
 /* Sharpness of the mesh's edges (num_edges, edge order of ccn_mesh_copy) and vertices
  * (num_verts) at its level (refined creases decay); any pointer may be NULL. */
-ccn_status ccn_mesh_creases(const ccn_mesh *mesh, double *edge_sharpness, double *vertex_sharpness);
+ccn_status ccn_mesh_get_creases(const ccn_mesh *mesh, double *edge_sharpness, double *vertex_sharpness);
 /* Replaces the vertex positions (3*num_verts) keeping topology and intervals. */
 ccn_status ccn_mesh_set_positions(ccn_mesh *mesh, const double *positions, ccn_error *err);
 
@@ -195,7 +196,7 @@ typedef struct {
 ccn_status ccn_fvar_refine(const ccn_mesh *cage, const ccn_fvar_channel *channel,
                            int32_t levels, const ccn_options *opts, ccn_fvar **out,
                            ccn_error *err);
-ccn_status ccn_fvar_info_get(const ccn_fvar *fvar, ccn_fvar_info *info);
+ccn_status ccn_fvar_get_info(const ccn_fvar *fvar, ccn_fvar_info *info);
 /* values: width * num_values; face_values: num_face_verts value indices; either may be NULL. */
 ccn_status ccn_fvar_copy(const ccn_fvar *fvar, double *values, int32_t *face_values);
 void ccn_fvar_destroy(ccn_fvar *fvar);
@@ -214,7 +215,10 @@ typedef struct {
                            the vertex is outside the range where G1 is verified */
 } ccn_ev_info;
 
-/* Eigen polyhedra (scheme EIGEN; the list with reasons: csrc/rules/eigen_shape.h):
+/* EXPERIMENTAL (research; may change without notice): the fixed eigen-polyhedron candidates,
+ * for `ccnurbs experiment` and studies of the rules. Applications use CCN_POLY_SELECT (the
+ * default, 0 in ccn_options) and ccn_ev_matrix.
+ * Eigen polyhedra (scheme EIGEN; the list with reasons: csrc/rules/eigen_shape.h):
  * CCN_POLY_PAPER = Li 2016 section 5's spoke lengths; 2..11 = l_i^(1-e) d_i^e with
  * e = 0.1, 0.2, -0.1, 0.05, -0.05, 0.15, -0.2, 0.3, -0.3, 0.4; 12 = lengths in the ratio of the
  * transverse Greville abscissae (least squares); 13..28 = interval-dependent sector angles. */
@@ -232,8 +236,9 @@ typedef struct {
 ccn_status ccn_ev_matrix(int32_t n, const double *spoke_knots, ccn_scheme scheme, double *M,
                          ccn_ev_info *info, ccn_error *err);
 
-/* ccn_ev_matrix with a given polyhedron: CCN_POLY_SELECT (= ccn_ev_matrix) or a fixed
- * candidate 1..CCN_POLY_COUNT (no verification). */
+/* EXPERIMENTAL (research; may change without notice): ccn_ev_matrix with a given
+ * polyhedron, CCN_POLY_SELECT (= ccn_ev_matrix) or a fixed candidate 1..CCN_POLY_COUNT (no
+ * verification). */
 ccn_status ccn_ev_matrix_polyhedron(int32_t n, const double *spoke_knots, ccn_scheme scheme,
                                     int32_t polyhedron, double *M, ccn_ev_info *info,
                                     ccn_error *err);
@@ -265,7 +270,7 @@ typedef struct {
     int32_t num_edges;        /* output mesh edges (those of its faces) */
 } ccn_sizes;
 
-/* Caller-owned output buffers; sizes from ccn_plan_sizes. */
+/* Caller-owned output buffers; sizes from ccn_plan_get_sizes. */
 typedef struct {
     double *positions;    /* 3 * num_verts (required) */
     double *normals;      /* 3 * num_verts unit normals, may be NULL */
@@ -310,7 +315,7 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
  *    options' pointer). Face-varying channels are not carried over: add them to the new plan. */
 ccn_status ccn_cache_create(ccn_cache **out, ccn_error *err);
 void ccn_cache_destroy(ccn_cache *cache);
-ccn_status ccn_plan_sizes(const ccn_plan *plan, ccn_sizes *sizes);
+ccn_status ccn_plan_get_sizes(const ccn_plan *plan, ccn_sizes *sizes);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs
  * (face_verts, face_origin) are the same on every call. */
 ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
@@ -344,7 +349,7 @@ typedef struct {
 /* Adds a channel; *channel receives its index (0, 1, ...). */
 ccn_status ccn_plan_add_fvar(ccn_plan *plan, const ccn_fvar_channel *ch, int32_t *channel,
                              ccn_error *err);
-ccn_status ccn_plan_fvar_sizes(const ccn_plan *plan, int32_t channel, ccn_fvar_sizes *sizes);
+ccn_status ccn_plan_get_fvar_sizes(const ccn_plan *plan, int32_t channel, ccn_fvar_sizes *sizes);
 /* values: width * num_cage_values, or NULL for the values given to ccn_plan_add_fvar;
  * out_values: width * num_values (required); face_values: 4 * num_faces, may be NULL. Like
  * ccn_plan_evaluate, one call at a time per plan (a channel over a high-valence n-gon runs
@@ -375,12 +380,12 @@ ccn_status ccn_plan_patches(const ccn_plan *plan, ccn_patch_fn fn, void *user,
  *   # corner i s      vertex i has sharpness s
  * and OpenSubdiv's shape tags (0-based indices, regression/shapes): `t crease`, `t corner`,
  * `t interpolateboundary`, `t creasemethod`, `t facevaryinginterpolateboundary`; other tags
- * are ignored with a warning (ccn_obj_warning). */
+ * are ignored with a warning (ccn_obj_get_warning). */
 typedef struct ccn_obj ccn_obj;
 ccn_status ccn_obj_parse(const char *text, size_t len, ccn_obj **out, ccn_error *err);
 void ccn_obj_destroy(ccn_obj *obj);
 /* A view of the parsed data as a cage (valid while obj lives). */
-ccn_status ccn_obj_cage(const ccn_obj *obj, ccn_cage *cage);
+ccn_status ccn_obj_get_cage(const ccn_obj *obj, ccn_cage *cage);
 /* Options the file's tags ask for; -1 where the file has no such tag. */
 typedef struct {
     int32_t boundary_corners; /* t interpolateboundary: 1 (EDGE_AND_CORNER) -> PINNED,
@@ -395,10 +400,10 @@ ccn_status ccn_obj_get_tags(const ccn_obj *obj, ccn_obj_tags *tags);
  * (valid while obj lives): width = the most components a `vt` line has, linear = the
  * facevaryinginterpolateboundary tag or ALL. num_values = 0 and NULL arrays when the file has
  * no `vt` or a face without texture indices (then a warning says so). */
-ccn_status ccn_obj_fvar(const ccn_obj *obj, ccn_fvar_channel *channel);
+ccn_status ccn_obj_get_fvar(const ccn_obj *obj, ccn_fvar_channel *channel);
 /* Statements the reader skipped with a reason (unknown tags): count and text. */
-int32_t ccn_obj_num_warnings(const ccn_obj *obj);
-const char *ccn_obj_warning(const ccn_obj *obj, int32_t i);
+int32_t ccn_obj_get_num_warnings(const ccn_obj *obj);
+const char *ccn_obj_get_warning(const ccn_obj *obj, int32_t i);
 
 const char *ccn_status_name(ccn_status s);
 

@@ -361,7 +361,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     ccn_status st = check_opts(&o, err);
     if (st) return st;
     ccn_sizes sz;
-    ccn_plan_sizes(plan, &sz);
+    ccn_plan_get_sizes(plan, &sz);
     if (sz.num_caps_deferred > 0) /* no caps at L <= K; fills there would be needless */
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "the plan (output level %d) has no bi-5 caps for its %d extraordinary vertices: "

@@ -1,5 +1,5 @@
 /* OBJ reader: `v x y z`, `vt u [v [w]]`, `f a b c ...` (a, a/b, a/b/c, a//c; negative =
- * relative; the texture index b of every corner makes the UV map, ccn_obj_fvar), the
+ * relative; the texture index b of every corner makes the UV map, ccn_obj_get_fvar), the
  * comment statements `# knot i j d`, `# crease i j s`, `# corner i s` (1-based vertex indices;
  * other readers skip them), and OpenSubdiv's shape tags `t name nints/nfloats/nstrings ...`
  * (regression/common/shape_utils.cpp: crease, corner with 0-based indices, interpolateboundary,
@@ -429,7 +429,7 @@ void ccn_obj_destroy(ccn_obj *o) {
     free(o);
 }
 
-ccn_status ccn_obj_cage(const ccn_obj *o, ccn_cage *c) {
+ccn_status ccn_obj_get_cage(const ccn_obj *o, ccn_cage *c) {
     if (!o || !c) return CCN_ERR_ARGUMENT;
     memset(c, 0, sizeof *c);
     c->num_verts = o->nv;
@@ -445,7 +445,7 @@ ccn_status ccn_obj_cage(const ccn_obj *o, ccn_cage *c) {
     return CCN_OK;
 }
 
-ccn_status ccn_obj_fvar(const ccn_obj *o, ccn_fvar_channel *ch) {
+ccn_status ccn_obj_get_fvar(const ccn_obj *o, ccn_fvar_channel *ch) {
     if (!o || !ch) return CCN_ERR_ARGUMENT;
     memset(ch, 0, sizeof *ch);
     ch->linear = o->tags.fvar_boundary >= 0 ? o->tags.fvar_boundary : CCN_FVAR_LINEAR_ALL;
@@ -463,10 +463,10 @@ ccn_status ccn_obj_get_tags(const ccn_obj *o, ccn_obj_tags *tags) {
     return CCN_OK;
 }
 
-int32_t ccn_obj_num_warnings(const ccn_obj *o) {
+int32_t ccn_obj_get_num_warnings(const ccn_obj *o) {
     return o ? (o->nwarn < OBJ_MAX_WARNINGS ? o->nwarn : OBJ_MAX_WARNINGS) : 0;
 }
 
-const char *ccn_obj_warning(const ccn_obj *o, int32_t i) {
-    return o && i >= 0 && i < ccn_obj_num_warnings(o) ? o->warn[i] : NULL;
+const char *ccn_obj_get_warning(const ccn_obj *o, int32_t i) {
+    return o && i >= 0 && i < ccn_obj_get_num_warnings(o) ? o->warn[i] : NULL;
 }

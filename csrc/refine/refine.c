@@ -226,7 +226,7 @@ done:
     return st;
 }
 
-ccn_status ccn_fvar_info_get(const ccn_fvar *f, ccn_fvar_info *info) {
+ccn_status ccn_fvar_get_info(const ccn_fvar *f, ccn_fvar_info *info) {
     if (!f || !info) return CCN_ERR_ARGUMENT;
     info->width = f->width;
     info->level = f->level;

@@ -233,7 +233,7 @@ fail:
     return st;
 }
 
-ccn_status ccn_plan_sizes(const ccn_plan *p, ccn_sizes *s) {
+ccn_status ccn_plan_get_sizes(const ccn_plan *p, ccn_sizes *s) {
     if (!p || !s) return CCN_ERR_ARGUMENT;
     *s = p->sizes;
     return CCN_OK;

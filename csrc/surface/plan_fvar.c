@@ -67,7 +67,7 @@ ccn_status ccn_plan_add_fvar(ccn_plan *p, const ccn_fvar_channel *ch, int32_t *c
     return CCN_OK;
 }
 
-ccn_status ccn_plan_fvar_sizes(const ccn_plan *p, int32_t channel, ccn_fvar_sizes *s) {
+ccn_status ccn_plan_get_fvar_sizes(const ccn_plan *p, int32_t channel, ccn_fvar_sizes *s) {
     if (!p || !s || channel < 0 || channel >= p->nfv) return CCN_ERR_ARGUMENT;
     const struct ccn__fvchan *c = p->fv[channel];
     s->width = c->width;

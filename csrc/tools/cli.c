@@ -49,9 +49,9 @@ static int load_cage(const char *path, ccn_obj **obj, ccn_cage *cage) {
     ccn_status st = ccn_obj_parse(text, len, obj, &err);
     free(text);
     if (st) return ccn_cli_error(path, &err);
-    ccn_obj_cage(*obj, cage);
-    for (int32_t i = 0; i < ccn_obj_num_warnings(*obj); i++)
-        fprintf(stderr, "ccnurbs: %s: warning: %s\n", path, ccn_obj_warning(*obj, i));
+    ccn_obj_get_cage(*obj, cage);
+    for (int32_t i = 0; i < ccn_obj_get_num_warnings(*obj); i++)
+        fprintf(stderr, "ccnurbs: %s: warning: %s\n", path, ccn_obj_get_warning(*obj, i));
     return 0;
 }
 
@@ -68,7 +68,7 @@ int ccn_cli_load_uv(const char *path, ccn_options *o, int *fvar_linear, ccn_obj 
     int rc = load_cage(path, obj, cage);
     if (rc) return rc;
     resolve_options(*obj, o);
-    ccn_obj_fvar(*obj, uv);
+    ccn_obj_get_fvar(*obj, uv);
     if (*fvar_linear < 0) *fvar_linear = uv->linear;
     uv->linear = *fvar_linear;
     return 0;
@@ -108,7 +108,7 @@ int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan) {
     ccn_error err;
     ccn_status st = ccn_plan_create(&cage, o, plan, &err);
     ccn_sizes sz;
-    while (!st && ccn_plan_sizes(*plan, &sz) == CCN_OK && sz.num_caps_deferred > 0 && sz.levels < 10) {
+    while (!st && ccn_plan_get_sizes(*plan, &sz) == CCN_OK && sz.num_caps_deferred > 0 && sz.levels < 10) {
         ccn_plan_destroy(*plan);
         *plan = NULL;
         o->levels = sz.levels + 1;
@@ -121,7 +121,7 @@ int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan) {
 /* vt lines and the texture index of each face corner of a refined UV map. */
 static int write_uv_values(FILE *f, const ccn_fvar *uv, int32_t **corner) {
     ccn_fvar_info fi;
-    ccn_fvar_info_get(uv, &fi);
+    ccn_fvar_get_info(uv, &fi);
     double *val = malloc(sizeof(double) * (size_t)fi.width * (size_t)(fi.num_values ? fi.num_values : 1));
     *corner = malloc(sizeof(int32_t) * (size_t)(fi.num_face_verts ? fi.num_face_verts : 1));
     if (!val || !*corner) { free(val); return -1; }
@@ -139,7 +139,7 @@ static int write_uv_values(FILE *f, const ccn_fvar *uv, int32_t **corner) {
 
 static int write_body(FILE *f, const ccn_mesh *m, const ccn_fvar *uv, const char *header) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     double *pos = malloc(sizeof(double) * 3 * (size_t)(in.num_verts ? in.num_verts : 1));
     int32_t *fs = malloc(sizeof(int32_t) * (size_t)(in.num_faces ? in.num_faces : 1));
     int32_t *fv = malloc(sizeof(int32_t) * (size_t)(in.num_face_verts ? in.num_face_verts : 1));
@@ -151,7 +151,7 @@ static int write_body(FILE *f, const ccn_mesh *m, const ccn_fvar *uv, const char
     int rc = -1;
     if (!pos || !fs || !fv || !ev || !ek || !es || !vs) goto done;
     ccn_mesh_copy(m, pos, fs, fv, ev, ek);
-    ccn_mesh_creases(m, es, vs);
+    ccn_mesh_get_creases(m, es, vs);
     if (header) fprintf(f, "%s", header);
     fprintf(f, "# ccnurbs level %d: %d vertices, %d faces, %d edges, %d ring conflicts, "
                "%d EV fallbacks\n", (int)in.level, (int)in.num_verts, (int)in.num_faces,

@@ -83,13 +83,13 @@ int ccn_cmd_limit(int argc, char **argv) {
     }
     ccn_obj_destroy(obj);
     ccn_sizes s;
-    ccn_plan_sizes(plan, &s);
+    ccn_plan_get_sizes(plan, &s);
     uv_out uv = {0, 0, NULL, NULL};
     double *uv_values = NULL;
     int32_t *uv_faces = NULL;
     if (ch >= 0) {
         ccn_fvar_sizes fs;
-        ccn_plan_fvar_sizes(plan, ch, &fs);
+        ccn_plan_get_fvar_sizes(plan, ch, &fs);
         uv.width = fs.width;
         uv.num_values = fs.num_values;
         uv_values = malloc(sizeof(double) * (size_t)fs.width * (size_t)(fs.num_values ? fs.num_values : 1));

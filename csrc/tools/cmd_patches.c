@@ -27,7 +27,7 @@ int ccn_cmd_patches(int argc, char **argv) {
     int rc = ccn_cli_load_plan_caps(in, &o, &plan);
     if (rc) return rc;
     ccn_sizes s;
-    ccn_plan_sizes(plan, &s);
+    ccn_plan_get_sizes(plan, &s);
     ccn_limit_mesh lm = {0};
     lm.positions = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
     ccn_error err;

@@ -68,7 +68,7 @@ static ccn_status cm_columns(cm_ctx *c, int c0, double *pos, int32_t nv, ccn_err
     if (!st && c0 == 0) st = ring_of(L2, ev, s0, c->n, c->idx2, err);
     if (!st) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(L2, &in);
+        ccn_mesh_get_info(L2, &in);
         c->fallbacks = in.num_ev_fallbacks;
         double *p2 = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
         if (!p2) st = exp_fail_memory(err);
@@ -122,7 +122,7 @@ static void cm_matrix_checks(const cm_ctx *c, const double *d, cm_result *r) {
 
 static ccn_status cm_matrix(cm_ctx *c, const double *d, cm_result *r, ccn_error *err) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(c->L1, &in);
+    ccn_mesh_get_info(c->L1, &in);
     double *pos = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     if (!pos) return exp_fail_memory(err);
     ccn_status st = CCN_OK;
@@ -233,7 +233,7 @@ static ccn_status cm_spectrum(cm_ctx *c, cm_result *r, double *x, double *y, ccn
 static ccn_status cm_charring(cm_ctx *c, int k, const double *x, const double *y, cm_result *r,
                               ccn_error *err) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(c->L1, &in);
+    ccn_mesh_get_info(c->L1, &in);
     double *pos = calloc(3 * (size_t)in.num_verts, sizeof(double));
     if (!pos) return exp_fail_memory(err);
     for (int t = 0; t < c->N; t++) {

@@ -39,7 +39,7 @@ static void clear_non_argmax(const double *pos, int32_t nf, const int32_t *fs, c
 /* Counts vertices whose z exceeds that of every vertex sharing a face with them (SPEC A11). */
 static ccn_status count_maxima(const ccn_mesh *m, max_result *r, ccn_error *err) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     double *pos = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     int32_t *fs = malloc(sizeof(int32_t) * (size_t)in.num_faces);
     int32_t *fv = malloc(sizeof(int32_t) * (size_t)in.num_face_verts);
@@ -75,7 +75,7 @@ static ccn_status start_level1(const double *d, const fan_cage *c, ccn_mesh **ou
     ccn_mesh_destroy(m0);
     if (st) return st;
     ccn_mesh_info in;
-    ccn_mesh_info_get(*out, &in);
+    ccn_mesh_get_info(*out, &in);
     double *pos = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     if (!pos) return exp_fail_memory(err);
     ccn_mesh_copy(*out, pos, NULL, NULL, NULL, NULL);

@@ -29,7 +29,7 @@ static int quad_index(quad_mesh *q) {
 /* Copies a mesh's positions, faces (must all be quads) and edges, and indexes half-edges. */
 int exp_quad_load(const ccn_mesh *m, quad_mesh *q) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     memset(q, 0, sizeof *q);
     if (in.num_face_verts != 4 * in.num_faces) return -1;
     q->nv = in.num_verts;

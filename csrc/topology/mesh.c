@@ -521,7 +521,7 @@ done:
     return st;
 }
 
-ccn_status ccn_mesh_info_get(const ccn_mesh *m, ccn_mesh_info *info) {
+ccn_status ccn_mesh_get_info(const ccn_mesh *m, ccn_mesh_info *info) {
     if (!m || !info) return CCN_ERR_ARGUMENT;
     *info = m->info;
     return CCN_OK;
@@ -553,7 +553,7 @@ ccn_status ccn_mesh_copy(const ccn_mesh *m, double *positions, int32_t *face_siz
     return CCN_OK;
 }
 
-ccn_status ccn_mesh_creases(const ccn_mesh *m, double *edge_sharpness, double *vertex_sharpness) {
+ccn_status ccn_mesh_get_creases(const ccn_mesh *m, double *edge_sharpness, double *vertex_sharpness) {
     if (!m) return CCN_ERR_ARGUMENT;
     if (m->vweld) { /* welded view: the representatives' */
         for (int32_t e = 0; edge_sharpness && e < m->ne; e++)

@@ -68,7 +68,7 @@ int main(int argc, char **argv) {
     ccn_error err;
     if (!text || ccn_obj_parse(text, len, &obj, &err)) { fprintf(stderr, "cannot read %s\n", argv[1]); return 2; }
     ccn_cage cage;
-    ccn_obj_cage(obj, &cage);
+    ccn_obj_get_cage(obj, &cage);
     double tplan = 1e30, teval = 1e30, tfirst = 0;
     ccn_plan *plan = NULL;
     ccn_cache *cache = NULL; /* "cached": one ccn_cache for every plan (a session's rebuilds) */
@@ -82,7 +82,7 @@ int main(int argc, char **argv) {
         if (r + 1 < reps) ccn_plan_destroy(plan);
     }
     ccn_sizes s;
-    ccn_plan_sizes(plan, &s);
+    ccn_plan_get_sizes(plan, &s);
     double *pos = malloc(sizeof(double) * 3 * s.num_verts), *nrm = malloc(sizeof(double) * 3 * s.num_verts);
     double *cp = malloc(sizeof(double) * 3 * cage.num_verts);
     memcpy(cp, cage.positions, sizeof(double) * 3 * cage.num_verts);
@@ -157,7 +157,7 @@ int main(int argc, char **argv) {
     ccn_plan_destroy(plan);
     ccn_cache_destroy(cache);
     ccn_fvar_channel uv;
-    ccn_obj_fvar(obj, &uv);
+    ccn_obj_get_fvar(obj, &uv);
     const char *mode = getenv("CCN_BENCH_FVAR"); /* ccn_fvar_linear, default CORNERS_ONLY */
     uv.linear = mode ? atoi(mode) : CCN_FVAR_LINEAR_CORNERS_ONLY;
     if (uv.num_values) { /* the same plan with one UV channel */
@@ -176,7 +176,7 @@ int main(int argc, char **argv) {
             tp1 = t2 - t0 < tp1 ? t2 - t0 : tp1;
             m0 = h1 - h0;
             m1 = h2 - h0;
-            ccn_plan_fvar_sizes(p, ch, &fs);
+            ccn_plan_get_fvar_sizes(p, ch, &fs);
             if (!uvo) uvo = malloc(sizeof(double) * (size_t)fs.width * (size_t)fs.num_values);
             for (int k = 0; k < 3; k++) {
                 cp[0] += 1e-3;

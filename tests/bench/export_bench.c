@@ -36,15 +36,15 @@ int main(int argc, char **argv) {
     ccn_plan *plan;
     ccn_error err;
     ccn_options o = {0};
-    if (ccn_obj_parse(text, (size_t)n, &obj, &err) || ccn_obj_cage(obj, &cage) ||
+    if (ccn_obj_parse(text, (size_t)n, &obj, &err) || ccn_obj_get_cage(obj, &cage) ||
         ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
     ccn_sizes sz;
-    ccn_plan_sizes(plan, &sz);
+    ccn_plan_get_sizes(plan, &sz);
     while (sz.num_caps_deferred > 0) { /* the caps exist only above the cap level */
         o.levels = sz.levels + 1;
         ccn_plan_destroy(plan);
         if (ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
-        ccn_plan_sizes(plan, &sz);
+        ccn_plan_get_sizes(plan, &sz);
     }
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), tev = 1e30;
     ccn_limit_mesh lm = {.positions = pos};

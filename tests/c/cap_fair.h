@@ -131,7 +131,7 @@ static int fplan_run(const ccn_cage *cage, ccn_options o, fplan *f) {
     memset(f, 0, sizeof *f);
     if (ccn_plan_create(cage, &o, &f->p, &err)) { fprintf(stderr, "plan: %s\n", err.message); return -1; }
     ccn_sizes s;
-    ccn_plan_sizes(f->p, &s);
+    ccn_plan_get_sizes(f->p, &s);
     f->nv = s.num_verts, f->nf = s.num_faces;
     f->x = malloc(sizeof(double) * 3 * (size_t)f->nv);
     f->n = malloc(sizeof(double) * 3 * (size_t)f->nv);
@@ -314,7 +314,7 @@ static int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) 
     orf.cap = CCN_CAP_REFINE;
     if (fplan_run(cage, ob, &pb) || fplan_run(cage, orf, &pr)) { fplan_free(&pb); fplan_free(&pr); return -1; }
     ccn_sizes sz;
-    ccn_plan_sizes(pb.p, &sz);
+    ccn_plan_get_sizes(pb.p, &sz);
     F->caps += sz.num_caps;
     F->fallbacks += sz.num_cap_fallbacks;
     double size = bbox_diag(pr.x, pr.nv);

@@ -51,7 +51,7 @@ static void expect_obj_err(const char *text, ccn_status st, int line, const char
 /* Checks a mesh's outputs: finite positions and positive finite intervals. */
 static void check_mesh_finite(const ccn_mesh *m, const char *what) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     double *p = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     double *k = malloc(sizeof(double) * (size_t)in.num_edges);
     ccn_mesh_copy(m, p, NULL, NULL, NULL, k);
@@ -75,7 +75,7 @@ static ccn_mesh *accept_and_refine(const ccn_cage *c) {
     if (st != CCN_OK) return NULL;
     check_mesh_finite(m, "cage");
     ccn_mesh_info in0;
-    ccn_mesh_info_get(m, &in0);
+    ccn_mesh_get_info(m, &in0);
     for (int sc = 0; sc < 3; sc++)
         for (int corners = 0; corners < 2; corners++) {
             ccn_options o = {0};
@@ -89,7 +89,7 @@ static ccn_mesh *accept_and_refine(const ccn_cage *c) {
             snprintf(what, sizeof what, "scheme %d corners %d level 2", sc, corners);
             check_mesh_finite(r, what);
             ccn_mesh_info in;
-            ccn_mesh_info_get(r, &in);
+            ccn_mesh_get_info(r, &in);
             CHECK(in.level == 2 && in.num_faces == 4 * in0.num_face_verts,
                   "level %d, %d faces (cage corners %d)", in.level, in.num_faces,
                   in0.num_face_verts);
@@ -101,7 +101,7 @@ static ccn_mesh *accept_and_refine(const ccn_cage *c) {
 /* Resolved interval of cage edge (a, b); NaN if not an edge. */
 static double interval_of(const ccn_mesh *m, int32_t a, int32_t b) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)in.num_edges);
     double *k = malloc(sizeof(double) * (size_t)in.num_edges), x = NAN;
     ccn_mesh_copy(m, NULL, NULL, NULL, ev, k);
@@ -147,7 +147,7 @@ static void interval_row(double value, double want_ratio) {
         CHECK(fabs(r / want_ratio - 1) < 1e-9, "interval ratio %.17g, expected %.17g", r,
               want_ratio);
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         CHECK(in.num_ignored_edges == 0 && in.num_ring_conflicts == 0, "ignored %d conflicts %d",
               in.num_ignored_edges, in.num_ring_conflicts);
         ccn_mesh_destroy(m);
@@ -166,11 +166,11 @@ static void crease_row(double value, double want) {
     ccn_mesh *m = accept_and_refine(&c);
     if (m) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         int32_t *e2 = malloc(sizeof(int32_t) * 2 * (size_t)in.num_edges);
         double *sh = malloc(sizeof(double) * (size_t)in.num_edges), got = -1;
         ccn_mesh_copy(m, NULL, NULL, NULL, e2, NULL);
-        ccn_mesh_creases(m, sh, NULL);
+        ccn_mesh_get_creases(m, sh, NULL);
         for (int32_t e = 0; e < in.num_edges; e++)
             if ((e2[2 * e] == 5 && e2[2 * e + 1] == 6) || (e2[2 * e] == 6 && e2[2 * e + 1] == 5)) got = sh[e];
         CHECK(got == want, "sharpness %g stored as %g, expected %g", value, got, want);
@@ -339,7 +339,7 @@ static void row_valence_200(void) {
     ccn_mesh *m = accept_and_refine(&c);
     if (m) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         CHECK(in.max_valence == 200 && in.num_extraordinary == 1, "max valence %d, EVs %d",
               in.max_valence, in.num_extraordinary);
         ccn_mesh_destroy(m);
@@ -366,7 +366,7 @@ static void row_one_quad(void) {
     CHECK(ccn_refine(m, 2, NULL, &r, &err) == CCN_OK, "%s", err.message);
     if (r) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(r, &in);
+        ccn_mesh_get_info(r, &in);
         CHECK(in.num_verts == 25 && in.num_faces == 16, "%d verts %d faces", in.num_verts,
               in.num_faces);
         ccn_mesh_destroy(r);
@@ -384,14 +384,14 @@ static void row_isolated_vertices(void) {
     ccn_mesh *m = accept_and_refine(&c);
     if (!m) return;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     CHECK(in.num_ignored_verts == 2, "ignored %d", in.num_ignored_verts);
     ccn_mesh *r = NULL;
     ccn_error err;
     CHECK(ccn_refine(m, 1, NULL, &r, &err) == CCN_OK, "%s", err.message);
     if (r) {
         ccn_mesh_info ri;
-        ccn_mesh_info_get(r, &ri);
+        ccn_mesh_get_info(r, &ri);
         double *q = malloc(sizeof(double) * 3 * (size_t)ri.num_verts);
         ccn_mesh_copy(r, q, NULL, NULL, NULL, NULL);
         /* vertex points come last, in vertex order: isolated vertex 4 is carried along */
@@ -421,7 +421,7 @@ static void row_coordinates_1e30(void) {
         ccn_refine(u, 2, NULL, &ru, &err);
         if (r && ru) {
             ccn_mesh_info in;
-            ccn_mesh_info_get(r, &in);
+            ccn_mesh_get_info(r, &in);
             double *a = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
             double *b = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
             ccn_mesh_copy(r, a, NULL, NULL, NULL, NULL);
@@ -502,7 +502,7 @@ static void row_two_million_faces(void) {
           "create: %s", err.message);
     if (m) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         CHECK(in.num_faces == 2000000 && in.num_verts == 1001 * 2001 &&
                   in.num_edges == 1000 * 2001 + 2000 * 1001 && in.num_face_verts == 8000000,
               "cage counts %d %d %d %d", in.num_faces, in.num_verts, in.num_edges,
@@ -514,7 +514,7 @@ static void row_two_million_faces(void) {
               "refine: %s", err.message);
         if (r) {
             ccn_mesh_info ri;
-            ccn_mesh_info_get(r, &ri);
+            ccn_mesh_get_info(r, &ri);
             int64_t nv = (int64_t)in.num_faces + in.num_edges + in.num_verts;
             int64_t ne = 2 * (int64_t)in.num_edges + in.num_face_verts;
             CHECK(ri.num_verts == nv && ri.num_faces == 8000000 && ri.num_edges == ne &&
@@ -563,7 +563,7 @@ static ccn_obj *parsed_cage(const char *text, ccn_cage *c) {
     ccn_obj *o = NULL;
     ccn_error err;
     CHECK(ccn_obj_parse(text, strlen(text), &o, &err) == CCN_OK, "%s", err.message);
-    if (o) ccn_obj_cage(o, c);
+    if (o) ccn_obj_get_cage(o, c);
     return o;
 }
 

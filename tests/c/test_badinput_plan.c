@@ -27,7 +27,7 @@ static void expect_plan_err(const ccn_cage *c, const ccn_options *o, ccn_status 
 /* Evaluates a plan with every output; checks finiteness, unit normals, index ranges. */
 static int eval_check(ccn_plan *p, const ccn_cage *c, const double *positions, const char *what) {
     ccn_sizes z;
-    ccn_plan_sizes(p, &z);
+    ccn_plan_get_sizes(p, &z);
     CHECK(z.num_cage_verts == c->num_verts, "%s: num_cage_verts %d", what, z.num_cage_verts);
     double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     double *N = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
@@ -101,7 +101,7 @@ static void row_nan_inf_coordinate(void) {
     CHECK(ccn_plan_create(&good, &o, &pl, &err) == CCN_OK, "%s", err.message);
     if (!pl) return;
     ccn_sizes z;
-    ccn_plan_sizes(pl, &z);
+    ccn_plan_get_sizes(pl, &z);
     double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     ccn_limit_mesh out = {.positions = P};
     CHECK(ccn_plan_evaluate(pl, p, &out, &err) == CCN_ERR_ARGUMENT, "evaluate with Inf");
@@ -138,7 +138,7 @@ static void row_bad_options(void) {
     CHECK(ccn_plan_create(NULL, NULL, &p, &err) == CCN_ERR_ARGUMENT && p == NULL, "NULL cage");
     CHECK(ccn_plan_create(&c, NULL, NULL, &err) == CCN_ERR_ARGUMENT, "NULL out");
     ccn_sizes z;
-    CHECK(ccn_plan_sizes(NULL, &z) == CCN_ERR_ARGUMENT, "sizes of NULL");
+    CHECK(ccn_plan_get_sizes(NULL, &z) == CCN_ERR_ARGUMENT, "sizes of NULL");
     ccn_plan_destroy(NULL);
 }
 
@@ -203,7 +203,7 @@ static void row_valence_200(void) {
     CHECK(ccn_plan_create(&c, &o, &p, &err) == CCN_OK, "%s", err.message);
     if (p) {
         ccn_sizes z;
-        ccn_plan_sizes(p, &z);
+        ccn_plan_get_sizes(p, &z);
         CHECK(z.num_extraordinary == 1 && z.num_caps + z.num_cap_fallbacks == 1,
               "EVs %d, caps %d, cap fallbacks %d", z.num_extraordinary, z.num_caps,
               z.num_cap_fallbacks);
@@ -223,7 +223,7 @@ static void row_one_quad(void) {
         CHECK(ccn_plan_create(&c, &o, &p, &err) == CCN_OK, "%s", err.message);
         if (!p) continue;
         ccn_sizes z;
-        ccn_plan_sizes(p, &z);
+        ccn_plan_get_sizes(p, &z);
         int32_t side = (1 << L) + 1;
         CHECK(z.num_verts == side * side && z.num_faces == (1 << L) * (1 << L) && z.levels == L,
               "level %d: %d verts %d faces", L, z.num_verts, z.num_faces);
@@ -244,7 +244,7 @@ static void row_isolated_vertices(void) {
     CHECK(ccn_plan_create(&c, &o, &pl, &err) == CCN_OK, "%s", err.message);
     if (!pl) return;
     ccn_sizes z;
-    ccn_plan_sizes(pl, &z);
+    ccn_plan_get_sizes(pl, &z);
     CHECK(z.num_ignored_verts == 2 && z.num_cage_verts == 6, "ignored %d, cage verts %d",
           z.num_ignored_verts, z.num_cage_verts);
     CHECK(z.num_verts == 9 && z.num_faces == 4, "isolated vertices left out: %d verts %d faces",
@@ -265,7 +265,7 @@ static void row_coordinates_1e30(void) {
     CHECK(ccn_plan_create(&c, &o, &pl, &err) == CCN_OK, "%s", err.message);
     if (pl) {
         ccn_sizes z;
-        ccn_plan_sizes(pl, &z);
+        ccn_plan_get_sizes(pl, &z);
         double *a = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         double *b = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         double *u = malloc(sizeof(double) * 3 * (size_t)s.nv);
@@ -310,7 +310,7 @@ static void row_coordinates_near_dbl_max(void) {
             if (accepted) eval_check(p, &c, big, "evaluate(huge positions)");
             else {
                 ccn_sizes z;
-                ccn_plan_sizes(p, &z);
+                ccn_plan_get_sizes(p, &z);
                 double *out = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
                 ccn_limit_mesh lm = {.positions = out};
                 CHECK(ccn_plan_evaluate(p, big, &lm, &err) == CCN_ERR_ARGUMENT, "evaluate must refuse");
@@ -339,7 +339,7 @@ static void row_two_million_faces(void) {
     CHECK(st == CCN_OK || st == CCN_ERR_MEMORY, "plan: %s", err.message);
     if (p) {
         ccn_sizes z;
-        ccn_plan_sizes(p, &z);
+        ccn_plan_get_sizes(p, &z);
         CHECK(z.num_faces == 2000000 && z.num_verts == 1001 * 2001 && z.levels == 0,
               "sizes %d verts %d faces", z.num_verts, z.num_faces);
         double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);

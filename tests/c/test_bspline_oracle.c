@@ -8,7 +8,7 @@
  * oracle's own index bookkeeping.
  *
  * Library cases (public API only: ccn_mesh_create / ccn_refine / ccn_mesh_copy /
- * ccn_mesh_info_get):
+ * ccn_mesh_get_info):
  *   1. torus grids (all valence 4): EIGEN and NURSS after 1-3 levels == periodic tensor
  *      Boehm; refined edge intervals == ring interval / 2^L; refined faces == grid cells.
  *   2. open grids, pinned corners: == tensor Boehm of the doubly point-reflected grid
@@ -707,7 +707,7 @@ typedef struct {
 
 static int lmesh_get(const ccn_mesh *m, lmesh *o) {
     memset(o, 0, sizeof *o);
-    if (ccn_mesh_info_get(m, &o->info) != CCN_OK) return 0;
+    if (ccn_mesh_get_info(m, &o->info) != CCN_OK) return 0;
     o->pos = NEW(double, 3 * (size_t)o->info.num_verts);
     o->fs = NEW(int32_t, o->info.num_faces);
     o->fv = NEW(int32_t, o->info.num_face_verts);
@@ -737,7 +737,7 @@ static ccn_mesh *make_mesh(const gcage *g, int with_knots) {
     CHECK(st == CCN_OK && mesh, "ccn_mesh_create: %d %s", (int)st, err.message);
     if (st != CCN_OK) { ccn_mesh_destroy(mesh); return NULL; }
     ccn_mesh_info info;
-    if (ccn_mesh_info_get(mesh, &info) == CCN_OK) {
+    if (ccn_mesh_get_info(mesh, &info) == CCN_OK) {
         CHECK(info.num_verts == g->nverts && info.num_faces == g->nfaces && info.num_edges == g->nedges,
               "cage counts %d/%d/%d", info.num_verts, info.num_faces, info.num_edges);
         CHECK(info.num_rings == g->m + g->n, "num_rings %d, expected %d", info.num_rings, g->m + g->n);
@@ -876,7 +876,7 @@ static double run_direct(const gcage *g, int L, const ccn_options *opt, int with
     if (st == CCN_OK && out) {
         lmesh lm;
         if (lmesh_get(out, &lm)) e = compare_refined(g, &lm, L, tag);
-        else CHECK(0, "%s: ccn_mesh_info_get/ccn_mesh_copy failed", tag);
+        else CHECK(0, "%s: ccn_mesh_get_info/ccn_mesh_copy failed", tag);
         lmesh_free(&lm);
     }
     ccn_mesh_destroy(out);
@@ -1184,7 +1184,7 @@ static void test_refined_info_counts(void) {
             opt.boundary_corners = CCN_CORNERS_PINNED;
             ccn_mesh *out = NULL;
             ccn_mesh_info info;
-            if (ccn_refine(mesh, L, &opt, &out, NULL) == CCN_OK && ccn_mesh_info_get(out, &info) == CCN_OK) {
+            if (ccn_refine(mesh, L, &opt, &out, NULL) == CCN_OK && ccn_mesh_get_info(out, &info) == CCN_OK) {
                 const int Mc = g.m << L, Nc = g.n << L;
                 CHECK(info.num_rings == Mc + Nc, "%s L=%d: num_rings %d, expected %d (2^L x the cage's %d)",
                       periodic ? "torus" : "open", L, info.num_rings, Mc + Nc, g.m + g.n);

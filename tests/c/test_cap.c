@@ -208,7 +208,7 @@ static void compare_cage(const ccn_cage *cage, int levels, cap_stats *st) {
     CHECK(ccn_plan_create(cage, &orf, &pr, &err) == CCN_OK, "%s", err.message);
     if (!pb || !pr) { ccn_plan_destroy(pb); ccn_plan_destroy(pr); return; }
     ccn_sizes s;
-    ccn_plan_sizes(pb, &s);
+    ccn_plan_get_sizes(pb, &s);
     double *xb = malloc(sizeof(double) * 3 * s.num_verts), *nb = malloc(sizeof(double) * 3 * s.num_verts);
     double *xr = malloc(sizeof(double) * 3 * s.num_verts), *nr = malloc(sizeof(double) * 3 * s.num_verts);
     ccn_limit_mesh lb = {.positions = xb, .normals = nb}, lr = {.positions = xr, .normals = nr};
@@ -298,7 +298,7 @@ static void test_shipped_cages(void) {
         ccn_error err;
         if (!t || ccn_obj_parse(t, len, &o, &err)) { CHECK(0, "load %s", names[i]); free(t); continue; }
         ccn_cage cage;
-        ccn_obj_cage(o, &cage);
+        ccn_obj_get_cage(o, &cage);
         compare_cage(&cage, 4, &st); /* above K (2, or 3 for close EVs) */
         ccn_obj_destroy(o);
         free(t);
@@ -358,7 +358,7 @@ static void test_nonuniform_period4(void) {
         ccn_error err;
         if (p) {
             ccn_sizes s;
-            ccn_plan_sizes(p, &s);
+            ccn_plan_get_sizes(p, &s);
             st.caps += s.num_caps;
             double *x = malloc(sizeof(double) * 3 * s.num_verts), *nn = malloc(sizeof(double) * 3 * s.num_verts);
             ccn_limit_mesh lm = {.positions = x, .normals = nn};
@@ -431,7 +431,7 @@ static void test_nonuniform_extreme(void) {
         ccn_plan *p = fan_plan(&c, 6, d);
         if (p) {
             ccn_sizes sz;
-            ccn_plan_sizes(p, &sz);
+            ccn_plan_get_sizes(p, &sz);
             printf("  Fig. 16 pattern, ratio %g: %d caps, %d cap fallbacks\n", ratios[q], sz.num_caps, sz.num_cap_fallbacks);
             CHECK(q == 0 ? sz.num_caps == 1 && sz.num_cap_fallbacks == 0 : sz.num_caps == 0 && sz.num_cap_fallbacks == 1,
                   "ratio %g: %d caps, %d fallbacks", ratios[q], sz.num_caps, sz.num_cap_fallbacks);
@@ -457,7 +457,7 @@ static void test_nonuniform_planar(void) {
         ccn_error err;
         if (p) {
             ccn_sizes sz;
-            ccn_plan_sizes(p, &sz);
+            ccn_plan_get_sizes(p, &sz);
             caps += sz.num_caps;
             double *x = malloc(sizeof(double) * 3 * sz.num_verts);
             ccn_limit_mesh lm = {.positions = x};
@@ -499,8 +499,8 @@ static void test_shared_cache(void) {
         CHECK(plan_cached(&cage, &o, cache, &b, &err) == CCN_OK, "%s", err.message);
         if (a && b) {
             ccn_sizes sa, sb;
-            ccn_plan_sizes(a, &sa);
-            ccn_plan_sizes(b, &sb);
+            ccn_plan_get_sizes(a, &sa);
+            ccn_plan_get_sizes(b, &sb);
             caps += sb.num_caps;
             size_t nv = (size_t)sa.num_verts;
             double *xa = malloc(sizeof(double) * 6 * nv), *xb = malloc(sizeof(double) * 6 * nv);

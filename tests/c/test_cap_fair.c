@@ -117,7 +117,7 @@ static void test_no_cap_work_at_low_levels(void) {
         o.cap = CCN_CAP_REFINE;
         CHECK(fplan_run(&g, o, &pr) == 0, "plan");
         ccn_sizes sz;
-        ccn_plan_sizes(pb.p, &sz);
+        ccn_plan_get_sizes(pb.p, &sz);
         int same = memcmp(pb.x, pr.x, sizeof(double) * 3 * pr.nv) == 0 && memcmp(pb.n, pr.n, sizeof(double) * 3 * pr.nv) == 0;
         if (L <= 2) CHECK(sz.num_caps == 0 && sz.num_cap_fallbacks == 0 && same, "L%d: %d caps, identical %d", L, sz.num_caps, same);
         else CHECK(sz.num_caps == 4 && sz.num_cap_fallbacks == 4 && !same, "L%d: %d caps, %d fallbacks", L, sz.num_caps, sz.num_cap_fallbacks);

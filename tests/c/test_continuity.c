@@ -135,7 +135,7 @@ static int limit_of(const ccn_cage *cage, ccn_cache *cache, double **out, int32_
         return -1;
     }
     ccn_sizes sz;
-    ccn_plan_sizes(p, &sz);
+    ccn_plan_get_sizes(p, &sz);
     *nv = sz.num_verts;
     *out = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     ccn_limit_mesh m;
@@ -346,7 +346,7 @@ static void regression(const char *path, double x) {
     free(text);
     if (!obj) return;
     ccn_cage cage;
-    ccn_obj_cage(obj, &cage);
+    ccn_obj_get_cage(obj, &cage);
     double *k = malloc(sizeof(double) * (size_t)(cage.num_edges ? cage.num_edges : 1)), *s[3];
     int32_t nv = 0, hits = 0;
     ccn_cache *cache = NULL;

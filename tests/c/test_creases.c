@@ -191,7 +191,7 @@ static int limit(const ccn_cage *c, const ccn_options *o, lmesh *lm) {
     ccn_error err;
     memset(lm, 0, sizeof *lm);
     if (ccn_plan_create(c, o, &p, &err)) { fprintf(stderr, "plan: %s\n", err.message); return -1; }
-    ccn_plan_sizes(p, &lm->s);
+    ccn_plan_get_sizes(p, &lm->s);
     lm->nv = lm->s.num_verts; lm->nf = lm->s.num_faces;
     lm->pos = NEW(double, 3 * lm->nv);
     lm->nrm = NEW(double, 3 * lm->nv);
@@ -362,11 +362,11 @@ static void check_crease_curve(int torus, int L) {
     for (int j = 0; j < nj; j++) memcpy(Q + 3 * j, g.P + 3 * gv(&g, c, j), sizeof(double) * 3);
     double *B = oc_boehm(Q, N, g.dv, torus, L, &n);
     ccn_mesh_info in;
-    ccn_mesh_info_get(r, &in);
+    ccn_mesh_get_info(r, &in);
     double *pos = NEW(double, 3 * in.num_verts), *es = NEW(double, in.num_edges);
     int32_t *ev = NEW(int32_t, 2 * in.num_edges);
     ccn_mesh_copy(r, pos, NULL, NULL, ev, NULL);
-    ccn_mesh_creases(r, es, NULL);
+    ccn_mesh_get_creases(r, es, NULL);
     /* every vertex of a sharp refined edge is a point of the refined crease polygon */
     double size = bbox(pos, in.num_verts), worst = 0;
     int nsharp = 0;
@@ -398,12 +398,12 @@ typedef struct { int nv, nf, ne, nfv; double *pos, *kn, *es; int32_t *fs, *fv, *
 static mdata mesh_data(const ccn_mesh *m) {
     mdata d;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     d.nv = in.num_verts; d.nf = in.num_faces; d.ne = in.num_edges; d.nfv = in.num_face_verts;
     d.pos = NEW(double, 3 * d.nv); d.kn = NEW(double, d.ne); d.es = NEW(double, d.ne);
     d.fs = NEW(int32_t, d.nf); d.fv = NEW(int32_t, d.nfv); d.ev = NEW(int32_t, 2 * d.ne);
     ccn_mesh_copy(m, d.pos, d.fs, d.fv, d.ev, d.kn);
-    ccn_mesh_creases(m, d.es, NULL);
+    ccn_mesh_get_creases(m, d.es, NULL);
     return d;
 }
 static void md_free(mdata *d) { free(d->pos); free(d->kn); free(d->es); free(d->fs); free(d->fv); free(d->ev); }

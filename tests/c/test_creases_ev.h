@@ -113,7 +113,7 @@ static void test_crease_evs(void) {
         free(t);
         if (!obj) continue;
         ccn_cage c;
-        ccn_obj_cage(obj, &c);
+        ccn_obj_get_cage(obj, &c);
         /* vertex 0 is the centre; its spokes go to the vertices sharing an edge with it */
         int32_t sp[2 * 8], ns = 0;
         for (int f = 0, off = 0; f < c.num_faces; off += c.face_sizes[f], f++)

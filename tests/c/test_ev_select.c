@@ -86,7 +86,7 @@ static int engine_blend(int n, const double *d, int poly, int levels, double *su
     int maxima = -1;
     if (ccn_mesh_create(&cg, &m0, NULL) || ccn_refine(m0, 1, &o1, &m1, NULL)) goto done;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m1, &in);
+    ccn_mesh_get_info(m1, &in);
     double *p = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     ccn_mesh_copy(m1, p, NULL, NULL, NULL, NULL);
     for (int32_t v = 0; v < in.num_verts; v++) p[3 * v + 2] = 0;
@@ -94,7 +94,7 @@ static int engine_blend(int n, const double *d, int poly, int levels, double *su
     ccn_mesh_set_positions(m1, p, NULL);
     free(p);
     if (ccn_refine(m1, levels, &o, &m5, NULL)) goto done;
-    ccn_mesh_info_get(m5, &in);
+    ccn_mesh_get_info(m5, &in);
     p = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
     int32_t *fs = malloc(sizeof(int32_t) * (size_t)in.num_faces), *fv = malloc(sizeof(int32_t) * (size_t)in.num_face_verts);
     unsigned char *low = calloc((size_t)in.num_verts, 1);
@@ -221,7 +221,7 @@ static void test_plan_counters(void) {
             CHECK(ccn_plan_create(&cg, &o, &p, NULL) == CCN_OK, "plan");
             double ms = 1e3 * (double)(clock() - t0) / CLOCKS_PER_SEC;
             if (!p) continue;
-            ccn_plan_sizes(p, &sz);
+            ccn_plan_get_sizes(p, &sz);
             CHECK(sz.num_ev_verified == want_ver[c] && sz.num_ev_outside_g1 == want_out[c],
                   "cage %d cap %d: verified %d outside %d", c, cap, sz.num_ev_verified, sz.num_ev_outside_g1);
             if (cap) printf("# fan cage %d (n %d): verified %d, outside G1 %d, plan %.1f ms\n", c, ns[c],

@@ -111,11 +111,11 @@ static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn
     if (!text) return NULL;
     ccn_error err;
     ccn_plan *p = NULL;
-    if (ccn_obj_parse(text, len, obj, &err) || ccn_obj_cage(*obj, cage) || ccn_plan_create(cage, o, &p, &err))
+    if (ccn_obj_parse(text, len, obj, &err) || ccn_obj_get_cage(*obj, cage) || ccn_plan_create(cage, o, &p, &err))
         p = NULL;
     free(text);
     ccn_sizes sz; /* the bi-5 caps exist only above the cap level; raise the level */
-    while (p && ccn_plan_sizes(p, &sz) == CCN_OK && sz.num_caps_deferred > 0) {
+    while (p && ccn_plan_get_sizes(p, &sz) == CCN_OK && sz.num_caps_deferred > 0) {
         ccn_options o2 = {0};
         if (o) o2 = *o;
         o2.levels = sz.levels + 1;
@@ -193,7 +193,7 @@ static int cell_uv(const ccn_export_cell *c, const double st[2], double *u, doub
 static int against_limit(ccn_plan *p, const ccn_cage *cage, const faces *F, double *worst,
                          double *fill_worst, int *unmatched) {
     ccn_sizes sz;
-    ccn_plan_sizes(p, &sz);
+    ccn_plan_get_sizes(p, &sz);
     int L = sz.levels;
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)sz.num_faces);
@@ -344,7 +344,7 @@ static void check_refined(const char *name, int fill_levels) {
     ccn_error err;
     CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "export: %s", err.message);
     ccn_sizes sz;
-    ccn_plan_sizes(p, &sz);
+    ccn_plan_get_sizes(p, &sz);
     int top = info.fill_level;
     int plevel = top - fill_levels; /* the patch level: the cap level K (fallbacks) or the deepest */
     CHECK(sz.num_caps == 0 && plevel >= 1 && plevel <= sz.refine_levels, "%s: fill level %d, patch level %d + %d",
@@ -363,7 +363,7 @@ static void check_refined(const char *name, int fill_levels) {
         CHECK(l >= 1 && l <= top && l < 8, "refined face %d has level %d", i, l);
         if (l < 1 || l > top || l >= 8) continue;
         ccn_mesh_info mi;
-        ccn_mesh_info_get(ref[l], &mi);
+        ccn_mesh_get_info(ref[l], &mi);
         int found = -1;
         double Q[3][2];
         for (int q = 0; q < mi.num_faces && found < 0; q++) { /* the level-l face at this place */

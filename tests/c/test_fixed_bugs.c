@@ -31,7 +31,7 @@ static void accepted_means_finite(const ccn_cage *c, ccn_status allowed_err) {
                   ccn_status_name(st), err.message);
             if (!r) continue;
             ccn_mesh_info in;
-            ccn_mesh_info_get(r, &in);
+            ccn_mesh_get_info(r, &in);
             double *p = malloc(sizeof(double) * 3 * (size_t)in.num_verts);
             ccn_mesh_copy(r, p, NULL, NULL, NULL, NULL);
             int bad = 0;
@@ -61,7 +61,7 @@ static void plan_accepted_means_finite(const ccn_cage *c, ccn_status allowed_err
                 continue;
             }
             ccn_sizes z;
-            ccn_plan_sizes(p, &z);
+            ccn_plan_get_sizes(p, &z);
             double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
             double *N = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
             ccn_limit_mesh out = {.positions = P, .normals = N};
@@ -144,7 +144,7 @@ static void kb3_plan_null_positions(void) {
     CHECK(ccn_plan_create(&c, &o, &pl, &err) == CCN_OK, "%s", err.message);
     if (!pl) return;
     ccn_sizes z;
-    ccn_plan_sizes(pl, &z);
+    ccn_plan_get_sizes(pl, &z);
     double *a = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     double *b = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     ccn_limit_mesh oa = {.positions = a}, ob = {.positions = b};

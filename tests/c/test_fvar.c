@@ -185,8 +185,8 @@ static int run(const grid *g, int linear, ccn_scheme scheme, int L, int corners,
     }
     ccn_sizes s;
     ccn_fvar_sizes fs;
-    ccn_plan_sizes(p, &s);
-    ccn_plan_fvar_sizes(p, c, &fs);
+    ccn_plan_get_sizes(p, &s);
+    ccn_plan_get_fvar_sizes(p, c, &fs);
     double *pos = NEW(double, 3 * s.num_verts), *vals = NEW(double, (size_t)g->W * fs.num_values);
     int32_t *fv = NEW(int32_t, 4 * s.num_faces), *fo = NEW(int32_t, s.num_faces), *fvv = NEW(int32_t, 4 * s.num_faces);
     ccn_limit_mesh lm = {.positions = pos, .face_verts = fv, .face_origin = fo};
@@ -344,8 +344,8 @@ static void test_uv_corners_follow_mode(void) {
         CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK && ccn_plan_add_fvar(p, &ch, &c, &err) == CCN_OK, "%s", err.message);
         ccn_sizes s;
         ccn_fvar_sizes fs;
-        ccn_plan_sizes(p, &s);
-        ccn_plan_fvar_sizes(p, c, &fs);
+        ccn_plan_get_sizes(p, &s);
+        ccn_plan_get_fvar_sizes(p, c, &fs);
         double *vals = NEW(double, 2 * fs.num_values);
         int32_t *fvv = NEW(int32_t, 4 * s.num_faces);
         CHECK(ccn_plan_evaluate_fvar(p, c, NULL, vals, fvv, &err) == CCN_OK, "%s", err.message);
@@ -415,8 +415,8 @@ static void test_plan_reuse_and_vertex_data(void) {
     CHECK(ccn_plan_add_fvar(p, &ch, &c1, &err) == CCN_OK && c1 == 1, "%s", err.message);
     ccn_sizes s;
     ccn_fvar_sizes fs;
-    ccn_plan_sizes(p, &s);
-    ccn_plan_fvar_sizes(p, c0, &fs);
+    ccn_plan_get_sizes(p, &s);
+    ccn_plan_get_fvar_sizes(p, c0, &fs);
     CHECK(fs.width == 5 && fs.num_cage_values == g.nval && fs.num_seam_edges == g.N, "sizes: width %d, %d cage values, %d seams",
           (int)fs.width, (int)fs.num_cage_values, (int)fs.num_seam_edges);
     size_t nout = (size_t)5 * fs.num_values;
@@ -430,7 +430,7 @@ static void test_plan_reuse_and_vertex_data(void) {
     CHECK(ccn_plan_evaluate_fvar(p, c0, NULL, b, NULL, &err) == CCN_OK && !memcmp(a, b, sizeof(double) * nout),
           "NULL values: not the values given");
     ccn_fvar_sizes fs1;
-    ccn_plan_fvar_sizes(p, c1, &fs1);
+    ccn_plan_get_fvar_sizes(p, c1, &fs1);
     double *lin = NEW(double, 5 * (size_t)fs1.num_values);
     CHECK(ccn_plan_evaluate_fvar(p, c1, vals, lin, NULL, &err) == CCN_OK, "bilinear channel: %s", err.message);
     free(lin);
@@ -505,8 +505,8 @@ static void test_refine_and_obj(void) {
     if (!obj) return;
     ccn_cage cage;
     ccn_fvar_channel ch;
-    ccn_obj_cage(obj, &cage);
-    ccn_obj_fvar(obj, &ch);
+    ccn_obj_get_cage(obj, &cage);
+    ccn_obj_get_fvar(obj, &ch);
     CHECK(ch.width == 2 && ch.num_values == 8 && ch.linear == CCN_FVAR_LINEAR_ALL && ch.indices[5] == 5,
           "UV map: width %d, %d values, mode %d", (int)ch.width, (int)ch.num_values, (int)ch.linear);
     ccn_mesh *m = NULL;
@@ -515,7 +515,7 @@ static void test_refine_and_obj(void) {
     CHECK(ccn_mesh_create(&cage, &m, &err) == CCN_OK && ccn_fvar_refine(m, &ch, 1, &o, &fv, &err) == CCN_OK, "%s", err.message);
     if (fv) {
         ccn_fvar_info in;
-        ccn_fvar_info_get(fv, &in);
+        ccn_fvar_get_info(fv, &in);
         CHECK(in.num_face_verts == 32 && in.num_seam_edges == 1 && in.level == 1, "info: %d corners, %d seams",
               (int)in.num_face_verts, (int)in.num_seam_edges);
         double *v = NEW(double, 2 * in.num_values);
@@ -533,9 +533,9 @@ static void test_refine_and_obj(void) {
     /* a partial map is ignored with a warning; an index beyond the vt lines names its line */
     const char *partial = "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3\n";
     CHECK(ccn_obj_parse(partial, strlen(partial), &obj, &err) == CCN_OK, "%s", err.message);
-    ccn_obj_fvar(obj, &ch);
-    CHECK(ch.num_values == 0 && ccn_obj_num_warnings(obj) == 1 && strstr(ccn_obj_warning(obj, 0), "UV map ignored"),
-          "partial UV map: %d values, %d warnings", (int)ch.num_values, (int)ccn_obj_num_warnings(obj));
+    ccn_obj_get_fvar(obj, &ch);
+    CHECK(ch.num_values == 0 && ccn_obj_get_num_warnings(obj) == 1 && strstr(ccn_obj_get_warning(obj, 0), "UV map ignored"),
+          "partial UV map: %d values, %d warnings", (int)ch.num_values, (int)ccn_obj_get_num_warnings(obj));
     ccn_obj_destroy(obj);
     const char *beyond = "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/4\n";
     CHECK(ccn_obj_parse(beyond, strlen(beyond), &obj, &err) == CCN_ERR_IO && err.element_kind == CCN_ELEM_LINE &&
@@ -557,7 +557,7 @@ static void test_uv_follows_polyhedron(void) {
     free(t);
     if (!obj) return;
     ccn_cage cage;
-    ccn_obj_cage(obj, &cage);
+    ccn_obj_get_cage(obj, &cage);
     ccn_fvar_channel ch = {.width = 3, .num_values = cage.num_verts, .values = cage.positions,
                            .indices = cage.face_verts, .linear = CCN_FVAR_LINEAR_NONE};
     ccn_mesh *m = NULL;
@@ -572,8 +572,8 @@ static void test_uv_follows_polyhedron(void) {
         if (ccn_refine(m, 2, &o, &r, &err) == CCN_OK && ccn_fvar_refine(m, &ch, 2, &o, &fv, &err) == CCN_OK) {
             ccn_mesh_info mi;
             ccn_fvar_info fi;
-            ccn_mesh_info_get(r, &mi);
-            ccn_fvar_info_get(fv, &fi);
+            ccn_mesh_get_info(r, &mi);
+            ccn_fvar_get_info(fv, &fi);
             double *P = NEW(double, 3 * mi.num_verts), *V = NEW(double, 3 * fi.num_values);
             int32_t *pf = NEW(int32_t, mi.num_face_verts), *vf = NEW(int32_t, fi.num_face_verts);
             ccn_mesh_copy(r, P, NULL, pf, NULL, NULL);
@@ -591,8 +591,8 @@ static void test_uv_follows_polyhedron(void) {
         if (ccn_plan_create(&cage, &o, &p, &err) == CCN_OK && ccn_plan_add_fvar(p, &ch, &idx, &err) == CCN_OK) {
             ccn_sizes sz;
             ccn_fvar_sizes fs;
-            ccn_plan_sizes(p, &sz);
-            ccn_plan_fvar_sizes(p, idx, &fs);
+            ccn_plan_get_sizes(p, &sz);
+            ccn_plan_get_fvar_sizes(p, idx, &fs);
             double *X = NEW(double, 3 * sz.num_verts), *U = NEW(double, 3 * fs.num_values);
             int32_t *q4 = NEW(int32_t, 4 * sz.num_faces), *u4 = NEW(int32_t, 4 * sz.num_faces);
             ccn_limit_mesh lm = {.positions = X, .face_verts = q4};
@@ -629,8 +629,8 @@ static void test_levels_channel(void) {
     free(t);
     ccn_cage cage;
     ccn_fvar_channel uv;
-    ccn_obj_cage(obj, &cage);
-    ccn_obj_fvar(obj, &uv);
+    ccn_obj_get_cage(obj, &cage);
+    ccn_obj_get_fvar(obj, &uv);
     int nv = uv.num_values;
     for (int mode = 0; mode < 6; mode++)
         for (int W = 1; W <= 5; W += 2) {
@@ -647,7 +647,7 @@ static void test_levels_channel(void) {
                 CHECK(0, "mode %d width %d: %s", mode, W, err.message);
             } else {
                 ccn_fvar_sizes fs;
-                ccn_plan_fvar_sizes(p, c, &fs);
+                ccn_plan_get_fvar_sizes(p, c, &fs);
                 size_t n = (size_t)W * fs.num_values;
                 double *a = malloc(sizeof(double) * n), *b = malloc(sizeof(double) * n), *bq = malloc(sizeof(double) * n);
                 double *cc = malloc(sizeof(double) * n), *a2 = malloc(sizeof(double) * n);

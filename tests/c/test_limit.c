@@ -19,7 +19,7 @@ static ccn_obj *load(const char *name, ccn_cage *cage) {
     ccn_error err;
     if (!t || ccn_obj_parse(t, len, &o, &err)) { free(t); return NULL; }
     free(t);
-    ccn_obj_cage(o, cage);
+    ccn_obj_get_cage(o, cage);
     return o;
 }
 
@@ -28,7 +28,7 @@ static int evaluate(const ccn_cage *cage, const ccn_options *o, const double *po
     ccn_error err;
     memset(lm, 0, sizeof *lm);
     if (ccn_plan_create(cage, o, &p, &err)) { fprintf(stderr, "plan: %s\n", err.message); return -1; }
-    ccn_plan_sizes(p, &lm->s);
+    ccn_plan_get_sizes(p, &lm->s);
     lm->nv = lm->s.num_verts; lm->nf = lm->s.num_faces;
     lm->pos = malloc(sizeof(double) * 3 * lm->nv);
     lm->nrm = malloc(sizeof(double) * 3 * lm->nv);
@@ -174,7 +174,7 @@ static void test_watertight(void) {
         ccn_error err;
         ccn_mesh_create(&cage, &m, &err);
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         for (int L = 1; L <= 3; L++)
             for (int cap = 0; cap < 2; cap++) {
                 ccn_options o = {0};
@@ -257,7 +257,7 @@ static void test_plan_reuse(void) {
         ccn_error err;
         CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "%s", err.message);
         ccn_sizes s;
-        ccn_plan_sizes(p, &s);
+        ccn_plan_get_sizes(p, &s);
         double *a = malloc(sizeof(double) * 3 * s.num_verts), *na = malloc(sizeof(double) * 3 * s.num_verts);
         ccn_limit_mesh out = {.positions = a, .normals = na};
         CHECK(ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK, "%s", err.message);

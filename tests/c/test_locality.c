@@ -46,7 +46,7 @@ static int load(const char *path, double lo, double hi, soup *s) {
     if (!text || ccn_obj_parse(text, len, &obj, &err) != CCN_OK) { free(text); return 0; }
     free(text);
     ccn_cage c;
-    ccn_obj_cage(obj, &c);
+    ccn_obj_get_cage(obj, &c);
     s->nv = c.num_verts, s->nf = c.num_faces;
     s->pos = malloc(sizeof(double) * 3 * (size_t)s->nv);
     memcpy(s->pos, c.positions, sizeof(double) * 3 * (size_t)s->nv);
@@ -149,7 +149,7 @@ static double *limit(const soup *s, int32_t levels, int32_t *nv) {
         return NULL;
     }
     ccn_sizes sz;
-    ccn_plan_sizes(p, &sz);
+    ccn_plan_get_sizes(p, &sz);
     double *out = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     ccn_limit_mesh m;
     memset(&m, 0, sizeof m);

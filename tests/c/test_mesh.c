@@ -60,13 +60,13 @@ static void expect_nonmanifold(int nv, int nf, const int32_t *fs, const int32_t 
     CHECK(st == CCN_OK, "accepted: %s", err.message);
     if (!m) return;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     CHECK(in.num_verts == nv && in.num_faces == nf && in.num_edges == ne,
           "counts %d %d %d, expected %d %d %d", in.num_verts, in.num_faces, in.num_edges, nv, nf, ne);
     int32_t ev[64];
     double es[32], vs[8];
     ccn_mesh_copy(m, NULL, NULL, NULL, ev, NULL);
-    ccn_mesh_creases(m, es, vs);
+    ccn_mesh_get_creases(m, es, vs);
     int found = a < 0;
     for (int32_t e = 0; e < in.num_edges && a >= 0; e++) {
         int hit = (ev[2 * e] == a && ev[2 * e + 1] == b) || (ev[2 * e] == b && ev[2 * e + 1] == a);
@@ -83,7 +83,7 @@ static void expect_nonmanifold(int nv, int nf, const int32_t *fs, const int32_t 
     CHECK(ccn_refine(m, 1, NULL, &r, &err) == CCN_OK, "refine: %s", err.message);
     if (r) {
         ccn_mesh_info ri;
-        ccn_mesh_info_get(r, &ri);
+        ccn_mesh_get_info(r, &ri);
         CHECK(ri.num_verts == nv + ne + nf, "level 1: %d vertices, expected %d", ri.num_verts, nv + ne + nf);
         double *p = malloc(sizeof(double) * 3 * (size_t)ri.num_verts);
         ccn_mesh_copy(r, p, NULL, NULL, NULL, NULL);
@@ -170,7 +170,7 @@ static void test_isolated_and_loose(void) {
     CHECK(ccn_mesh_create(&c, &m, &err) == CCN_OK, "%s", err.message);
     if (!m) return;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     CHECK(in.num_ignored_verts == 4, "ignored verts %d", in.num_ignored_verts);
     CHECK(in.num_ignored_edges == 2, "ignored edges %d", in.num_ignored_edges);
     CHECK(in.num_edges == 4 && in.num_boundary_edges == 4, "edges %d/%d", in.num_edges, in.num_boundary_edges);
@@ -200,7 +200,7 @@ static void check_grid_rings(int nx, int ny, int32_t a, int32_t b, const double 
     CHECK(ccn_mesh_create(&c, &m, &err) == CCN_OK, "%s", err.message);
     if (!m) return;
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     int32_t oev[512];
     double okn[256];
     ccn_mesh_copy(m, NULL, NULL, NULL, oev, okn);
@@ -287,7 +287,7 @@ static void test_clamp_extreme_ratio(void) {
     CHECK(ccn_refine(m, 3, &o, &r, &err) == CCN_OK, "%s", err.message);
     if (r) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(r, &in);
+        ccn_mesh_get_info(r, &in);
         double *pos = malloc(sizeof(double) * 3 * in.num_verts);
         ccn_mesh_copy(r, pos, NULL, NULL, NULL, NULL);
         int finite = 1;

@@ -202,7 +202,7 @@ static int run_plan(const cage_t *c, const ccn_options *o, outmesh *m) {
     ccn_sizes s;
     memset(m, 0, sizeof *m);
     if (ccn_plan_create(&g, o, &p, &err)) { fprintf(stderr, "%s: %s\n", c->name, err.message); return -1; }
-    ccn_plan_sizes(p, &s);
+    ccn_plan_get_sizes(p, &s);
     m->nv = s.num_verts, m->nf = s.num_faces;
     m->pos = malloc(sizeof(double) * 3 * (size_t)m->nv);
     m->nrm = malloc(sizeof(double) * 3 * (size_t)m->nv);

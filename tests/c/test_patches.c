@@ -91,7 +91,7 @@ static void check_level(int levels, double *maxerr) {
     CHECK(ccn_refine(m, levels, &o, &r, &err) == CCN_OK, "%s", err.message);
     if (!m || !r) { ccn_mesh_destroy(m); ccn_mesh_destroy(r); return; }
     ccn_mesh_info in;
-    ccn_mesh_info_get(r, &in);
+    ccn_mesh_get_info(r, &in);
     double size = 0;
     for (int k = 0; k < 3 * nv; k++) size = fabs(pos[k]) > size ? fabs(pos[k]) : size;
     int nfaces = in.num_faces, checked = 0;

@@ -56,7 +56,7 @@ static int load(const char *path, int random_knots, int random_creases, edit_cag
     ccn_error err;
     if (!text || ccn_obj_parse(text, len, &c->obj, &err) != CCN_OK) { free(text); return 0; }
     free(text);
-    ccn_obj_cage(c->obj, &c->cage);
+    ccn_obj_get_cage(c->obj, &c->cage);
     int64_t nh = 0;
     for (int32_t f = 0; f < c->cage.num_faces; f++) nh += c->cage.face_sizes[f];
     c->ev = malloc(sizeof(int32_t) * 2 * (size_t)nh);
@@ -112,7 +112,7 @@ typedef struct { ccn_sizes s; double *x; int32_t *fv; } result;
  * updates in place. */
 static int evaluate_at(ccn_plan *p, const double *positions, result *from, result *r) {
     ccn_error err;
-    ccn_plan_sizes(p, &r->s);
+    ccn_plan_get_sizes(p, &r->s);
     size_t nv = (size_t)r->s.num_verts, nf = (size_t)r->s.num_faces;
     if (from) {
         r->x = from->x, r->fv = from->fv;
@@ -346,7 +346,7 @@ static void test_channels_and_unevaluated(void) {
     edit_cage c;
     if (!load("tests/data/fvar_abab.obj", 1, 0, &c)) { CHECK(0, "cannot read fvar_abab.obj"); return; }
     ccn_fvar_channel uv;
-    CHECK(ccn_obj_fvar(c.obj, &uv) == CCN_OK && uv.num_values > 0, "no UV map");
+    CHECK(ccn_obj_get_fvar(c.obj, &uv) == CCN_OK && uv.num_values > 0, "no UV map");
     ccn_error err;
     ccn_options o = {0};
     o.levels = 2;
@@ -363,7 +363,7 @@ static void test_channels_and_unevaluated(void) {
         CHECK(d == 0 && dn == 0, "unevaluated earlier plan: differs from a new plan (%g, %g)", d, dn);
         free(a.x); free(a.fv); free(b.x); free(b.fv);
         ccn_fvar_sizes fs;
-        CHECK(ccn_plan_fvar_sizes(next, 0, &fs) != CCN_OK, "the earlier plan's channel was carried over");
+        CHECK(ccn_plan_get_fvar_sizes(next, 0, &fs) != CCN_OK, "the earlier plan's channel was carried over");
         int32_t ch2 = -1;
         CHECK(ccn_plan_add_fvar(next, &uv, &ch2, &err) == CCN_OK && ch2 == 0, "%s", err.message);
     }

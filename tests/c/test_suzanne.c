@@ -105,7 +105,7 @@ static void test_forehead(void) {
     free(t);
     if (!obj) return;
     ccn_cage cg;
-    ccn_obj_cage(obj, &cg);
+    ccn_obj_get_cage(obj, &cg);
     knots_t k;
     int sizes[5];
     forehead_rings(&cg, &k, sizes);
@@ -122,7 +122,7 @@ static void test_forehead(void) {
             CHECK(ccn_plan_create(&cg, &o, &p, &err) == CCN_OK, "%s", err.message);
             if (!p) return;
             ccn_sizes s;
-            ccn_plan_sizes(p, &s);
+            ccn_plan_get_sizes(p, &s);
             double *x = malloc(sizeof(double) * 3 * s.num_verts), *n = malloc(sizeof(double) * 3 * s.num_verts);
             int32_t *q = malloc(sizeof(int32_t) * 4 * s.num_faces);
             ccn_limit_mesh lm = {.positions = x, .normals = n, .face_verts = q};

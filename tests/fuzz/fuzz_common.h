@@ -39,7 +39,7 @@ static inline int fz_known_bugs(void) { return 1; } /* KB1, KB2b, KB3 are fixed:
  * (KB1). */
 static inline void fz_mesh_facts(const ccn_mesh *m, double *maxabs, int *interior_v2) {
     ccn_mesh_info in;
-    ccn_mesh_info_get(m, &in);
+    ccn_mesh_get_info(m, &in);
     double *p = malloc(sizeof(double) * 3 * (size_t)(in.num_verts + 1));
     int32_t *fs = malloc(sizeof(int32_t) * (size_t)(in.num_faces + 1));
     int32_t *ev = malloc(sizeof(int32_t) * 2 * (size_t)(in.num_edges + 1));
@@ -106,8 +106,8 @@ static inline ccn_status fz_refine_check(const ccn_mesh *m, int levels, const cc
     }
     FZ_CHECK(r != NULL, "ccn_refine OK without a mesh");
     ccn_mesh_info in0, in;
-    FZ_CHECK(ccn_mesh_info_get(m, &in0) == CCN_OK, "info");
-    FZ_CHECK(ccn_mesh_info_get(r, &in) == CCN_OK, "info");
+    FZ_CHECK(ccn_mesh_get_info(m, &in0) == CCN_OK, "info");
+    FZ_CHECK(ccn_mesh_get_info(r, &in) == CCN_OK, "info");
     FZ_CHECK(in.level == in0.level + levels, "level %d after %d levels from %d", in.level,
              levels, in0.level);
     if (levels == 1) {
@@ -155,7 +155,7 @@ static inline ccn_status fz_create_check(const ccn_cage *c, ccn_mesh **out) {
     }
     FZ_CHECK(*out != NULL, "ccn_mesh_create OK without a mesh");
     ccn_mesh_info in;
-    FZ_CHECK(ccn_mesh_info_get(*out, &in) == CCN_OK, "info");
+    FZ_CHECK(ccn_mesh_get_info(*out, &in) == CCN_OK, "info");
     FZ_CHECK(in.num_verts == c->num_verts && in.num_faces == c->num_faces, "counts %d %d",
              in.num_verts, in.num_faces);
     FZ_CHECK(in.num_ignored_verts >= 0 && in.num_ignored_verts <= in.num_verts, "ignored");

@@ -72,7 +72,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (nonfinite && c.num_verts > 0) FZ_CHECK(st != CCN_OK, "non-finite coordinate accepted");
     if (st == CCN_OK) {
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         uint8_t sel = next(&r); /* which (scheme, corners) also gets 2 levels */
         for (int sc = 0; sc < 3; sc++)
             for (int corners = 0; corners < 2; corners++) {

@@ -1,5 +1,5 @@
 /* libFuzzer harness: ccn_obj_parse on arbitrary bytes (not NUL-terminated); when it parses,
- * ccn_obj_cage + ccn_mesh_create, and when that succeeds ccn_refine by 1 and 2 levels with
+ * ccn_obj_get_cage + ccn_mesh_create, and when that succeeds ccn_refine by 1 and 2 levels with
  * a scheme and corner rule picked from a hash of the input. Checks: statuses in range and
  * equal to err.status, messages NUL-terminated, refined counts, indices and positions
  * finite (fuzz_common.h). */
@@ -25,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     FZ_CHECK(obj != NULL, "parse OK without an object");
     ccn_cage cage;
-    FZ_CHECK(ccn_obj_cage(obj, &cage) == CCN_OK, "ccn_obj_cage");
+    FZ_CHECK(ccn_obj_get_cage(obj, &cage) == CCN_OK, "ccn_obj_get_cage");
     FZ_CHECK(cage.num_verts >= 0 && cage.num_faces >= 0 && cage.num_edges >= 0, "counts");
     ccn_mesh *m = NULL;
     if (fz_create_check(&cage, &m) == CCN_OK) {
@@ -34,7 +34,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         o.scheme = (ccn_scheme)(h % 3);
         o.boundary_corners = (int32_t)((h >> 2) & 1);
         ccn_mesh_info in;
-        ccn_mesh_info_get(m, &in);
+        ccn_mesh_get_info(m, &in);
         int32_t max_face = 0;
         for (int32_t f = 0; f < cage.num_faces; f++)
             if (cage.face_sizes[f] > max_face) max_face = cage.face_sizes[f];

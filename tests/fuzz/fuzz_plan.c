@@ -1,5 +1,5 @@
 /* libFuzzer harness: bytes -> a cage (fuzz_cage.h) and options (including out-of-range
- * scheme, cap, levels and corners) -> ccn_plan_create + ccn_plan_sizes + ccn_plan_evaluate
+ * scheme, cap, levels and corners) -> ccn_plan_create + ccn_plan_get_sizes + ccn_plan_evaluate
  * (cage positions, then positions from the input, then with optional outputs left NULL).
  * Checks: statuses in range, messages NUL-terminated, invalid options and cages rejected,
  * sizes consistent, every position and normal finite (normals of unit length), indices in
@@ -7,7 +7,7 @@
  * control points, cage face in range; a face-varying channel and per-vertex data from the
  * input (fvar_stage); an interval edit through ccn_plan_create with options.previous and ccn_plan_evaluate_changed,
  * byte-identical to a new plan (edit_stage). Output buffers are allocated at exactly
- * the sizes ccn_plan_sizes gives, so ASan catches any write past them.
+ * the sizes ccn_plan_get_sizes gives, so ASan catches any write past them.
  * Input: byte 0 flags (as fuzz_mesh.c), the cage, then scheme, cap, levels, corners,
  * threads bytes, then positions for the second evaluation. Built only once the library
  * defines ccn_plan_evaluate (tests/fuzz/fuzz.mk). */
@@ -88,7 +88,7 @@ static void fvar_stage(ccn_plan *plan, const ccn_cage *c, const ccn_sizes *z, rd
     else FZ_CHECK(st == CCN_OK || st == CCN_ERR_MEMORY, "add_fvar: %d %s", (int)st, e.message);
     if (st == CCN_OK) {
         ccn_fvar_sizes fs;
-        FZ_CHECK(ccn_plan_fvar_sizes(plan, id, &fs) == CCN_OK, "ccn_plan_fvar_sizes");
+        FZ_CHECK(ccn_plan_get_fvar_sizes(plan, id, &fs) == CCN_OK, "ccn_plan_get_fvar_sizes");
         FZ_CHECK(fs.width == width && fs.num_cage_values == nvals && fs.num_values > 0 &&
                      fs.num_values <= 4 * (int64_t)z->num_faces,
                  "fvar sizes: width %d, %d cage values, %d values", fs.width, fs.num_cage_values,
@@ -183,7 +183,7 @@ static void edit_stage(ccn_plan **plan, const ccn_cage *c, const ccn_options *o,
     FZ_CHECK((sr == CCN_OK) == (next_plan != NULL), "recreate %d with plan %p", (int)sr, (void *)next_plan);
     if (sr == CCN_OK && sf == CCN_OK && s0 == CCN_OK) {
         ccn_sizes z2;
-        FZ_CHECK(ccn_plan_sizes(next_plan, &z2) == CCN_OK && z2.num_verts == z->num_verts, "sizes changed");
+        FZ_CHECK(ccn_plan_get_sizes(next_plan, &z2) == CCN_OK && z2.num_verts == z->num_verts, "sizes changed");
         fz_err_init(&e);
         ccn_status e1 = ccn_plan_evaluate(fresh, NULL, &lb, &e);
         fz_err_init(&e);
@@ -256,7 +256,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
     ccn_sizes z;
     memset(&z, 0x5A, sizeof z);
-    FZ_CHECK(ccn_plan_sizes(plan, &z) == CCN_OK, "ccn_plan_sizes");
+    FZ_CHECK(ccn_plan_get_sizes(plan, &z) == CCN_OK, "ccn_plan_get_sizes");
     FZ_CHECK(z.num_cage_verts == c.num_verts, "num_cage_verts %d, cage %d", z.num_cage_verts,
              c.num_verts);
     FZ_CHECK(z.num_verts > 0 && z.num_faces > 0, "sizes %d %d", z.num_verts, z.num_faces);

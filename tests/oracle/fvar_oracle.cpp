@@ -8,7 +8,7 @@
 // limit masks are not exact), per face corner, against ccnurbs' ccn_fvar_refine (refined) and
 // ccn_plan_evaluate_fvar on a plan with --cap refine (limit), for each scheme (cc; eigen, with
 // the shapes' equal intervals). ccnurbs reads the file with its own OBJ reader (ccn_obj_parse,
-// ccn_obj_fvar); options as the CLI resolves them (interpolateboundary 1 pins corners,
+// ccn_obj_get_fvar); options as the CLI resolves them (interpolateboundary 1 pins corners,
 // creasemethod). Corners are matched through OpenSubdiv's topology (ccnurbsFaceOrder below),
 // and the corner positions (refined, limit) must agree too (<= T of the bounding box), so a
 // wrong match cannot pass. Error: the largest component difference over the diagonal of the
@@ -246,8 +246,8 @@ int main(int argc, char **argv) {
         ccn_cage cage;
         ccn_fvar_channel ch;
         ccn_obj_tags tags;
-        ccn_obj_cage(obj, &cage);
-        ccn_obj_fvar(obj, &ch);
+        ccn_obj_get_cage(obj, &cage);
+        ccn_obj_get_fvar(obj, &ch);
         ccn_obj_get_tags(obj, &tags);
         if (ch.num_values != (int)m.uvs.size()) die("ccnurbs reads another UV map");
         const double uvdiag = bboxDiag(ch.values, (size_t)ch.num_values, ch.width);
@@ -274,7 +274,7 @@ int main(int argc, char **argv) {
                 ccn_mesh *ref = nullptr;
                 if (ccn_refine(cm, K, &co, &ref, &err)) ccnDie("ccn_refine", err);
                 ccn_mesh_info ri;
-                ccn_mesh_info_get(ref, &ri);
+                ccn_mesh_get_info(ref, &ri);
                 std::vector<double> rpos(3 * (size_t)ri.num_verts);
                 std::vector<int32_t> rfv((size_t)ri.num_face_verts);
                 ccn_mesh_copy(ref, rpos.data(), nullptr, rfv.data(), nullptr, nullptr);
@@ -283,7 +283,7 @@ int main(int argc, char **argv) {
                 ccn_plan *plan = nullptr;
                 if (ccn_plan_create(&cage, &co, &plan, &err)) ccnDie("ccn_plan_create", err);
                 ccn_sizes sz;
-                ccn_plan_sizes(plan, &sz);
+                ccn_plan_get_sizes(plan, &sz);
                 std::vector<double> lp(3 * (size_t)sz.num_verts);
                 std::vector<int32_t> lfv(4 * (size_t)sz.num_faces);
                 ccn_limit_mesh lm = {lp.data(), nullptr, lfv.data(), nullptr, nullptr, nullptr, nullptr, nullptr};
@@ -296,7 +296,7 @@ int main(int argc, char **argv) {
                     ccn_fvar *fv = nullptr;
                     if (ccn_fvar_refine(cm, &c, K, &co, &fv, &err)) ccnDie("ccn_fvar_refine", err);
                     ccn_fvar_info fi;
-                    ccn_fvar_info_get(fv, &fi);
+                    ccn_fvar_get_info(fv, &fi);
                     std::vector<double> vals((size_t)fi.width * (size_t)fi.num_values);
                     std::vector<int32_t> fvi((size_t)fi.num_face_verts);
                     ccn_fvar_copy(fv, vals.data(), fvi.data());
@@ -304,7 +304,7 @@ int main(int argc, char **argv) {
                     int32_t idx;
                     if (ccn_plan_add_fvar(plan, &c, &idx, &err)) ccnDie("ccn_plan_add_fvar", err);
                     ccn_fvar_sizes fs;
-                    ccn_plan_fvar_sizes(plan, idx, &fs);
+                    ccn_plan_get_fvar_sizes(plan, idx, &fs);
                     std::vector<double> lv((size_t)fs.width * (size_t)fs.num_values);
                     std::vector<int32_t> lfi(4 * (size_t)sz.num_faces);
                     if (ccn_plan_evaluate_fvar(plan, idx, nullptr, lv.data(), lfi.data(), &err))

@@ -96,11 +96,11 @@ int main(int argc, char **argv) {
     }
     obj_parse_fn obj_parse = (obj_parse_fn)sym(h, "ccn_obj_parse");
     obj_destroy_fn obj_destroy = (obj_destroy_fn)sym(h, "ccn_obj_destroy");
-    obj_cage_fn obj_cage = (obj_cage_fn)sym(h, "ccn_obj_cage");
+    obj_cage_fn obj_cage = (obj_cage_fn)sym(h, "ccn_obj_get_cage");
     cache_create_fn cache_create = (cache_create_fn)sym(h, "ccn_cache_create");
     cache_destroy_fn cache_destroy = (cache_destroy_fn)sym(h, "ccn_cache_destroy");
     plan_create_fn plan_create = (plan_create_fn)sym(h, "ccn_plan_create");
-    plan_sizes_fn plan_sizes = (plan_sizes_fn)sym(h, "ccn_plan_sizes");
+    plan_sizes_fn plan_sizes = (plan_sizes_fn)sym(h, "ccn_plan_get_sizes");
     plan_evaluate_fn plan_evaluate = (plan_evaluate_fn)sym(h, "ccn_plan_evaluate");
     plan_destroy_fn plan_destroy = (plan_destroy_fn)sym(h, "ccn_plan_destroy");
     if (!obj_parse || !obj_destroy || !obj_cage || !cache_create || !cache_destroy ||
