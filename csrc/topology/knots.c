@@ -15,31 +15,18 @@
 #include "topology/knots.h"
 
 #include "base/error.h"
+#include "base/union_find.h"
 
 #include <math.h>
 #include <string.h>
-
-static int32_t uf_find(int32_t *parent, int32_t x) {
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-static void uf_union(int32_t *parent, int32_t a, int32_t b) {
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a != b) parent[a < b ? b : a] = a < b ? a : b;
-}
 
 static void link_quads(const ccn_mesh *m, int32_t *parent) {
     for (int32_t e = 0; e < m->ne; e++) parent[e] = e;
     for (int32_t f = 0; f < m->nf; f++) {
         if (ccn__fsize(m, f) != 4) continue;
         const int32_t *he = m->hedge + m->fstart[f];
-        uf_union(parent, he[0], he[2]);
-        uf_union(parent, he[1], he[3]);
+        ccn__uf_union(parent, he[0], he[2]);
+        ccn__uf_union(parent, he[1], he[3]);
     }
 }
 
@@ -103,7 +90,7 @@ ccn_status ccn__resolve_rings(ccn_mesh *m, const double *val, const int32_t *sou
     }
     link_quads(m, parent);
     for (int32_t e = 0; e < m->ne; e++) {
-        parent[e] = uf_find(parent, e);
+        parent[e] = ccn__uf_find(parent, e);
         lo[e] = INFINITY;
         hi[e] = -INFINITY;
     }

@@ -14,6 +14,7 @@
 #include "topology/split.h"
 
 #include "base/error.h"
+#include "base/union_find.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -25,19 +26,6 @@ static int ekey_cmp(const void *x, const void *y) {
     if (p->a != q->a) return p->a < q->a ? -1 : 1;
     if (p->b != q->b) return p->b < q->b ? -1 : 1;
     return (p->h > q->h) - (p->h < q->h);
-}
-
-static int32_t uf_find(int32_t *par, int32_t x) {
-    while (par[x] != x) {
-        par[x] = par[par[x]];
-        x = par[x];
-    }
-    return x;
-}
-
-static void uf_union(int32_t *par, int32_t a, int32_t b) {
-    a = uf_find(par, a), b = uf_find(par, b);
-    if (a != b) par[a < b ? b : a] = a < b ? a : b;
 }
 
 void ccn__split_free(ccn__split *s) {
@@ -97,8 +85,8 @@ ccn_status ccn__split_cage(const ccn_cage *c, int32_t nh, ccn__split *s, ccn_err
     for (int32_t h = 0; h < nh; h++) {
         cnt[4 * c->face_verts[h] + 1]++;
         if (twin[h] >= 0) {
-            uf_union(par, h, next[twin[h]]);
-            uf_union(par, next[h], twin[h]);
+            ccn__uf_union(par, h, next[twin[h]]);
+            ccn__uf_union(par, next[h], twin[h]);
         }
     }
     /* fans: the first keeps the vertex's index, the others get copies after the cage's */
@@ -106,7 +94,7 @@ ccn_status ccn__split_cage(const ccn_cage *c, int32_t nh, ccn__split *s, ccn_err
     if (!used) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory"); goto done; }
     int32_t nv2 = nv;
     for (int32_t h = 0; h < nh; h++) {
-        int32_t r = uf_find(par, h), v = c->face_verts[h];
+        int32_t r = ccn__uf_find(par, h), v = c->face_verts[h];
         if (copy[r] >= 0) continue;
         if (!used[v]) copy[r] = v, used[v] = 1;
         else copy[r] = nv2++, nmv[v] = 1, any = 1;
@@ -130,7 +118,7 @@ ccn_status ccn__split_cage(const ccn_cage *c, int32_t nh, ccn__split *s, ccn_err
     }
     for (int32_t v = 0; v < nv; v++) s->vorig[v] = v;
     for (int32_t h = 0; h < nh; h++) {
-        int32_t v2 = copy[uf_find(par, h)];
+        int32_t v2 = copy[ccn__uf_find(par, h)];
         s->face_verts[h] = v2;
         s->vorig[v2] = c->face_verts[h];
     }

@@ -3,6 +3,7 @@
  * map (`vt`) also: the plan with one UV channel against the plan without (creation time,
  * evaluation of positions + UVs against positions alone, heap bytes the plan holds). */
 #include "ccnurbs.h"
+#include "../c/plan_with.h"
 
 #include <malloc.h>
 #include <stdio.h>
@@ -11,23 +12,6 @@
 #include <time.h>
 
 #include <sys/resource.h>
-
-/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
- * options.cache and options.previous (prev is consumed). */
-static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
-                              ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = NULL;
-    return ccn_plan_create(c, &q, out, err);
-}
-static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
-                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = prev;
-    return ccn_plan_create(c, &q, out, err);
-}
 
 static double now(void) {
     struct timespec t;

@@ -12,17 +12,8 @@
 #include "surface/patches.h"
 #include "surface/plan_types.h"
 #include "testlib.h"
+#include "plan_with.h"
 #include "bi5_props.h"
-
-/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
- * options.cache and options.previous (prev is consumed). */
-static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
-                              ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = NULL;
-    return ccn_plan_create(c, &q, out, err);
-}
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -284,7 +275,6 @@ static void test_random_fans(void) {
     snprintf(what, sizeof what, "%d random fans", ncases);
     report(what, &st);
 }
-
 
 static void test_shipped_cages(void) {
     const char *names[] = {"cube.obj", "icosa_quad.obj", "pole12.obj", "pentaprism.obj", "jitter_sphere.obj", "flip35.obj", "ngon_prism.obj"};

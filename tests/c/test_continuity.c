@@ -22,21 +22,12 @@
  * sweep (make test: 12 x 400). */
 #include "ccnurbs.h"
 #include "testlib.h"
+#include "plan_with.h"
 
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
- * options.cache and options.previous (prev is consumed). */
-static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
-                              ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = NULL;
-    return ccn_plan_create(c, &q, out, err);
-}
 
 #define PI 3.14159265358979323846
 
@@ -229,7 +220,6 @@ static double zoom_once(star *w, int32_t ring, double a, double b, ccn_cache *ca
     qsort(sorted, ZOOM, sizeof(double), dcmp);
     return worst <= 1e-13 * size ? 0 : worst / fmax(sorted[ZOOM / 2], 1e-14 * size);
 }
-
 
 /* Returns the largest step over the median step; *pert the largest +-1e-9 change / size;
  * *fine the same ratio at the finest cut of the largest step. */

@@ -12,26 +12,10 @@
  * result is then byte-identical to a new plan. */
 #include "ccnurbs.h"
 #include "testlib.h"
+#include "plan_with.h"
 
 #include <math.h>
 #include <string.h>
-
-/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
- * options.cache and options.previous (prev is consumed). */
-static ccn_status plan_cached(const ccn_cage *c, const ccn_options *o, ccn_cache *cache,
-                              ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = NULL;
-    return ccn_plan_create(c, &q, out, err);
-}
-static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
-                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = prev;
-    return ccn_plan_create(c, &q, out, err);
-}
 
 typedef struct {
     ccn_obj *obj;

@@ -12,16 +12,7 @@
  * threads bytes, then positions for the second evaluation. Built only once the library
  * defines ccn_plan_evaluate (tests/fuzz/fuzz.mk). */
 #include "fuzz_cage.h"
-
-/* The plan with a cache, and the plan replacing prev after an edit: ccn_plan_create with
- * options.cache and options.previous (prev is consumed). */
-static ccn_status plan_recreate(ccn_plan *prev, const ccn_cage *c, const ccn_options *o,
-                                ccn_cache *cache, ccn_plan **out, ccn_error *err) {
-    ccn_options q = {0};
-    if (o) q = *o;
-    q.cache = cache, q.previous = prev;
-    return ccn_plan_create(c, &q, out, err);
-}
+#include "../c/plan_with.h"
 
 static void check_outputs(const ccn_sizes *z, const ccn_limit_mesh *out, int32_t cage_faces) {
     fz_check_finite(out->positions, 3 * (size_t)z->num_verts, "limit position");
