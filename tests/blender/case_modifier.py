@@ -252,14 +252,15 @@ class TestModifier(AddonTestCase):
         self.assertEqual(calls, [], "edit-mode moves ran the hygiene pass")
         self.assertEqual(len(bpy.data.meshes), meshes)
 
-    def test_render_uses_render_levels(self):
-        ob = add_modifier(load_cage("Fan5", os.path.join(DATA, "fan5.obj")), levels=1,
-                          render_levels=3)
-        n_view = len(evaluated_positions(ob))
+    @staticmethod
+    def _probe_render(ob, idname, during=None):
+        """Renders one frame with a probe engine; returns what the engine saw of ob's own
+        geometry: {"verts": count, "positions": array}. during: a context manager the render
+        runs inside (e.g. to capture the console)."""
         seen = {}
 
         class ProbeEngine(bpy.types.RenderEngine):
-            bl_idname = "CCNURBS_TEST_PROBE"
+            bl_idname = idname
             bl_label = "probe"
 
             def render(self, depsgraph):
@@ -270,6 +271,7 @@ class TestModifier(AddonTestCase):
                 r = self.begin_result(0, 0, 4, 4)
                 self.end_result(r)
 
+        import contextlib
         bpy.utils.register_class(ProbeEngine)
         try:
             scene = bpy.context.scene
@@ -278,9 +280,17 @@ class TestModifier(AddonTestCase):
             scene.camera = cam
             scene.render.engine = ProbeEngine.bl_idname
             scene.render.resolution_x = scene.render.resolution_y = 4
-            bpy.ops.render.render()
+            with during if during is not None else contextlib.nullcontext():
+                bpy.ops.render.render()
         finally:
             bpy.utils.unregister_class(ProbeEngine)
+        return seen
+
+    def test_render_uses_render_levels(self):
+        ob = add_modifier(load_cage("Fan5", os.path.join(DATA, "fan5.obj")), levels=1,
+                          render_levels=3)
+        n_view = len(evaluated_positions(ob))
+        seen = self._probe_render(ob, "CCNURBS_TEST_PROBE")
         R, _ = reference(ob, levels=3)
         self.assertIn("verts", seen, "render did not see the cage")
         self.assertEqual(seen["verts"], len(R))
@@ -296,35 +306,13 @@ class TestModifier(AddonTestCase):
         ob = add_modifier(load_cage("Fan5R", os.path.join(DATA, "fan5.obj")), levels=1,
                           render_levels=10)
         n_view = len(evaluated_positions(ob))
-        seen = {}
-
-        class ProbeEngine(bpy.types.RenderEngine):
-            bl_idname = "CCNURBS_TEST_PROBE2"
-            bl_label = "probe"
-
-            def render(self, depsgraph):
-                for inst in depsgraph.object_instances:
-                    if inst.object.original.name == ob.name and not inst.is_instance:
-                        seen["verts"] = len(inst.object.data.vertices)
-                r = self.begin_result(0, 0, 4, 4)
-                self.end_result(r)
-
-        bpy.utils.register_class(ProbeEngine)
         out = io.StringIO()
+        free = ccn.memory.free_bytes
+        ccn.memory.free_bytes = lambda: 50 * 2 ** 20
         try:
-            scene = bpy.context.scene
-            cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-            scene.collection.objects.link(cam)
-            scene.camera = cam
-            scene.render.engine = ProbeEngine.bl_idname
-            scene.render.resolution_x = scene.render.resolution_y = 4
-            free = ccn.memory.free_bytes
-            ccn.memory.free_bytes = lambda: 50 * 2 ** 20
-            with contextlib.redirect_stdout(out):
-                bpy.ops.render.render()
+            seen = self._probe_render(ob, "CCNURBS_TEST_PROBE2", contextlib.redirect_stdout(out))
         finally:
             ccn.memory.free_bytes = free
-            bpy.utils.unregister_class(ProbeEngine)
         self.assertEqual(seen.get("verts"), n_view, "the render shows the viewport limit")
         self.assertIn("Render levels 10 not rendered", out.getvalue())
         self.assertIn("rendering the viewport limit", out.getvalue())
