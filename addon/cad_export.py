@@ -161,7 +161,7 @@ def read_cages(objects, depsgraph=None):
 
 def make_plan(pos, c, scheme, cap, boundary, creases):
     """A plan whose bi-5 caps exist: they are built only at output levels above the cap level
-    (ccn_sizes.num_caps_deferred), so the level is raised from 0 until none is deferred."""
+    (ccn_plan_stats.num_caps_deferred), so the level is raised from 0 until none is deferred."""
     sharp = cage_sharpness(c.edge_creases) if creases else None
     vsharp = cage_sharpness(c.vertex_creases) if creases else None
     levels = 0

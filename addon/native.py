@@ -2,7 +2,7 @@
 (libccnurbs.so / ccnurbs.dll / libccnurbs.dylib, OpenBLAS beside it; see blender_manifest.toml).
 
 Only the plan API is bound: ccn_plan_create (with the session's ccn_cache and, after an edit,
-the plan it replaces, in its options) / ccn_plan_get_sizes / ccn_plan_evaluate (the first
+the plan it replaces, in its options) / ccn_plan_get_sizes, _get_stats / ccn_plan_evaluate (the first
 evaluation after an edit: ccn_plan_evaluate_changed) / ccn_plan_destroy, and its face-varying channels and
 per-vertex data (ccn_plan_add_fvar / ccn_plan_get_fvar_sizes / ccn_plan_evaluate_fvar /
 ccn_plan_evaluate_vertex_data). Structures mirror csrc/include/ccnurbs.h field by field. Arrays are numpy
@@ -90,22 +90,25 @@ class ccn_sizes(ctypes.Structure):
     _fields_ = [("num_verts", ctypes.c_int32),
                 ("num_faces", ctypes.c_int32),
                 ("num_cage_verts", ctypes.c_int32),
-                ("levels", ctypes.c_int32),
+                ("num_edges", ctypes.c_int32)]
+
+
+class ccn_plan_stats(ctypes.Structure):
+    _fields_ = [("levels", ctypes.c_int32),
                 ("refine_levels", ctypes.c_int32),
                 ("num_extraordinary", ctypes.c_int32),
                 ("num_caps", ctypes.c_int32),
                 ("num_cap_fallbacks", ctypes.c_int32),
+                ("num_caps_deferred", ctypes.c_int32),
                 ("num_ev_fallbacks", ctypes.c_int32),
+                ("num_ev_verified", ctypes.c_int32),
+                ("num_ev_outside_g1", ctypes.c_int32),
                 ("num_ring_conflicts", ctypes.c_int32),
                 ("num_ignored_verts", ctypes.c_int32),
                 ("num_ignored_edges", ctypes.c_int32),
                 ("num_sharp_edges", ctypes.c_int32),
                 ("num_sharp_vertices", ctypes.c_int32),
-                ("num_sharp_corners", ctypes.c_int32),
-                ("num_ev_verified", ctypes.c_int32),
-                ("num_ev_outside_g1", ctypes.c_int32),
-                ("num_caps_deferred", ctypes.c_int32),
-                ("num_edges", ctypes.c_int32)]
+                ("num_sharp_corners", ctypes.c_int32)]
 
 
 class ccn_limit_mesh(ctypes.Structure):
@@ -172,6 +175,8 @@ def _bind(lib):
     lib.ccn_cache_create.restype = ctypes.c_int
     lib.ccn_plan_get_sizes.argtypes = [P, ctypes.POINTER(ccn_sizes)]
     lib.ccn_plan_get_sizes.restype = ctypes.c_int
+    lib.ccn_plan_get_stats.argtypes = [P, ctypes.POINTER(ccn_plan_stats)]
+    lib.ccn_plan_get_stats.restype = ctypes.c_int
     lib.ccn_plan_evaluate.argtypes = [P, c_double_p, ctypes.POINTER(ccn_limit_mesh),
                                       ctypes.POINTER(ccn_error)]
     lib.ccn_plan_evaluate.restype = ctypes.c_int
@@ -340,12 +345,14 @@ class Plan:
         if st != 0:
             _raise(st, err)
         self._handle = handle
-        s = ccn_sizes()
-        st = lib.ccn_plan_get_sizes(handle, ctypes.byref(s))
+        s, t = ccn_sizes(), ccn_plan_stats()
+        st = lib.ccn_plan_get_sizes(handle, ctypes.byref(s)) or lib.ccn_plan_get_stats(handle, ctypes.byref(t))
         if st != 0:
             self.close()
             _raise(st, ccn_error())
+        # buffer sizes and statistics in one dict (the panel shows both)
         self.sizes = {name: int(getattr(s, name)) for name, _ in ccn_sizes._fields_}
+        self.sizes.update({name: int(getattr(t, name)) for name, _ in ccn_plan_stats._fields_})
 
     def evaluate(self, positions=None, topology=True):
         """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces

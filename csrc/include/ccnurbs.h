@@ -246,29 +246,35 @@ ccn_status ccn_ev_matrix_polyhedron(int32_t n, const double *spoke_knots, ccn_sc
 /* ---- limit surface: plan once, evaluate many times ------------------------------ */
 
 
+/* The sizes of a plan's output buffers (ccn_plan_get_sizes). */
 typedef struct {
     int32_t num_verts;        /* output mesh vertices */
     int32_t num_faces;        /* output mesh faces (all quads) */
     int32_t num_cage_verts;   /* length/3 of the positions ccn_plan_evaluate expects */
+    int32_t num_edges;        /* output mesh edges (those of its faces) */
+} ccn_sizes;
+
+/* What a plan is made of (ccn_plan_get_stats): its levels, the cage's extraordinary vertices
+ * and how they are treated, its sharp features, what the cage reader set aside. */
+typedef struct {
     int32_t levels;           /* effective output level (>= 1 when the cage has non-quads) */
     int32_t refine_levels;    /* internal refinement depth */
     int32_t num_extraordinary;/* interior EVs of the cage after the first split */
     int32_t num_caps;         /* EVs filled by the guided bi-5 cap */
     int32_t num_cap_fallbacks;/* EVs that use the refined limit instead of the cap */
-    int32_t num_ev_fallbacks; /* EVs whose eigen rules fell back to NURSS */
-    int32_t num_ring_conflicts, num_ignored_verts, num_ignored_edges;
-    int32_t num_sharp_edges;  /* cage edges with sharpness > 0 */
-    int32_t num_sharp_vertices;
-    int32_t num_sharp_corners;/* output vertices whose faces see more than one tangent plane
-                                 (creases, corners): corner_normals differ from normals */
-    int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 4) */
-    int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
     int32_t num_caps_deferred;/* cap EVs (bi-5) with no cap built because the output level is not
                                  above the cap level (they would change no output sample); the
                                  finite patch set (ccn_plan_patches, ccn_plan_export) needs them:
                                  a plan one level finer builds them */
-    int32_t num_edges;        /* output mesh edges (those of its faces) */
-} ccn_sizes;
+    int32_t num_ev_fallbacks; /* EVs whose eigen rules fell back to NURSS */
+    int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 4) */
+    int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
+    int32_t num_ring_conflicts, num_ignored_verts, num_ignored_edges; /* as ccn_mesh_info */
+    int32_t num_sharp_edges;  /* cage edges with sharpness > 0 */
+    int32_t num_sharp_vertices;
+    int32_t num_sharp_corners;/* output vertices whose faces see more than one tangent plane
+                                 (creases, corners): corner_normals differ from normals */
+} ccn_plan_stats;
 
 /* Caller-owned output buffers; sizes from ccn_plan_get_sizes. */
 typedef struct {
@@ -316,6 +322,7 @@ ccn_status ccn_plan_create(const ccn_cage *cage, const ccn_options *opts, ccn_pl
 ccn_status ccn_cache_create(ccn_cache **out, ccn_error *err);
 void ccn_cache_destroy(ccn_cache *cache);
 ccn_status ccn_plan_get_sizes(const ccn_plan *plan, ccn_sizes *sizes);
+ccn_status ccn_plan_get_stats(const ccn_plan *plan, ccn_plan_stats *stats);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs
  * (face_verts, face_origin) are the same on every call. */
 ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,
@@ -495,7 +502,7 @@ typedef struct {
  * of a deeper local refinement closed by fill faces, whose G1 deviation is measured. Faces
  * share their edges (one shell; closed cages: a solid). opts NULL = defaults; info may be
  * NULL. Nothing is written if the status is not CCN_OK before output starts. A bi-5 plan
- * whose caps were not built (ccn_sizes.num_caps_deferred > 0: output level not above the cap
+ * whose caps were not built (ccn_plan_stats.num_caps_deferred > 0: output level not above the cap
  * level) is CCN_ERR_ARGUMENT: create it with more levels. */
 ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_export_options *opts,
                            ccn_write_fn fn, void *user, ccn_export_info *info, ccn_error *err);

@@ -301,7 +301,7 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     int32_t ncand = 0; /* pass 1: every cap EV in order, a slot each */
     for (int32_t v = 0; v < m->nv; v++) {
         if (!cap_ev(m, v)) continue;
-        if (!cap_isolated(m, v, stamp, q)) { p->sizes.num_cap_fallbacks++; continue; }
+        if (!cap_isolated(m, v, stamp, q)) { p->stats.num_cap_fallbacks++; continue; }
         cap_begin(p, v, hint_caps, &p->caps[ncand], &todo[ncand]);
         ncand++;
     }
@@ -317,12 +317,12 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     for (int32_t i = 0; i < ncand; i++) { /* pass 3: in EV order; the kept caps packed */
         ccn__cap c = p->caps[i];
         if (cap_finish(p, &c, &todo[i])) p->caps[p->ncap++] = c;
-        else p->sizes.num_cap_fallbacks++;
+        else p->stats.num_cap_fallbacks++;
     }
     free(todo);
     free(hint_caps);
     free(stamp); free(q);
-    p->sizes.num_caps = p->ncap;
+    p->stats.num_caps = p->ncap;
     int32_t maxn = 0;
     for (int32_t c = 0; c < p->ncap; c++) maxn = p->caps[c].n > maxn ? p->caps[c].n : maxn;
     p->cap_net = malloc(sizeof(double) * 3 * (6 * (size_t)maxn + 1));

@@ -98,15 +98,16 @@ static int has_non_quads(const ccn_mesh *m) {
 }
 
 static void fill_sizes(ccn_plan *p) {
-    ccn_sizes *s = &p->sizes;
+    ccn_sizes *z = &p->sizes;
+    ccn_plan_stats *s = &p->stats;
     const ccn_mesh_info *c = &p->lev[0]->info, *r = &p->lev[p->R]->info;
-    s->num_verts = p->nout_v;
-    s->num_faces = p->nout_f;
-    s->num_cage_verts = p->ncage;
+    z->num_verts = p->nout_v;
+    z->num_faces = p->nout_f;
+    z->num_cage_verts = p->ncage;
+    z->num_edges = p->nout_e;
     s->levels = p->L;
     s->refine_levels = p->R;
     s->num_caps_deferred = p->caps_deferred;
-    s->num_edges = p->nout_e;
     s->num_extraordinary = p->R >= 1 ? p->lev[1]->info.num_extraordinary : c->num_extraordinary;
     s->num_ev_fallbacks = r->num_ev_fallbacks;
     s->num_ring_conflicts = c->num_ring_conflicts;
@@ -236,6 +237,12 @@ fail:
 ccn_status ccn_plan_get_sizes(const ccn_plan *p, ccn_sizes *s) {
     if (!p || !s) return CCN_ERR_ARGUMENT;
     *s = p->sizes;
+    return CCN_OK;
+}
+
+ccn_status ccn_plan_get_stats(const ccn_plan *p, ccn_plan_stats *s) {
+    if (!p || !s) return CCN_ERR_ARGUMENT;
+    *s = p->stats;
     return CCN_OK;
 }
 

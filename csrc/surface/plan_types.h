@@ -90,6 +90,7 @@ struct ccn_plan {
     int32_t *bv_out, *bv_rf;
     double *bv_uv;
     ccn_sizes sizes;
+    ccn_plan_stats stats;
     /* face-varying channels (surface/plan_fvar.c) */
     int32_t nfv;
     struct ccn__fvchan **fv;

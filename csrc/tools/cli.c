@@ -107,11 +107,11 @@ int ccn_cli_load_plan_caps(const char *path, ccn_options *o, ccn_plan **plan) {
     resolve_options(obj, o);
     ccn_error err;
     ccn_status st = ccn_plan_create(&cage, o, plan, &err);
-    ccn_sizes sz;
-    while (!st && ccn_plan_get_sizes(*plan, &sz) == CCN_OK && sz.num_caps_deferred > 0 && sz.levels < 10) {
+    ccn_plan_stats ps;
+    while (!st && ccn_plan_get_stats(*plan, &ps) == CCN_OK && ps.num_caps_deferred > 0 && ps.levels < 10) {
         ccn_plan_destroy(*plan);
         *plan = NULL;
-        o->levels = sz.levels + 1;
+        o->levels = ps.levels + 1;
         st = ccn_plan_create(&cage, o, plan, &err);
     }
     ccn_obj_destroy(obj);

@@ -8,7 +8,7 @@
  * --face-map FILE: per face "F index kind patch cells", then per cell "C cage_face sub u0 u1
  * v0 v1 s0 t0 s1 t1 s2 t2" (ccn_export_cell): where every face lies on the cage, for tests.
  * --levels L: the plan's output level; raised until the plan builds its bi-5 caps (they exist
- * only above the cap level; ccn_sizes.num_caps_deferred).
+ * only above the cap level; ccn_plan_stats.num_caps_deferred).
  * Output files are written to a temporary name and renamed: nothing is left on failure. */
 #include "cli.h"
 #include "commands.h"

@@ -10,11 +10,12 @@
 typedef struct { int32_t width, num_values; const double *values; const int32_t *face_values; } uv_out;
 
 /* vn lines: one per vertex, or (corner normals) one per face corner, 4 per face in order. */
-static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm, const uv_out *uv) {
+static int write_limit(FILE *f, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm,
+                       const uv_out *uv) {
     fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
-               "%d EV fallbacks, %d ring conflicts\n", (int)s->levels, (int)s->num_verts,
-            (int)s->num_faces, (int)s->num_caps, (int)s->num_cap_fallbacks,
-            (int)s->num_ev_fallbacks, (int)s->num_ring_conflicts);
+               "%d EV fallbacks, %d ring conflicts\n", (int)ps->levels, (int)s->num_verts,
+            (int)s->num_faces, (int)ps->num_caps, (int)ps->num_cap_fallbacks,
+            (int)ps->num_ev_fallbacks, (int)ps->num_ring_conflicts);
     for (int32_t v = 0; v < s->num_verts; v++)
         fprintf(f, "v %.17g %.17g %.17g\n", lm->positions[3 * v], lm->positions[3 * v + 1],
                 lm->positions[3 * v + 2]);
@@ -40,13 +41,14 @@ static int write_limit(FILE *f, const ccn_sizes *s, const ccn_limit_mesh *lm, co
     return ferror(f) ? -1 : 0;
 }
 
-static int write_atomic(const char *path, const ccn_sizes *s, const ccn_limit_mesh *lm, const uv_out *uv) {
+static int write_atomic(const char *path, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm,
+                        const uv_out *uv) {
     size_t n = strlen(path);
     char *tmp = malloc(n + 32);
     if (!tmp) return 2;
     snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
-    int rc = f ? write_limit(f, s, lm, uv) : -1;
+    int rc = f ? write_limit(f, s, ps, lm, uv) : -1;
     if (f && fclose(f) != 0) rc = -1;
     if (rc == 0 && rename(tmp, path) != 0) rc = -1;
     if (rc) { remove(tmp); fprintf(stderr, "ccnurbs: cannot write %s\n", path); }
@@ -84,6 +86,8 @@ int ccn_cmd_limit(int argc, char **argv) {
     ccn_obj_destroy(obj);
     ccn_sizes s;
     ccn_plan_get_sizes(plan, &s);
+    ccn_plan_stats ps;
+    ccn_plan_get_stats(plan, &ps);
     uv_out uv = {0, 0, NULL, NULL};
     double *uv_values = NULL;
     int32_t *uv_faces = NULL;
@@ -110,7 +114,7 @@ int ccn_cmd_limit(int argc, char **argv) {
                (ch >= 0 && ccn_plan_evaluate_fvar(plan, ch, NULL, uv_values, uv_faces, &err))) {
         rc = ccn_cli_error(in, &err);
     } else {
-        rc = write_atomic(out, &s, &lm, ch >= 0 ? &uv : NULL);
+        rc = write_atomic(out, &s, &ps, &lm, ch >= 0 ? &uv : NULL);
     }
     free(lm.positions); free(lm.normals); free(lm.face_verts); free(lm.corner_normals);
     free(uv_values); free(uv_faces);

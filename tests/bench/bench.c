@@ -67,6 +67,8 @@ int main(int argc, char **argv) {
     }
     ccn_sizes s;
     ccn_plan_get_sizes(plan, &s);
+    ccn_plan_stats s_st;
+    ccn_plan_get_stats(plan, &s_st);
     double *pos = malloc(sizeof(double) * 3 * s.num_verts), *nrm = malloc(sizeof(double) * 3 * s.num_verts);
     double *cp = malloc(sizeof(double) * 3 * cage.num_verts);
     memcpy(cp, cage.positions, sizeof(double) * 3 * cage.num_verts);
@@ -95,7 +97,7 @@ int main(int argc, char **argv) {
     printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s; "
            "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d; peak RSS %ld kB; first plan %.4f s%s\n",
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,
-           tplan, teval, tref, s.num_caps, s.num_cap_fallbacks, s.num_ev_verified, s.num_ev_outside_g1, ru.ru_maxrss, tfirst,
+           tplan, teval, tref, s_st.num_caps, s_st.num_cap_fallbacks, s_st.num_ev_verified, s_st.num_ev_outside_g1, ru.ru_maxrss, tfirst,
            cache ? " (one ccn_cache)" : "");
     /* an interval edit: one ring's interval changed (the cage's first edge, alternately 3 and
      * 1.5 times its interval), the plan made again and evaluated (the add-on's rebuild), by a

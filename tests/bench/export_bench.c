@@ -40,11 +40,14 @@ int main(int argc, char **argv) {
         ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
     ccn_sizes sz;
     ccn_plan_get_sizes(plan, &sz);
-    while (sz.num_caps_deferred > 0) { /* the caps exist only above the cap level */
-        o.levels = sz.levels + 1;
+    ccn_plan_stats sz_st;
+    ccn_plan_get_stats(plan, &sz_st);
+    while (sz_st.num_caps_deferred > 0) { /* the caps exist only above the cap level */
+        o.levels = sz_st.levels + 1;
         ccn_plan_destroy(plan);
         if (ccn_plan_create(&cage, &o, &plan, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
         ccn_plan_get_sizes(plan, &sz);
+        ccn_plan_get_stats(plan, &sz_st);
     }
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), tev = 1e30;
     ccn_limit_mesh lm = {.positions = pos};

@@ -315,8 +315,10 @@ static int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) 
     if (fplan_run(cage, ob, &pb) || fplan_run(cage, orf, &pr)) { fplan_free(&pb); fplan_free(&pr); return -1; }
     ccn_sizes sz;
     ccn_plan_get_sizes(pb.p, &sz);
-    F->caps += sz.num_caps;
-    F->fallbacks += sz.num_cap_fallbacks;
+    ccn_plan_stats sz_st;
+    ccn_plan_get_stats(pb.p, &sz_st);
+    F->caps += sz_st.num_caps;
+    F->fallbacks += sz_st.num_cap_fallbacks;
     double size = bbox_diag(pr.x, pr.nv);
     /* hole membership: output vertex strictly inside cap c -> c + 1 */
     uint8_t *hole = calloc((size_t)pr.nv, 1);

@@ -28,6 +28,8 @@ static void expect_plan_err(const ccn_cage *c, const ccn_options *o, ccn_status 
 static int eval_check(ccn_plan *p, const ccn_cage *c, const double *positions, const char *what) {
     ccn_sizes z;
     ccn_plan_get_sizes(p, &z);
+    ccn_plan_stats z_st;
+    ccn_plan_get_stats(p, &z_st);
     CHECK(z.num_cage_verts == c->num_verts, "%s: num_cage_verts %d", what, z.num_cage_verts);
     double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     double *N = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
@@ -102,6 +104,8 @@ static void row_nan_inf_coordinate(void) {
     if (!pl) return;
     ccn_sizes z;
     ccn_plan_get_sizes(pl, &z);
+    ccn_plan_stats z_st;
+    ccn_plan_get_stats(pl, &z_st);
     double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
     ccn_limit_mesh out = {.positions = P};
     CHECK(ccn_plan_evaluate(pl, p, &out, &err) == CCN_ERR_ARGUMENT, "evaluate with Inf");
@@ -204,9 +208,11 @@ static void row_valence_200(void) {
     if (p) {
         ccn_sizes z;
         ccn_plan_get_sizes(p, &z);
-        CHECK(z.num_extraordinary == 1 && z.num_caps + z.num_cap_fallbacks == 1,
-              "EVs %d, caps %d, cap fallbacks %d", z.num_extraordinary, z.num_caps,
-              z.num_cap_fallbacks);
+        ccn_plan_stats z_st;
+        ccn_plan_get_stats(p, &z_st);
+        CHECK(z_st.num_extraordinary == 1 && z_st.num_caps + z_st.num_cap_fallbacks == 1,
+              "EVs %d, caps %d, cap fallbacks %d", z_st.num_extraordinary, z_st.num_caps,
+              z_st.num_cap_fallbacks);
         ccn_plan_destroy(p);
     }
     soup_free(&s);
@@ -224,8 +230,10 @@ static void row_one_quad(void) {
         if (!p) continue;
         ccn_sizes z;
         ccn_plan_get_sizes(p, &z);
+        ccn_plan_stats z_st;
+        ccn_plan_get_stats(p, &z_st);
         int32_t side = (1 << L) + 1;
-        CHECK(z.num_verts == side * side && z.num_faces == (1 << L) * (1 << L) && z.levels == L,
+        CHECK(z.num_verts == side * side && z.num_faces == (1 << L) * (1 << L) && z_st.levels == L,
               "level %d: %d verts %d faces", L, z.num_verts, z.num_faces);
         ccn_plan_destroy(p);
     }
@@ -245,8 +253,10 @@ static void row_isolated_vertices(void) {
     if (!pl) return;
     ccn_sizes z;
     ccn_plan_get_sizes(pl, &z);
-    CHECK(z.num_ignored_verts == 2 && z.num_cage_verts == 6, "ignored %d, cage verts %d",
-          z.num_ignored_verts, z.num_cage_verts);
+    ccn_plan_stats z_st;
+    ccn_plan_get_stats(pl, &z_st);
+    CHECK(z_st.num_ignored_verts == 2 && z.num_cage_verts == 6, "ignored %d, cage verts %d",
+          z_st.num_ignored_verts, z.num_cage_verts);
     CHECK(z.num_verts == 9 && z.num_faces == 4, "isolated vertices left out: %d verts %d faces",
           z.num_verts, z.num_faces);
     ccn_plan_destroy(pl);
@@ -266,6 +276,8 @@ static void row_coordinates_1e30(void) {
     if (pl) {
         ccn_sizes z;
         ccn_plan_get_sizes(pl, &z);
+        ccn_plan_stats z_st;
+        ccn_plan_get_stats(pl, &z_st);
         double *a = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         double *b = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         double *u = malloc(sizeof(double) * 3 * (size_t)s.nv);
@@ -311,6 +323,8 @@ static void row_coordinates_near_dbl_max(void) {
             else {
                 ccn_sizes z;
                 ccn_plan_get_sizes(p, &z);
+                ccn_plan_stats z_st;
+                ccn_plan_get_stats(p, &z_st);
                 double *out = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
                 ccn_limit_mesh lm = {.positions = out};
                 CHECK(ccn_plan_evaluate(p, big, &lm, &err) == CCN_ERR_ARGUMENT, "evaluate must refuse");
@@ -340,7 +354,9 @@ static void row_two_million_faces(void) {
     if (p) {
         ccn_sizes z;
         ccn_plan_get_sizes(p, &z);
-        CHECK(z.num_faces == 2000000 && z.num_verts == 1001 * 2001 && z.levels == 0,
+        ccn_plan_stats z_st;
+        ccn_plan_get_stats(p, &z_st);
+        CHECK(z.num_faces == 2000000 && z.num_verts == 1001 * 2001 && z_st.levels == 0,
               "sizes %d verts %d faces", z.num_verts, z.num_faces);
         double *P = malloc(sizeof(double) * 3 * (size_t)z.num_verts);
         int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)z.num_faces);

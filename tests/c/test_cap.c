@@ -200,6 +200,8 @@ static void compare_cage(const ccn_cage *cage, int levels, cap_stats *st) {
     if (!pb || !pr) { ccn_plan_destroy(pb); ccn_plan_destroy(pr); return; }
     ccn_sizes s;
     ccn_plan_get_sizes(pb, &s);
+    ccn_plan_stats s_st;
+    ccn_plan_get_stats(pb, &s_st);
     double *xb = malloc(sizeof(double) * 3 * s.num_verts), *nb = malloc(sizeof(double) * 3 * s.num_verts);
     double *xr = malloc(sizeof(double) * 3 * s.num_verts), *nr = malloc(sizeof(double) * 3 * s.num_verts);
     ccn_limit_mesh lb = {.positions = xb, .normals = nb}, lr = {.positions = xr, .normals = nr};
@@ -224,7 +226,7 @@ static void compare_cage(const ccn_cage *cage, int levels, cap_stats *st) {
         double an = angle(nb + 3 * v, nr + 3 * v);
         if (!(an <= st->nrm_err)) st->nrm_err = an;
     }
-    st->caps += s.num_caps;
+    st->caps += s_st.num_caps;
     check_separators(pb, st, size);
     check_props(pb, st, size);
     free(inside); free(xb); free(nb); free(xr); free(nr);
@@ -349,7 +351,9 @@ static void test_nonuniform_period4(void) {
         if (p) {
             ccn_sizes s;
             ccn_plan_get_sizes(p, &s);
-            st.caps += s.num_caps;
+            ccn_plan_stats s_st;
+            ccn_plan_get_stats(p, &s_st);
+            st.caps += s_st.num_caps;
             double *x = malloc(sizeof(double) * 3 * s.num_verts), *nn = malloc(sizeof(double) * 3 * s.num_verts);
             ccn_limit_mesh lm = {.positions = x, .normals = nn};
             CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
@@ -422,9 +426,11 @@ static void test_nonuniform_extreme(void) {
         if (p) {
             ccn_sizes sz;
             ccn_plan_get_sizes(p, &sz);
-            printf("  Fig. 16 pattern, ratio %g: %d caps, %d cap fallbacks\n", ratios[q], sz.num_caps, sz.num_cap_fallbacks);
-            CHECK(q == 0 ? sz.num_caps == 1 && sz.num_cap_fallbacks == 0 : sz.num_caps == 0 && sz.num_cap_fallbacks == 1,
-                  "ratio %g: %d caps, %d fallbacks", ratios[q], sz.num_caps, sz.num_cap_fallbacks);
+            ccn_plan_stats sz_st;
+            ccn_plan_get_stats(p, &sz_st);
+            printf("  Fig. 16 pattern, ratio %g: %d caps, %d cap fallbacks\n", ratios[q], sz_st.num_caps, sz_st.num_cap_fallbacks);
+            CHECK(q == 0 ? sz_st.num_caps == 1 && sz_st.num_cap_fallbacks == 0 : sz_st.num_caps == 0 && sz_st.num_cap_fallbacks == 1,
+                  "ratio %g: %d caps, %d fallbacks", ratios[q], sz_st.num_caps, sz_st.num_cap_fallbacks);
             ccn_plan_destroy(p);
         }
     }
@@ -448,7 +454,9 @@ static void test_nonuniform_planar(void) {
         if (p) {
             ccn_sizes sz;
             ccn_plan_get_sizes(p, &sz);
-            caps += sz.num_caps;
+            ccn_plan_stats sz_st;
+            ccn_plan_get_stats(p, &sz_st);
+            caps += sz_st.num_caps;
             double *x = malloc(sizeof(double) * 3 * sz.num_verts);
             ccn_limit_mesh lm = {.positions = x};
             CHECK(ccn_plan_evaluate(p, NULL, &lm, &err) == CCN_OK, "%s", err.message);
@@ -490,14 +498,18 @@ static void test_shared_cache(void) {
         if (a && b) {
             ccn_sizes sa, sb;
             ccn_plan_get_sizes(a, &sa);
+            ccn_plan_stats sa_st;
+            ccn_plan_get_stats(a, &sa_st);
             ccn_plan_get_sizes(b, &sb);
-            caps += sb.num_caps;
+            ccn_plan_stats sb_st;
+            ccn_plan_get_stats(b, &sb_st);
+            caps += sb_st.num_caps;
             size_t nv = (size_t)sa.num_verts;
             double *xa = malloc(sizeof(double) * 6 * nv), *xb = malloc(sizeof(double) * 6 * nv);
             ccn_limit_mesh la = {.positions = xa, .normals = xa + 3 * nv}, lb = {.positions = xb, .normals = xb + 3 * nv};
             CHECK(ccn_plan_evaluate(a, NULL, &la, &err) == CCN_OK, "%s", err.message);
             CHECK(ccn_plan_evaluate(b, NULL, &lb, &err) == CCN_OK, "%s", err.message);
-            int eq = sa.num_verts == sb.num_verts && sa.num_caps == sb.num_caps &&
+            int eq = sa.num_verts == sb.num_verts && sa_st.num_caps == sb_st.num_caps &&
                      memcmp(xa, xb, sizeof(double) * 6 * nv) == 0;
             CHECK(eq, "n = %d (case %d): the cached plan's output differs", n, k);
             same += eq;

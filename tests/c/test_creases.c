@@ -184,7 +184,7 @@ static ccn_cage grid_cage(const grid *g) {
     return c;
 }
 
-typedef struct { int32_t nv, nf; double *pos, *nrm, *cn; int32_t *fv, *eo; ccn_sizes s; } lmesh;
+typedef struct { int32_t nv, nf; double *pos, *nrm, *cn; int32_t *fv, *eo; ccn_sizes s; ccn_plan_stats st; } lmesh;
 
 static int limit(const ccn_cage *c, const ccn_options *o, lmesh *lm) {
     ccn_plan *p = NULL;
@@ -192,6 +192,7 @@ static int limit(const ccn_cage *c, const ccn_options *o, lmesh *lm) {
     memset(lm, 0, sizeof *lm);
     if (ccn_plan_create(c, o, &p, &err)) { fprintf(stderr, "plan: %s\n", err.message); return -1; }
     ccn_plan_get_sizes(p, &lm->s);
+    ccn_plan_get_stats(p, &lm->st);
     lm->nv = lm->s.num_verts; lm->nf = lm->s.num_faces;
     lm->pos = NEW(double, 3 * lm->nv);
     lm->nrm = NEW(double, 3 * lm->nv);
@@ -312,7 +313,7 @@ static void check_two_sides(int M, int N, int torus, int c, int L, ccn_scheme sc
         }
     }
     CHECK(worst_n <= TOL_ANGLE, "%s crease corner normals: worst angle %.3g rad", torus ? "torus" : "grid", worst_n);
-    CHECK(lm.s.num_sharp_corners > 0, "crease vertices with two normals: %d", lm.s.num_sharp_corners);
+    CHECK(lm.st.num_sharp_corners > 0, "crease vertices with two normals: %d", lm.st.num_sharp_corners);
     /* corner_edge_origin: the output edges on the crease line are exactly the corners whose
      * cage corner starts a crease edge (2 faces x N 2^L edges, one loop on the torus too) */
     int on_crease = 0, bad_origin = 0;
@@ -331,7 +332,7 @@ static void check_two_sides(int M, int N, int torus, int c, int L, ccn_scheme sc
           on_crease, 2 * (g.N << L), bad_origin);
     printf("#   %s %dx%d crease at %d, level %d, %s: positions %.2e of size, corner normals %.2e rad, %d two-sided vertices\n",
            torus ? "torus" : "grid ", M, N, c, L, scheme == CCN_SCHEME_EIGEN ? "eigen" : "nurss", worst / size, worst_n,
-           lm.s.num_sharp_corners);
+           lm.st.num_sharp_corners);
     free(orc); free(mt);
     lm_free(&lm);
     grid_free(&g);

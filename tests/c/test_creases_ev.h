@@ -52,11 +52,11 @@ static void check_ev_case(const char *name, const ccn_cage *c, int expect_caps) 
     for (int i = 0; i < 3 * a.nv; i++) finite &= isfinite(a.pos[i]) && isfinite(a.nrm[i]);
     for (int i = 0; i < 12 * a.nf; i++) finite &= isfinite(a.cn[i]);
     CHECK(finite, "%s: finite", name);
-    CHECK(a.s.num_sharp_corners > 0, "%s: %d vertices with several normals", name, a.s.num_sharp_corners);
+    CHECK(a.st.num_sharp_corners > 0, "%s: %d vertices with several normals", name, a.st.num_sharp_corners);
     /* the smooth EVs get caps (creases at cage level are >= 4 level-K rings away from them,
      * so never in the 3 regular rings a cap needs); the creased ones are refined to the limit */
-    CHECK(a.s.num_caps == expect_caps && a.s.num_cap_fallbacks == 0, "%s: %d caps (expected %d), %d fallbacks",
-          name, a.s.num_caps, expect_caps, a.s.num_cap_fallbacks);
+    CHECK(a.st.num_caps == expect_caps && a.st.num_cap_fallbacks == 0, "%s: %d caps (expected %d), %d fallbacks",
+          name, a.st.num_caps, expect_caps, a.st.num_cap_fallbacks);
     /* the level-2 surface (refine cap) against finite differences of levels 4 and 5 */
     lmesh a2;
     o.levels = 2;
@@ -68,8 +68,8 @@ static void check_ev_case(const char *name, const ccn_cage *c, int expect_caps) 
     CHECK(s5 < 0.1 && s5 < 0.75 * s4, "%s: sharp corners vs finite differences: level 4 %.3g, level 5 %.3g rad",
           name, s4, s5);
     printf("#   %s: %d two-sided vertices, %d caps, %d cap fallbacks; corner normals vs finite differences "
-           "%.3f (L4) -> %.3f (L5) rad, at sharp corners %.3f -> %.3f\n", name, a.s.num_sharp_corners,
-           a.s.num_caps, a.s.num_cap_fallbacks, e4, e5, s4, s5);
+           "%.3f (L4) -> %.3f (L5) rad, at sharp corners %.3f -> %.3f\n", name, a.st.num_sharp_corners,
+           a.st.num_caps, a.st.num_cap_fallbacks, e4, e5, s4, s5);
     if (ok) lm_free(&a2);
     lm_free(&a); lm_free(&f4); lm_free(&f5);
 }

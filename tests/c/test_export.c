@@ -114,11 +114,11 @@ static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn
     if (ccn_obj_parse(text, len, obj, &err) || ccn_obj_get_cage(*obj, cage) || ccn_plan_create(cage, o, &p, &err))
         p = NULL;
     free(text);
-    ccn_sizes sz; /* the bi-5 caps exist only above the cap level; raise the level */
-    while (p && ccn_plan_get_sizes(p, &sz) == CCN_OK && sz.num_caps_deferred > 0) {
+    ccn_plan_stats ps; /* the bi-5 caps exist only above the cap level; raise the level */
+    while (p && ccn_plan_get_stats(p, &ps) == CCN_OK && ps.num_caps_deferred > 0) {
         ccn_options o2 = {0};
         if (o) o2 = *o;
-        o2.levels = sz.levels + 1;
+        o2.levels = ps.levels + 1;
         ccn_plan_destroy(p);
         if (ccn_plan_create(cage, &o2, &p, &err)) p = NULL;
     }
@@ -194,7 +194,9 @@ static int against_limit(ccn_plan *p, const ccn_cage *cage, const faces *F, doub
                          double *fill_worst, int *unmatched) {
     ccn_sizes sz;
     ccn_plan_get_sizes(p, &sz);
-    int L = sz.levels;
+    ccn_plan_stats ps;
+    ccn_plan_get_stats(p, &ps);
+    int L = ps.levels;
     double *pos = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     int32_t *fv = malloc(sizeof(int32_t) * 4 * (size_t)sz.num_faces);
     ccn_limit_mesh lm = {.positions = pos, .face_verts = fv};
@@ -345,10 +347,12 @@ static void check_refined(const char *name, int fill_levels) {
     CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "export: %s", err.message);
     ccn_sizes sz;
     ccn_plan_get_sizes(p, &sz);
+    ccn_plan_stats ps;
+    ccn_plan_get_stats(p, &ps);
     int top = info.fill_level;
     int plevel = top - fill_levels; /* the patch level: the cap level K (fallbacks) or the deepest */
-    CHECK(sz.num_caps == 0 && plevel >= 1 && plevel <= sz.refine_levels, "%s: fill level %d, patch level %d + %d",
-          name, top, (int)sz.refine_levels, fill_levels);
+    CHECK(ps.num_caps == 0 && plevel >= 1 && plevel <= ps.refine_levels, "%s: fill level %d, patch level %d + %d",
+          name, top, (int)ps.refine_levels, fill_levels);
     ccn_mesh *cm = NULL, *ref[8] = {NULL};
     CHECK(ccn_mesh_create(&cage, &cm, &err) == CCN_OK, "mesh");
     for (int l = 1; l <= top && l < 8; l++) CHECK(ccn_refine(cm, l, &o, &ref[l], &err) == CCN_OK, "refine %d", l);

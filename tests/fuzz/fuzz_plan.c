@@ -1,5 +1,5 @@
 /* libFuzzer harness: bytes -> a cage (fuzz_cage.h) and options (including out-of-range
- * scheme, cap, levels and corners) -> ccn_plan_create + ccn_plan_get_sizes + ccn_plan_evaluate
+ * scheme, cap, levels and corners) -> ccn_plan_create + ccn_plan_get_sizes / _get_stats + ccn_plan_evaluate
  * (cage positions, then positions from the input, then with optional outputs left NULL).
  * Checks: statuses in range, messages NUL-terminated, invalid options and cages rejected,
  * sizes consistent, every position and normal finite (normals of unit length), indices in
@@ -133,11 +133,11 @@ static void fvar_stage(ccn_plan *plan, const ccn_cage *c, const ccn_sizes *z, rd
  * gives the same status as a new plan of the edited cage and, when both succeed, the same
  * bytes (positions, normals). *plan is consumed; the recreated plan (or NULL) replaces it. */
 static void edit_stage(ccn_plan **plan, const ccn_cage *c, const ccn_options *o, const ccn_sizes *z,
-                       int strict, rd *r) {
+                       const ccn_plan_stats *zs, int strict, rd *r) {
     /* two more plans: only for cages up to valence and face size 12 whose plan verified no
-     * eigen polyhedron (ccn_sizes.num_ev_verified: that verification, made again by the new
+     * eigen polyhedron (ccn_plan_stats.num_ev_verified: that verification, made again by the new
      * plan, takes some inputs past the fuzzer's 10 s; test_recreate covers such cages) */
-    if (c->num_edges <= 0 || !c->edge_verts || z->num_ev_verified > 0) return;
+    if (c->num_edges <= 0 || !c->edge_verts || zs->num_ev_verified > 0) return;
     int32_t *deg = calloc((size_t)c->num_verts + 1, sizeof(int32_t));
     FZ_CHECK(deg != NULL, "harness out of memory");
     int big = 0;
@@ -251,13 +251,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FZ_CHECK(z.num_cage_verts == c.num_verts, "num_cage_verts %d, cage %d", z.num_cage_verts,
              c.num_verts);
     FZ_CHECK(z.num_verts > 0 && z.num_faces > 0, "sizes %d %d", z.num_verts, z.num_faces);
-    FZ_CHECK(z.levels == o.levels || (o.levels == 0 && z.levels == 1), "levels %d for %d",
-             z.levels, o.levels);
-    FZ_CHECK(z.refine_levels >= 0 && z.num_extraordinary >= 0 && z.num_caps >= 0 &&
-                 z.num_cap_fallbacks >= 0 && z.num_ev_fallbacks >= 0 &&
-                 z.num_ring_conflicts >= 0 && z.num_ignored_verts >= 0 &&
-                 z.num_ignored_edges >= 0,
-             "negative counts in ccn_sizes");
+    ccn_plan_stats zs;
+    memset(&zs, 0x5A, sizeof zs);
+    FZ_CHECK(ccn_plan_get_stats(plan, &zs) == CCN_OK, "ccn_plan_get_stats");
+    FZ_CHECK(zs.levels == o.levels || (o.levels == 0 && zs.levels == 1), "levels %d for %d",
+             zs.levels, o.levels);
+    FZ_CHECK(zs.refine_levels >= 0 && zs.num_extraordinary >= 0 && zs.num_caps >= 0 &&
+                 zs.num_cap_fallbacks >= 0 && zs.num_ev_fallbacks >= 0 &&
+                 zs.num_ring_conflicts >= 0 && zs.num_ignored_verts >= 0 &&
+                 zs.num_ignored_edges >= 0,
+             "negative counts in ccn_plan_stats");
     if (z.num_verts > 2000000 || z.num_faces > 2000000) { ccn_plan_destroy(plan); return 0; }
 
     size_t nv3 = 3 * (size_t)z.num_verts, nf4 = 4 * (size_t)z.num_faces;
@@ -337,7 +340,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FZ_CHECK(st == CCN_ERR_ARGUMENT, "NULL out gave %d", (int)st);
 
     fvar_stage(plan, &c, &z, &r);
-    edit_stage(&plan, &c, &o, &z, strict, &r);
+    edit_stage(&plan, &c, &o, &z, &zs, strict, &r);
     free(p2); free(pos1); free(pos); free(nrm); free(fv); free(fo); free(fv2); free(fo2);
     ccn_plan_destroy(plan);
     return 0;
