@@ -6,7 +6,7 @@
 # Measure at level 7 too: coarser levels under-sample a narrow blend band.
 cd "$(dirname "$0")/../.." || exit 2
 B=${B:-build}
-out=$PWD/$B/cap_mesh
+case $B in /*) out=$B/cap_mesh ;; *) out=$PWD/$B/cap_mesh ;; esac
 cap=${1:-bi5}
 src=$out/src_$cap
 rm -rf "$src" && mkdir -p "$src" || exit 2
