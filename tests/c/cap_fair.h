@@ -179,6 +179,23 @@ static double plane_angle(const double *a, const double *b) {
     return fmin(t, M_PI - t);
 }
 
+/* Normal-turn rates per output edge (angle between the end normals / edge length): the largest
+ * of pb's minus pr's over the edges; *rmax gets pr's largest rate. */
+static inline double turn_excess(const fplan *pr, const fplan *pb, double *rmax) {
+    double excess = -1e300;
+    *rmax = 0;
+    for (int32_t q = 0; q < pr->nf; q++)
+        for (int j = 0; j < 4; j++) {
+            int32_t a = pr->fv[4 * q + j], b = pr->fv[4 * q + (j + 1) % 4];
+            double dr[3], db[3];
+            for (int k = 0; k < 3; k++) dr[k] = pr->x[3 * a + k] - pr->x[3 * b + k], db[k] = pb->x[3 * a + k] - pb->x[3 * b + k];
+            double rr = angle(pr->n + 3 * a, pr->n + 3 * b) / norm3(dr), rb = angle(pb->n + 3 * a, pb->n + 3 * b) / norm3(db);
+            *rmax = fmax(*rmax, rr);
+            excess = fmax(excess, rb - rr);
+        }
+    return excess;
+}
+
 /* Everything about one cap. */
 static void measure_cap(const ccn_plan *plan, const ccn__cap *cp, const fplan *pr, const uint8_t *in_hole_of,
                         int32_t cap_id, const int32_t *nbs, const int32_t *nb, int32_t ev_out, fair *F) {
@@ -300,13 +317,13 @@ static void measure_cap(const ccn_plan *plan, const ccn__cap *cp, const fplan *p
     F->holes_checked++;
 }
 
-static void fair_init(fair *F) {
+static inline void fair_init(fair *F) {
     memset(F, 0, sizeof *F);
     F->jac = 1;
 }
 
 /* Both plans of one cage at level L; returns -1 if a plan failed. */
-static int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) {
+static inline int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) {
     fplan pb, pr;
     ccn_options ob = base, orf = base;
     ob.levels = orf.levels = L;
@@ -335,22 +352,9 @@ static int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) 
         F->outside = fmax(F->outside, norm3(d) / size);
         F->g1 = fmax(F->g1, angle(pb.n + 3 * v, pr.n + 3 * v)); /* the hole's border and beyond */
     }
-    /* normal-turn rates per output edge */
-    double rmax = 0, excess = 0;
-    double *rate = malloc(sizeof(double) * 4 * (size_t)pr.nf * 2);
-    for (int32_t q = 0; q < pr.nf; q++)
-        for (int j = 0; j < 4; j++) {
-            int32_t a = pr.fv[4 * q + j], b = pr.fv[4 * q + (j + 1) % 4];
-            double dr[3] = {pr.x[3 * a] - pr.x[3 * b], pr.x[3 * a + 1] - pr.x[3 * b + 1], pr.x[3 * a + 2] - pr.x[3 * b + 2]};
-            double db[3] = {pb.x[3 * a] - pb.x[3 * b], pb.x[3 * a + 1] - pb.x[3 * b + 1], pb.x[3 * a + 2] - pb.x[3 * b + 2]};
-            double rr = angle(pr.n + 3 * a, pr.n + 3 * b) / norm3(dr), rb = angle(pb.n + 3 * a, pb.n + 3 * b) / norm3(db);
-            rate[2 * (4 * q + j)] = rr, rate[2 * (4 * q + j) + 1] = rb;
-            rmax = fmax(rmax, rr);
-        }
-    for (int32_t e = 0; e < 4 * pr.nf; e++) excess = fmax(excess, rate[2 * e + 1] - rate[2 * e]);
+    double rmax, excess = turn_excess(&pr, &pb, &rmax);
     F->turn = fmax(F->turn, excess / rmax);
     F->turn_ref = fmax(F->turn_ref, rmax);
-    free(rate);
     int32_t *nbs, *nb;
     neighbours(&pr, &nbs, &nb);
     for (int32_t c = 0; c < pb.p->ncap; c++)
@@ -361,7 +365,7 @@ static int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) 
     return 0;
 }
 
-static void fair_print(const char *what, const fair *F) {
+static inline void fair_print(const char *what, const fair *F) {
     printf("%-34s caps %d (fallbacks %d): turn excess %.3f of max %.3g; K sign %d, H sign %d; max|K| ratio %.2f; "
            "K jump %.3f; centre %.2g rad; outside %.2g; G1 %.2g rad; min|Xu x Xv| %.3f\n", what, F->caps,
            F->fallbacks, F->turn, F->turn_ref, F->ksign, F->hsign, F->kratio, F->kjump, F->centre, F->outside,
@@ -408,10 +412,31 @@ static void star_cage(int n, int m, const double *d, fcage *c) {
 #undef SV
 }
 
+/* Random general stars (tests/experiments/cap_table.c, cap_mesh_table.c): spoke intervals
+ * log-uniform in [1, R] with one spoke at 1 and one at R (R > 1); 3 x 3 quads per sector,
+ * jittered, random heights (not a symmetric dome). */
+static inline void random_spokes(int n, double R, double *d) {
+    for (int s = 0; s < n; s++) d[s] = exp(log(R) * tl_rand01());
+    if (R > 1) {
+        int a = (int)(tl_rand01() * n), b = (a + 1 + (int)(tl_rand01() * (n - 1))) % n;
+        d[a] = 1, d[b] = R;
+    }
+}
+
+static inline void general_star(int n, const double *d, fcage *c) {
+    star_cage(n, 3, d, c);
+    for (int32_t v = 1; v < c->nv; v++) {
+        c->pos[3 * v] += 0.25 * (tl_rand01() - 0.5);
+        c->pos[3 * v + 1] += 0.25 * (tl_rand01() - 0.5);
+        c->pos[3 * v + 2] += 0.5 * (tl_rand01() - 0.5);
+    }
+    c->pos[2] = 0.3 + 0.6 * tl_rand01();
+}
+
 /* The tear box: a cube of 3 x 3 quads per side, x scaled by 1.4 and z by 0.8; the
  * x-parallel edges of the slab of largest x carry 0.25, the z-parallel edges of the middle z
  * slab 3, every other edge 1. */
-static void tear_box(fcage *c) {
+static inline void tear_box(fcage *c) {
     int32_t id[4][4][4];
     c->nv = 0;
     c->pos = malloc(sizeof(double) * 3 * 64);

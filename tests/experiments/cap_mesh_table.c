@@ -22,16 +22,6 @@
 
 #include "../c/cap_fair.h"
 
-static void general_star(int n, const double *d, fcage *c) {
-    star_cage(n, 3, d, c);
-    for (int32_t v = 1; v < c->nv; v++) {
-        c->pos[3 * v] += 0.25 * (tl_rand01() - 0.5);
-        c->pos[3 * v + 1] += 0.25 * (tl_rand01() - 0.5);
-        c->pos[3 * v + 2] += 0.5 * (tl_rand01() - 0.5);
-    }
-    c->pos[2] = 0.3 + 0.6 * tl_rand01();
-}
-
 typedef struct { double turn, kring, kself, outside; int ksign, hsign, caps, pass, rpass; } mfair;
 
 static int measure(const ccn_cage *cage, int L, ccn_cap cap, mfair *F) {
@@ -54,16 +44,7 @@ static int measure(const ccn_cage *cage, int L, ccn_cap cap, mfair *F) {
             double d[3] = {pb.x[3 * v] - pr.x[3 * v], pb.x[3 * v + 1] - pr.x[3 * v + 1], pb.x[3 * v + 2] - pr.x[3 * v + 2]};
             G.outside = fmax(G.outside, norm3(d) / size);
         }
-    double rmax = 0, excess = 0;
-    for (int32_t q = 0; q < pr.nf; q++)
-        for (int j = 0; j < 4; j++) {
-            int32_t a = pr.fv[4 * q + j], b = pr.fv[4 * q + (j + 1) % 4];
-            double dr[3] = {pr.x[3 * a] - pr.x[3 * b], pr.x[3 * a + 1] - pr.x[3 * b + 1], pr.x[3 * a + 2] - pr.x[3 * b + 2]};
-            double db[3] = {pb.x[3 * a] - pb.x[3 * b], pb.x[3 * a + 1] - pb.x[3 * b + 1], pb.x[3 * a + 2] - pb.x[3 * b + 2]};
-            double rr = angle(pr.n + 3 * a, pr.n + 3 * b) / norm3(dr), rb = angle(pb.n + 3 * a, pb.n + 3 * b) / norm3(db);
-            rmax = fmax(rmax, rr);
-            excess = fmax(excess, rb - rr);
-        }
+    double rmax, excess = turn_excess(&pr, &pb, &rmax);
     G.turn = excess / rmax;
     int32_t *nbs, *nb;
     neighbours(&pr, &nbs, &nb);
@@ -142,11 +123,7 @@ int main(int argc, char **argv) {
             int evs = 0;
             for (int k = 0; k < cases; k++) {
                 double d[12], R = Rs[ri];
-                for (int s = 0; s < n; s++) d[s] = exp(log(R) * tl_rand01());
-                if (R > 1) {
-                    int a = (int)(tl_rand01() * n), b = (a + 1 + (int)(tl_rand01() * (n - 1))) % n;
-                    d[a] = 1, d[b] = R;
-                }
+                random_spokes(n, R, d);
                 fcage c;
                 general_star(n, d, &c);
                 ccn_cage g = fcage_view(&c);

@@ -14,16 +14,6 @@
 
 #include "../c/cap_fair.h"
 
-static void general_star(int n, const double *d, fcage *c) {
-    star_cage(n, 3, d, c);
-    for (int32_t v = 1; v < c->nv; v++) { /* jitter and random heights: a general shape */
-        c->pos[3 * v] += 0.25 * (tl_rand01() - 0.5);
-        c->pos[3 * v + 1] += 0.25 * (tl_rand01() - 0.5);
-        c->pos[3 * v + 2] += 0.5 * (tl_rand01() - 0.5);
-    }
-    c->pos[2] = 0.3 + 0.6 * tl_rand01();
-}
-
 int main(int argc, char **argv) {
     int cases = argc > 1 ? atoi(argv[1]) : 4, L = argc > 2 ? atoi(argv[2]) : 5;
     tl_rng_state ^= (unsigned long long)(argc > 3 ? atoi(argv[3]) : 1) * 0x9E3779B97F4A7C15ull;
@@ -39,11 +29,7 @@ int main(int argc, char **argv) {
             int evs = 0, passed = 0;
             for (int k = 0; k < cases; k++) {
                 double d[12], R = Rs[ri];
-                for (int s = 0; s < n; s++) d[s] = exp(log(R) * tl_rand01());
-                if (R > 1) {
-                    int a = (int)(tl_rand01() * n), b = (a + 1 + (int)(tl_rand01() * (n - 1))) % n;
-                    d[a] = 1, d[b] = R;
-                }
+                random_spokes(n, R, d);
                 fcage c;
                 general_star(n, d, &c);
                 ccn_cage g = fcage_view(&c);
