@@ -25,6 +25,11 @@
 
 typedef struct { int32_t type, form, pline, nlines, top; } iges_de;
 
+/* Sequence numbers have 7 columns: a section of more lines is not IGES (a test lowers it). */
+#ifndef CCN_IGES_MAX_LINES
+#define CCN_IGES_MAX_LINES 9999999
+#endif
+
 typedef struct {
     char *buf;       /* parameter lines, 80 chars + '\n' each */
     size_t len, cap;
@@ -33,6 +38,7 @@ typedef struct {
     int col;
     int32_t de;      /* DE pointer of the entity being written */
     int oom;
+    int too_long;    /* more than CCN_IGES_MAX_LINES lines: nothing more is written */
 } iges_pd;
 
 static int pd_reserve(iges_pd *p, size_t more) {
@@ -48,17 +54,20 @@ static int pd_reserve(iges_pd *p, size_t more) {
 
 static void pd_newline(iges_pd *p) {
     char l[128];
+    int col = p->col;
+    p->col = 0; /* whatever happens, the next token starts a line: p->line never overflows */
+    if (p->nlines >= CCN_IGES_MAX_LINES || p->de > CCN_IGES_MAX_LINES) { p->too_long = 1; return; }
     p->nlines++;
-    int n = snprintf(l, sizeof l, "%-64.*s %7dP%7d\n", p->col, p->line, (int)p->de, (int)p->nlines);
-    if (n != 81) { p->oom = 1; return; } /* more than 9,999,999 lines: not IGES any more */
+    int n = snprintf(l, sizeof l, "%-64.*s %7dP%7d\n", col, p->line, (int)p->de, (int)p->nlines);
+    if (n != 81) { p->too_long = 1; return; }
     if (!pd_reserve(p, 81)) return;
     memcpy(p->buf + p->len, l, 81);
     p->len += 81;
-    p->col = 0;
 }
 
 /* A token and its delimiter (',' or ';'), never split across lines. */
 static void pd_token(iges_pd *p, const char *tok, char delim) {
+    if (p->oom || p->too_long) return; /* the export fails; stop writing */
     int n = (int)strlen(tok);
     if (p->col + n + 1 > 64) pd_newline(p);
     memcpy(p->line + p->col, tok, (size_t)n);
@@ -239,7 +248,7 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         de[k_shell + 1].top = 1;
     }
 #undef DEP
-    return p->oom ? CCN_ERR_MEMORY : CCN_OK;
+    return p->oom ? CCN_ERR_MEMORY : p->too_long ? CCN_ERR_ARGUMENT : CCN_OK;
 }
 
 ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
@@ -263,7 +272,17 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     ccn__cad_curve c = {0, 0, pts + 3 * (size_t)maxp, pts, 0}; /* poles, then knots */
     iges_pd *p = calloc(1, sizeof *p);
     ccn__cad_out *o = malloc(sizeof *o);
-    if (!de || !pts || !p || !o || build_pd(m, &t, p, de, &c) != CCN_OK) {
+    ccn_status bs = de && pts && p && o ? build_pd(m, &t, p, de, &c) : CCN_ERR_MEMORY;
+    if (bs == CCN_OK && 2 * (int64_t)nde > CCN_IGES_MAX_LINES) bs = CCN_ERR_ARGUMENT;
+    if (bs == CCN_ERR_ARGUMENT) {
+        st = ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
+                       "the IGES file of this surface (%d faces) needs a section of more than %d lines, "
+                       "which its 7-digit sequence numbers cannot count: export STEP, or the packed "
+                       "export, or a coarser surface",
+                       (int)m->num_faces, (int)CCN_IGES_MAX_LINES);
+        goto done;
+    }
+    if (bs != CCN_OK) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }

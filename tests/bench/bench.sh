@@ -82,6 +82,9 @@ for cage in $D/carlike_knots.obj tests/data/fig16_v6.obj tests/data/fig17_v7.obj
 done
 echo "CAD export (ccn_plan_export) of the production-like cages, into memory:"
 for cage in carlike carlike_knots; do build/bench/export_bench "$D/$cage.obj" 3 || exit 2; done
+echo "CAD export of OpenSubdiv's catmark_car (semi-sharp creases; target: <= 3,000 faces, <= 30 MB):"
+shapes=$(tests/oracle/osd_shapes_deps.sh) && python3 tests/data/osd/extract_shapes.py "$shapes" "$D/osd" > /dev/null &&
+  build/bench/export_bench "$D/osd/catmark_car.obj" 1 || exit 2
 echo "One UV channel (the cages' box unwrap, --cap refine; target: <= 1.5x the plan without):"
 echo "mesh level | plan | plan + uv | ratio | evaluate | evaluate + uv | ratio | memory MB | memory + uv MB | ratio"
 for cage in sphere8k carlike carlike_knots; do
