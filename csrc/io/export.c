@@ -362,13 +362,13 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (st) return st;
     ccn_sizes sz;
     ccn_plan_get_sizes(plan, &sz);
-    ccn_plan_stats sz_st;
-    ccn_plan_get_stats(plan, &sz_st);
-    if (sz_st.num_caps_deferred > 0) /* no caps at L <= K; fills there would be needless */
+    ccn_plan_stats ps;
+    ccn_plan_get_stats(plan, &ps);
+    if (ps.num_caps_deferred > 0) /* no caps at L <= K; fills there would be needless */
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
                          "the plan (output level %d) has no bi-5 caps for its %d extraordinary vertices: "
                          "none is built below the output level; export a plan with more levels (%d or more)",
-                         (int)sz_st.levels, (int)sz_st.num_caps_deferred, (int)sz_st.levels + 1);
+                         (int)ps.levels, (int)ps.num_caps_deferred, (int)ps.levels + 1);
     ccn_limit_mesh lm = {.positions = malloc(sizeof(double) * 3 * (size_t)(sz.num_verts ? sz.num_verts : 1))};
     if (!lm.positions) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)");
     st = ccn_plan_evaluate(plan, positions, &lm, err);

@@ -433,6 +433,31 @@ static inline void general_star(int n, const double *d, fcage *c) {
     c->pos[2] = 0.3 + 0.6 * tl_rand01();
 }
 
+/* A row of the tables: `cases` random general stars of valence n and ratio R, each given to fn
+ * (k: its index in the row) and freed after. */
+typedef void (*star_fn)(void *ctx, int k, fcage *c);
+static inline void star_row(int n, double R, int cases, star_fn fn, void *ctx) {
+    for (int k = 0; k < cases; k++) {
+        double d[12];
+        random_spokes(n, R, d);
+        fcage c;
+        general_star(n, d, &c);
+        fn(ctx, k, &c);
+        fcage_free(&c);
+    }
+}
+
+/* The cage as an OBJ with `# knot` lines (to look at a case of the tables). */
+static inline void fcage_write_obj(const fcage *c, const char *path) {
+    FILE *fo = fopen(path, "w");
+    if (!fo) return;
+    for (int32_t v = 0; v < c->nv; v++) fprintf(fo, "v %.17g %.17g %.17g\n", c->pos[3 * v], c->pos[3 * v + 1], c->pos[3 * v + 2]);
+    for (int32_t f = 0; f < c->nf; f++)
+        fprintf(fo, "f %d %d %d %d\n", c->fv[4 * f] + 1, c->fv[4 * f + 1] + 1, c->fv[4 * f + 2] + 1, c->fv[4 * f + 3] + 1);
+    for (int32_t e = 0; e < c->ne; e++) fprintf(fo, "# knot %d %d %.17g\n", c->ev[2 * e] + 1, c->ev[2 * e + 1] + 1, c->kn[e]);
+    fclose(fo);
+}
+
 /* The tear box: a cube of 3 x 3 quads per side, x scaled by 1.4 and z by 0.8; the
  * x-parallel edges of the slab of largest x carry 0.25, the z-parallel edges of the middle z
  * slab 3, every other edge 1. */

@@ -107,6 +107,23 @@ static int measure(const ccn_cage *cage, int L, ccn_cap cap, mfair *F) {
     return 0;
 }
 
+typedef struct { ccn_cap cap; int L, n; double R; int evs; mfair all; } row;
+
+static void measure_star(void *ctx, int k, fcage *c) {
+    row *r = ctx;
+    char have[64];
+    snprintf(have, sizeof have, "%d,%g,%d", r->n, r->R, k);
+    if (getenv("CMT_DUMP") && strcmp(getenv("CMT_DUMP"), have) == 0) fcage_write_obj(c, "cage.obj");
+    ccn_cage g = fcage_view(c);
+    mfair F;
+    if (measure(&g, r->L, r->cap, &F) != 0) return;
+    r->evs++;
+    mfair *all = &r->all;
+    all->caps += F.caps, all->pass += F.pass, all->rpass += F.rpass, all->ksign += F.ksign, all->hsign += F.hsign;
+    if (F.caps) all->turn = fmax(all->turn, F.turn), all->kring = fmax(all->kring, F.kring), all->kself = fmax(all->kself, F.kself);
+    all->outside = fmax(all->outside, F.outside);
+}
+
 int main(int argc, char **argv) {
     /* "blend": the research cap of tests/experiments/cap_blend.patch (the enum value after REFINE) */
     ccn_cap cap = argc > 1 && strcmp(argv[1], "blend") == 0 ? (ccn_cap)(CCN_CAP_REFINE + 1) : CCN_CAP_GUIDED_BI5;
@@ -119,34 +136,10 @@ int main(int argc, char **argv) {
     for (int ri = 0; ri < 4; ri++)
         for (int n = 3; n <= 12; n++) {
             if (n == 4) continue;
-            mfair all = {0};
-            int evs = 0;
-            for (int k = 0; k < cases; k++) {
-                double d[12], R = Rs[ri];
-                random_spokes(n, R, d);
-                fcage c;
-                general_star(n, d, &c);
-                ccn_cage g = fcage_view(&c);
-                char want[64], have[64];
-                snprintf(have, sizeof have, "%d,%g,%d", n, R, k);
-                if (getenv("CMT_DUMP") && strcmp(getenv("CMT_DUMP"), have) == 0) {
-                    FILE *fo = fopen("cage.obj", "w");
-                    for (int32_t v = 0; v < c.nv; v++) fprintf(fo, "v %.17g %.17g %.17g\n", c.pos[3 * v], c.pos[3 * v + 1], c.pos[3 * v + 2]);
-                    for (int32_t f = 0; f < c.nf; f++)
-                        fprintf(fo, "f %d %d %d %d\n", c.fv[4 * f] + 1, c.fv[4 * f + 1] + 1, c.fv[4 * f + 2] + 1, c.fv[4 * f + 3] + 1);
-                    for (int32_t e = 0; e < c.ne; e++) fprintf(fo, "# knot %d %d %.17g\n", c.ev[2 * e] + 1, c.ev[2 * e + 1] + 1, c.kn[e]);
-                    fclose(fo);
-                }
-                (void)want;
-                mfair F;
-                if (measure(&g, L, cap, &F) == 0) {
-                    evs++;
-                    all.caps += F.caps, all.pass += F.pass, all.rpass += F.rpass, all.ksign += F.ksign, all.hsign += F.hsign;
-                    if (F.caps) all.turn = fmax(all.turn, F.turn), all.kring = fmax(all.kring, F.kring), all.kself = fmax(all.kself, F.kself);
-                    all.outside = fmax(all.outside, F.outside);
-                }
-                fcage_free(&c);
-            }
+            row r = {.cap = cap, .L = L, .n = n, .R = Rs[ri]};
+            star_row(n, Rs[ri], cases, measure_star, &r);
+            mfair all = r.all;
+            int evs = r.evs;
             printf("%-3d %-4g %5d %6d %6d %6d %6.2f %5d %5d %7.2f %7.2f %8.1e\n", n, Rs[ri], evs, all.caps, all.pass, all.rpass, all.turn,
                    all.ksign, all.hsign, all.kring, all.kself, all.outside);
             fflush(stdout);

@@ -14,6 +14,28 @@
 
 #include "../c/cap_fair.h"
 
+typedef struct { int L, evs, passed; fair all; } row;
+
+static void measure_star(void *ctx, int k, fcage *c) {
+    row *r = ctx;
+    (void)k;
+    ccn_cage g = fcage_view(c);
+    fair F;
+    fair_init(&F);
+    ccn_options o = {0};
+    if (fair_measure(&g, r->L, o, &F) != 0) return;
+    r->evs++;
+    r->passed += F.caps > 0 && F.turn <= 0.25 && !F.ksign && !F.hsign && F.kring <= 2 && F.kjump <= 0.15 && F.g1 <= 1e-9;
+    fair *all = &r->all;
+    all->caps += F.caps, all->fallbacks += F.fallbacks;
+    if (F.caps) {
+        all->turn = fmax(all->turn, F.turn), all->kring = fmax(all->kring, F.kring);
+        all->kjump = fmax(all->kjump, F.kjump), all->g1 = fmax(all->g1, F.g1);
+        all->jac = fmin(all->jac, F.jac);
+        all->ksign += F.ksign, all->hsign += F.hsign;
+    }
+}
+
 int main(int argc, char **argv) {
     int cases = argc > 1 ? atoi(argv[1]) : 4, L = argc > 2 ? atoi(argv[2]) : 5;
     tl_rng_state ^= (unsigned long long)(argc > 3 ? atoi(argv[3]) : 1) * 0x9E3779B97F4A7C15ull;
@@ -24,33 +46,11 @@ int main(int argc, char **argv) {
     for (int ri = 0; ri < 4; ri++)
         for (int n = 3; n <= 12; n++) {
             if (n == 4) continue;
-            fair all;
-            fair_init(&all);
-            int evs = 0, passed = 0;
-            for (int k = 0; k < cases; k++) {
-                double d[12], R = Rs[ri];
-                random_spokes(n, R, d);
-                fcage c;
-                general_star(n, d, &c);
-                ccn_cage g = fcage_view(&c);
-                fair F;
-                fair_init(&F);
-                ccn_options o = {0};
-                if (fair_measure(&g, L, o, &F) == 0) {
-                    evs++;
-                    int ok = F.caps > 0 && F.turn <= 0.25 && !F.ksign && !F.hsign && F.kring <= 2 && F.kjump <= 0.15 &&
-                             F.g1 <= 1e-9;
-                    passed += ok;
-                    all.caps += F.caps, all.fallbacks += F.fallbacks;
-                    if (F.caps) {
-                        all.turn = fmax(all.turn, F.turn), all.kring = fmax(all.kring, F.kring);
-                        all.kjump = fmax(all.kjump, F.kjump), all.g1 = fmax(all.g1, F.g1);
-                        all.jac = fmin(all.jac, F.jac);
-                        all.ksign += F.ksign, all.hsign += F.hsign;
-                    }
-                }
-                fcage_free(&c);
-            }
+            row r = {.L = L};
+            fair_init(&r.all);
+            star_row(n, Rs[ri], cases, measure_star, &r);
+            fair all = r.all;
+            int evs = r.evs, passed = r.passed;
             printf("%-3d %-4g %5d %6d %6.2f %6d %5d %5d %7.2f %7.3f %8.1e %6.3f\n", n, Rs[ri], evs, all.caps,
                    all.caps ? all.turn : 0.0, passed, all.ksign, all.hsign, all.caps ? all.kring : 0.0,
                    all.caps ? all.kjump : 0.0, all.caps ? all.g1 : 0.0, all.caps ? all.jac : 0.0);
