@@ -310,7 +310,10 @@ def blf_size(font_id, size):
 # ---- context ----------------------------------------------------------------------------------
 
 def has_evaluated_geometry():
-    """`Object.evaluated_geometry()` (4.3+): the evaluated GeometrySet with its instance
-    references, read per object instead of walking `depsgraph.object_instances`."""
-    return hasattr(bpy.types.Object, "evaluated_geometry")
+    """`Object.evaluated_geometry()`: the evaluated GeometrySet with its instance references,
+    read per object instead of walking `depsgraph.object_instances`. Used from 5.0: on 4.3-4.5
+    each call on a geometry holding instances leaks one 16-byte block (measured on 4.5.15:
+    "Not freed memory blocks: 50" after 50 calls, none on 5.2 and 5.3), and the tap is such a
+    geometry, read on every update."""
+    return hasattr(bpy.types.Object, "evaluated_geometry") and bpy.app.version >= (5, 0, 0)
 

@@ -9,11 +9,13 @@
 * frame_change_post: frame_set, playback and every frame of a render. Viewport depsgraph: the
   viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
   them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
-  then `depsgraph.update()` so the engine renders them (headless included).
+  then `depsgraph.update()` so the engine renders them (headless included); Render levels
+  refused for memory are an error of the render (_render_error).
 * render_init: Cycles' Persistent Data off for the render (it would keep the first frame's
   surface; _before_render).
 * render_complete / render_cancel: render proxies emptied and render plans freed (unless the
-  cage stores its render mesh in the file); Persistent Data restored.
+  cage stores its render mesh in the file); Persistent Data restored; the render's errors in a
+  popup (UI sessions).
 * save_pre / save_post: hygiene.collect(); viewport proxies swapped out of the write
   (proxies.py): nothing is rebuilt; the proxies are evaluated again at the next redraw.
 * load_post, undo_post, redo_post: hygiene, then every cage re-read.
@@ -222,13 +224,14 @@ def _on_frame(depsgraph):
         if sync_cages(depsgraph, cages, 'RENDER'):
             sync.stats["render_frames"] += 1
             depsgraph.update()
-        for o in cages:  # a render at other levels than asked for is said, not silent
+        for o in cages:  # a render at other levels than asked for is an error, not silent
             st = sync.status(o, 'RENDER')
             if st is not None and st.error:
-                print("CCNURBS: %s: Render levels %d not rendered (%s); rendering %s"
-                      % (o.name, o.ccnurbs.render_levels, st.error,
-                         "the viewport limit" if modifier.proxy(o, 'VIEW') is not None
-                         and len(modifier.proxy(o, 'VIEW').data.vertices) else "the cage"))
+                _render_error("%s: Render levels %d not rendered (%s); rendering %s"
+                              % (o.name, o.ccnurbs.render_levels, st.error,
+                                 "the viewport limit" if modifier.proxy(o, 'VIEW') is not None
+                                 and len(modifier.proxy(o, 'VIEW').data.vertices)
+                                 else "the cage"))
         return
     if sync_cages(depsgraph, cages_in(depsgraph), 'VIEW'):
         depsgraph.update()
@@ -240,6 +243,35 @@ def on_frame_change_post(scene, depsgraph=None):
 
 
 _persistent_off = []  # scenes whose Persistent Data this render turned off (restored after it)
+_render_errors = []   # this render's errors, shown in a popup when it ends (UI sessions)
+
+
+def _render_error(msg):
+    """An error of this render: printed at once as Blender prints its errors (what a headless
+    render or a farm log shows) and, in the UI, shown in a popup when the render ends (an add-on
+    cannot write into the render's own report)."""
+    print("Error: CCNURBS: " + msg)
+    if msg not in _render_errors:
+        _render_errors.append(msg)
+
+
+def _show_render_errors():
+    msgs = list(_render_errors)
+    _render_errors.clear()
+    wm = bpy.context.window_manager
+    if not msgs or bpy.app.background or wm is None or not wm.windows:
+        return None  # headless: no popup (bpy as a module has a window it cannot draw in)
+
+    def draw(menu, _context):
+        for m in msgs:
+            menu.layout.label(text=m, icon='ERROR')
+    try:
+        with bpy.context.temp_override(window=wm.windows[0]):
+            wm.popup_menu(draw, title="CCNURBS: render", icon='ERROR')
+    except Exception:  # a timer must not raise; the errors were printed
+        sync.stats["internal_errors"] += 1
+        traceback.print_exc()
+    return None
 
 
 def _before_render(scene):
@@ -271,6 +303,10 @@ def _after_render():
         if not obj.ccnurbs.store_render_mesh and obj.library is None:
             proxies.clear(modifier.proxy(obj, 'RENDER'))
     sync.free_render_plans()
+    if _render_errors and not bpy.app.background:  # render handlers may run off the main thread
+        bpy.app.timers.register(_show_render_errors, first_interval=0.0)
+    elif bpy.app.background:
+        _render_errors.clear()
 
 
 @persistent
@@ -360,7 +396,7 @@ def unregister():
         lst = getattr(bpy.app.handlers, event)
         for h in [h for h in lst if h is fn or _is_ours(h, fn.__name__)]:
             lst.remove(h)
-    for t in (_render_timer, refresh_after_enable):
+    for t in (_render_timer, refresh_after_enable, _show_render_errors):
         if bpy.app.timers.is_registered(t):
             bpy.app.timers.unregister(t)
     _render_dirty.clear()

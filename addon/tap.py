@@ -4,9 +4,10 @@ The CCNURBS group hands its input (the cage after every modifier above it, attri
 propagated) to Python as one collapsed instance carrying the point attribute "ccn_co". After an
 evaluation it is read:
 
-* 4.3+: `Object.evaluated_geometry().instance_references()` of each cage (per object);
-* 3.x: `depsgraph.object_instances`, the one walk Blender offers; it stops as soon as every cage
-  asked for has been found (instances of other objects before them are skipped unread). A cage
+* 5.0+: `Object.evaluated_geometry().instance_references()` of each cage (per object; on
+  4.3-4.5 each call leaks a block, compat.has_evaluated_geometry);
+* before: `depsgraph.object_instances`, the one walk Blender offers, always to its end (a walk
+  left early leaks its dupli list); instances of other objects are skipped unread. A cage
   drawn by a collection instance is the instance object of its tap's instance there.
 
 The temporary objects of `object_instances` are only valid during their iteration step, so the
@@ -111,6 +112,6 @@ def read(depsgraph, objects):
         me = inst.object.data
         if _is_tap(me):
             found[name] = _read(wanted[name], me)
-            if len(found) == len(wanted):
-                break
+    # no early break: a loop left before its end leaks the depsgraph's dupli list (measured on
+    # 3.4 and 4.5: "Not freed memory blocks", duplilist and dupli object, at exit)
     return found

@@ -283,10 +283,11 @@ class TestFileHygiene(AddonTestCase):
     def _instanced_positions(self, name):
         """The positions a collection instance draws for object `name` (evaluated)."""
         dg = update()
-        for inst in dg.object_instances:
+        found = None
+        for inst in dg.object_instances:  # to its end: a walk left early leaks its dupli list
             if inst.is_instance and inst.instance_object and inst.instance_object.original.name == name:
-                return cagelib.mesh_positions(inst.instance_object.data)
-        return None
+                found = cagelib.mesh_positions(inst.instance_object.data) if found is None else found
+        return found
 
     def test_collection_instance_shows_the_surface(self):
         """A cage inside a collection that an Empty instances (Add > Collection Instance; how
@@ -357,6 +358,53 @@ class TestFileHygiene(AddonTestCase):
             src = open(mod.__file__).read()
             self.assertNotIn("from_address", src, "%s reads or writes Blender's memory" % info.name)
 
+
+    def test_exit_frees_every_block(self):
+        """A Blender that used the modifier (edits, a frame change, a render, a save, a disable)
+        exits without "Not freed memory blocks"."""
+        if AS_MODULE and bpy.app.version[:2] == (4, 2):
+            # bpy 4.2 as a module crashes at interpreter exit once any add-on with a panel was
+            # enabled (bpy_class_free after Python is finalized): no exit report to read
+            self.skipTest("bpy 4.2 as a module cannot exit normally with an add-on enabled")
+        script = os.path.join(TMP, "exit_check.py")
+        with open(script, "w") as fh:
+            fh.write(EXIT_SCRIPT % {"module": module_name(), "tmp": TMP})
+        run = subprocess.run(blender_command(script), timeout=300, stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True)
+        self.assertIn("exit check: done", run.stdout, run.stdout[-2000:])
+        self.assertNotIn("Not freed memory blocks", run.stdout, run.stdout[-2000:])
+
+
+EXIT_SCRIPT = '''import os, addon_utils, bpy
+addon_utils.enable(%(module)r, default_set=True, handle_error=None)
+bpy.ops.mesh.primitive_cube_add()
+ob = bpy.context.object
+bpy.ops.object.ccnurbs_add()
+ob.ccnurbs.levels = 2
+bpy.context.view_layer.update()
+ob.data.vertices[0].co.x += 0.25
+ob.data.update()
+bpy.context.view_layer.update()
+d = ob.modifiers.new("Disp", 'DISPLACE')
+d.strength = 0.0
+d.keyframe_insert("strength", frame=1)
+d.strength = 1.0
+d.keyframe_insert("strength", frame=2)
+bpy.context.scene.frame_set(2)
+sc = bpy.context.scene
+cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+sc.collection.objects.link(cam)
+cam.location = (0.0, -6.0, 0.0)
+cam.rotation_euler = (1.5708, 0.0, 0.0)
+sc.camera = cam
+sc.render.engine = 'BLENDER_WORKBENCH'
+sc.render.resolution_x = sc.render.resolution_y = 16
+sc.render.filepath = os.path.join(%(tmp)r, "exit_check.png")
+bpy.ops.render.render(write_still=True)
+bpy.ops.wm.save_as_mainfile(filepath=os.path.join(%(tmp)r, "exit_check.blend"))
+addon_utils.disable(%(module)r, default_set=True)
+print("exit check: done")
+'''
 
 class TestSaveCost(AddonTestCase):
     def test_save_50k_cage_like_subsurf(self):

@@ -300,7 +300,8 @@ class TestModifier(AddonTestCase):
 
     def test_refused_render_levels_are_said(self):
         """Render levels that would not fit in memory are refused; the render then shows the
-        viewport limit and says so on the console (not silently)."""
+        viewport limit and reports it as an error (the console line Blender prints for its own
+        errors; in the UI also a popup when the render ends), not silently."""
         import contextlib
         import io
         ob = add_modifier(load_cage("Fan5R", os.path.join(DATA, "fan5.obj")), levels=1,
@@ -314,8 +315,13 @@ class TestModifier(AddonTestCase):
         finally:
             ccn.memory.free_bytes = free
         self.assertEqual(seen.get("verts"), n_view, "the render shows the viewport limit")
-        self.assertIn("Render levels 10 not rendered", out.getvalue())
+        self.assertIn("Error: CCNURBS: Fan5R: Render levels 10 not rendered", out.getvalue())
         self.assertIn("rendering the viewport limit", out.getvalue())
+        # headless: no window for the popup; the timer that shows it returns quietly
+        self.assertFalse(ccn.handlers._render_errors, "errors kept after a headless render")
+        ccn.handlers._render_errors.append("probe")
+        self.assertIsNone(ccn.handlers._show_render_errors())
+        self.assertFalse(ccn.handlers._render_errors)
 
     def _reload_without_addon(self, path):
         """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender

@@ -46,13 +46,20 @@ run() {
     echo "  run_blender: $tb Python traceback(s) in Blender's output:"
     sed '/^== CCNURBS blender tests ==$/,$d' "$d/log" | grep -A 16 "^Traceback" | sed 's/^/    /'
   fi
+  # Blender's own leak report at exit (the program prints it; bpy modules end with os._exit, and
+  # case_files checks a fresh module's exit instead)
+  leak=$(sed -n '/^== CCNURBS blender tests ==$/,$p' "$d/log" | grep -c '^Error: Not freed memory')
+  if [ "$leak" -ne 0 ]; then
+    echo "  run_blender: Blender reports memory not freed at exit:"
+    sed -n '/^== CCNURBS blender tests ==$/,$p' "$d/log" | grep -A 8 '^Error: Not freed memory' | sed 's/^/    /'
+  fi
   if [ -z "$summary" ]; then
     echo "  run_blender: exited with $rc before the tests finished; last output:"
     tail -n 40 "$d/log" | sed 's/^/    /'
     summary="0 passed, 1 failed"
   fi
   p=${summary%% passed*}; f=${summary#*passed, }; f=${f%% failed*}
-  if [ "$f" -eq 0 ] && { [ "$tb" -ne 0 ] || [ $rc -ne 0 ]; }; then f=1; fi
+  if [ "$f" -eq 0 ] && { [ "$tb" -ne 0 ] || [ "$leak" -ne 0 ] || [ $rc -ne 0 ]; }; then f=1; fi
   total_p=$((total_p + p)); total_f=$((total_f + f))
   versions="$versions ${ver:-?}${subset:+(subset)}"
   echo "== Blender ${ver:-$label} ($label${subset:+, subset of $(echo "$CCN_CASES" | tr , '\n' |
