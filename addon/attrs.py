@@ -46,8 +46,6 @@ TYPES = {'FLOAT': ('value', 1, np.float32), 'FLOAT2': ('vector', 2, np.float32),
 POINT_TYPES = ('FLOAT', 'FLOAT2', 'FLOAT_VECTOR', 'FLOAT_COLOR', 'BYTE_COLOR')  # interpolated
 MAX_WIDTH = 64  # CCN_FVAR_MAX_WIDTH: per-vertex data is evaluated in groups of this many
 
-_uv_cache = {}  # object name -> (data hash, UV channels)
-
 
 class Extras:
     """What a cage carries besides its geometry: UV maps, point and face attributes."""
@@ -148,13 +146,14 @@ def _weld_close(uniq, inv):
     return uniq[keep], new_index[target[inv]]
 
 
-def uv_channels(name, x, face_verts):
+def uv_channels(ost, x, face_verts):
     """Each UV map as (values (N, 2) f64, value index per face corner), and the key of their
-    topology (seams): cached per object while the UVs are unchanged."""
+    topology (seams): cached in the object's state `ost` (state.py) while the UVs are
+    unchanged."""
     if x is None or not x.uvs:
         return [], ""
     data = _hash([face_verts] + x.uvs + [repr(x.uv_names).encode()])
-    cached = _uv_cache.get(name)
+    cached = ost.uv
     if cached is not None and cached[0] == data:
         return cached[1]
     chans = []
@@ -168,7 +167,7 @@ def uv_channels(name, x, face_verts):
         values = uniq[:, 1:].astype(np.uint32).view(np.float32).astype(np.float64)
         chans.append((np.ascontiguousarray(values), np.asarray(inv, np.int32).ravel()))
     res = (chans, _hash([repr(x.uv_names).encode()] + [c[1] for c in chans]))
-    _uv_cache[name] = (data, res)
+    ost.uv = (data, res)
     return res
 
 
@@ -187,10 +186,6 @@ def add_corner_channels(plan, x):
         return []
     return [plan.add_fvar(a.astype(np.float64), np.arange(len(a), dtype=np.int32), "NONE")
             for _, _, a in x.corner]
-
-
-def forget(name):
-    _uv_cache.pop(name, None)
 
 
 def data_key(x, uv_smooth):

@@ -25,12 +25,11 @@ import traceback
 import bpy
 from bpy.app.handlers import persistent
 
-from . import compat, hygiene, modifier, overlay, proxies, sync, tap
+from . import compat, hygiene, modifier, overlay, proxies, state, sync, tap
 
 _busy = [False]
 _counts = [None]
 _saving = [False]  # between save_pre and save_post: the proxies are swapped out, read nothing
-_echo = set()      # cages whose proxies the save swapped back: their next update is our echo
 _refresh = [False]  # enabled while bpy.data was restricted: refresh at the first chance
 
 
@@ -49,9 +48,8 @@ def _guarded(fn, *args):
 
 
 def run_collect():
-    renamed, fresh, _ = hygiene.collect()
-    for old, new in renamed:
-        sync.rename(old, new)
+    _, fresh, _ = hygiene.collect()  # a rename needs nothing here: states follow the object
+    state.sweep()  # deleted objects' states
     _counts[0] = hygiene.counts()
     return fresh
 
@@ -101,12 +99,13 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
         if kind == 'VIEW' and obj.ccnurbs.store_render_mesh and bpy.app.background:
             sync.sync_object(obj, 'RENDER', cage)  # farm files from scripts: no idle timer here
         elif kind == 'VIEW' and obj.ccnurbs.store_render_mesh:
-            _render_dirty.add(obj.name_full)
-    if _render_dirty and not bpy.app.background:
+            state.of(obj).render_dirty = True
+    if not bpy.app.background and state.any_flag("render_dirty"):
         if bpy.app.timers.is_registered(_render_timer):
             bpy.app.timers.unregister(_render_timer)
         bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
-    if defer and sync.pending_normals and not bpy.app.background:  # each update: the delay again
+    # each update: the delay again
+    if defer and not bpy.app.background and state.any_flag("pending_normals"):
         if bpy.app.timers.is_registered(_normals_timer):
             bpy.app.timers.unregister(_normals_timer)
         bpy.app.timers.register(_normals_timer, first_interval=NORMALS_DELAY)
@@ -115,9 +114,8 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
 
 def write_pending_normals():
     """The exact normals of every viewport proxy that waits for them (sync.PENDING)."""
-    names = set(sync.pending_normals)
-    sync.pending_normals.clear()
-    objs = [o for o in bpy.data.objects if o.name_full in names]
+    objs = sync.pending_normals()
+    state.clear_field("pending_normals", False)
     if objs:
         sync_cages(bpy.context.evaluated_depsgraph_get(), objs, 'VIEW', defer=False)
 
@@ -130,15 +128,13 @@ def _normals_timer():
 
 
 RENDER_DELAY = 1.0  # seconds of quiet before stored render meshes are refreshed (UI only)
-_render_dirty = set()
 
 
 def _render_timer():
     if _busy[0]:
         return 0.2
-    names = set(_render_dirty)
-    _render_dirty.clear()
-    objs = [o for o in bpy.data.objects if o.name_full in names]
+    objs = state.objects_where("render_dirty")
+    state.clear_field("render_dirty", False)
 
     def run():
         dg = bpy.context.evaluated_depsgraph_get()
@@ -171,15 +167,14 @@ def _updated(depsgraph):
 
 def _is_echo(objs, geometry, depsgraph):
     """The update only re-evaluated cages because the save swapped their proxies back."""
-    if not _echo:
+    if not state.any_flag("echo"):
         return False
-    names = {o.name_full for o in objs}
-    cages = {n for n in names if n in _echo}
-    others = {o for o in objs if o.name_full not in cages and o.ccnurbs.role
+    cages = {o for o in objs if state.peek(o) is not None and state.peek(o).echo}
+    others = {o for o in objs if o not in cages and o.ccnurbs.role
               not in hygiene.PROXY_ROLES}
     meshes = [u for u in depsgraph.updates if isinstance(u.id, bpy.types.Mesh)
               and not u.id.name.startswith(".CCNURBS")]
-    _echo.clear()
+    state.clear_field("echo", False)
     return not others and not meshes
 
 
@@ -322,8 +317,9 @@ def _before_save():
 
 def _after_save():
     _saving[0] = False
-    if proxies.reattach_after_save():
-        _echo.update(o.name_full for o in modifier.cages())
+    if proxies.reattach_after_save():  # the cages' next update is our own echo
+        for o in modifier.cages():
+            state.of(o).echo = True
 
 
 @persistent
@@ -339,8 +335,7 @@ def on_save_post(*args):
 def _reload(forget):
     _saving[0] = False  # a save that failed between save_pre and save_post ends here
     if forget:
-        sync.forget_all()
-        hygiene.removed_note.clear()
+        state.forget_all()
     run_collect()
     sync_all()
 
@@ -399,5 +394,4 @@ def unregister():
     for t in (_render_timer, refresh_after_enable, _show_render_errors):
         if bpy.app.timers.is_registered(t):
             bpy.app.timers.unregister(t)
-    _render_dirty.clear()
-    sync.forget_all()
+    state.forget_all()

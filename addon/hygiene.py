@@ -13,7 +13,7 @@ after updates that change the object or group count or touch a cage whose owners
   group whose owner it records; the other cage gets new proxies;
 * one CCNURBS per object: a second one (the modifier panel's Duplicate, Copy to Selected or Copy
   Modifiers onto a cage, a Nodes modifier given one of our groups) is removed, the first in the
-  stack stays, and the panel says so (`removed_note`). Two would share a group and its proxies:
+  stack stays, and the panel says so (the state's `removed_note`, state.py). Two would share a group and its proxies:
   the second would read the first's limit as its cage and write the limit of the limit into the
   same proxy, growing at every edit;
 * a cage whose modifier is gone (Apply, X) stops being a cage; an applied limit loses its
@@ -24,11 +24,10 @@ after updates that change the object or group count or touch a cage whose owners
 import bpy
 import numpy as np
 
-from . import compat, modifier, proxies
+from . import compat, modifier, proxies, state
 
 REMOVED_NOTE = ("A second CCNURBS modifier (\"%s\") was removed: one per object. To subdivide "
                 "the limit again, apply this one first.")
-removed_note = {}  # object name -> the note shown in the panel after a second modifier went
 
 SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "uv_smooth",
             "normals", "use_creases", "store_render_mesh")
@@ -106,7 +105,7 @@ def _one_per_object(obj):
     for m in extra:
         name = m.name
         obj.modifiers.remove(m)
-        removed_note[obj.name_full] = REMOVED_NOTE % name
+        state.of(obj).removed_note = REMOVED_NOTE % name
         print("CCNURBS: %s: %s" % (obj.name_full, REMOVED_NOTE % name))
     return bool(extra)
 

@@ -2,7 +2,7 @@
 sync.py; none of those imports this module)."""
 import bpy
 
-from . import handlers, modifier, sync
+from . import handlers, modifier, state, sync
 
 
 class OBJECT_OT_ccnurbs_add(bpy.types.Operator):
@@ -55,7 +55,7 @@ class OBJECT_OT_ccnurbs_remove(bpy.types.Operator):
     def execute(self, context):
         obj = context.active_object
         modifier.remove(obj)
-        sync.forget(obj.name_full)
+        state.forget(obj)
         self.report({'INFO'}, "CCNURBS removed from %s (knot intervals kept)" % obj.name)
         return {'FINISHED'}
 

@@ -1,24 +1,23 @@
 """Viewport overlay: edit-mode edges coloured by knot interval, with a legend (gpu + blf).
 
 Colours are computed on a log scale: blue (short) ← grey (1) → red (long), the scale symmetric
-around 1 and wide enough for the largest ratio present. Edge coordinates and colours are cached
-per object by the depsgraph handler (sync.py) and the toggle; the draw callbacks only read the
-cache (they never touch bpy.data). Draw handlers exist while the add-on is enabled.
+around 1 and wide enough for the largest ratio present. Edge coordinates and colours are kept in
+each object's state (`overlay`, state.py), refreshed by the depsgraph handler and the toggle; the
+draw callbacks only read them (they never touch bpy.data). Draw handlers exist while the add-on
+is enabled.
 """
 import bpy
 import numpy as np
 
 from . import cage as cagemod
-from . import compat
+from . import compat, state
 
 SHORT = np.array((0.10, 0.45, 1.00, 1.0), np.float32)
 NEUTRAL = np.array((0.62, 0.62, 0.62, 0.55), np.float32)
 LONG = np.array((1.00, 0.22, 0.08, 1.0), np.float32)
 LINE_WIDTH = 3.0
 
-_cache = {}      # object name -> {"coords", "colors", "span", "batch"}
 _handles = []    # (space type, handle)
-_pending = set()
 _failed = []     # a draw error is printed once, then the overlay stops drawing
 
 
@@ -46,7 +45,7 @@ def refresh(obj, cage=None):
         cage = cagemod.read(obj)
     colors, span = interval_colors(cage.knots, cage.num_edges)
     coords = cage.positions[cage.edge_verts.reshape(-1)].astype(np.float32)
-    _cache[obj.name_full] = {"coords": coords, "colors": np.repeat(colors, 2, axis=0),
+    state.of(obj).overlay = {"coords": coords, "colors": np.repeat(colors, 2, axis=0),
                              "span": span, "batch": None, "knots": cage.knots}
     _tag_redraw()
 
@@ -59,17 +58,19 @@ def enabled(context=None):
 
 def on_objects_updated(objs):
     """Called by the depsgraph handler with the objects whose geometry changed."""
-    if not _cache and not enabled():
+    if not any(st.overlay for _, st in state.items()) and not enabled():
         return
     for obj in objs:
         if obj.type == 'MESH' and obj.data.is_editmode and enabled():
             refresh(obj)
         else:
-            _cache.pop(obj.name_full, None)
+            st = state.peek(obj)
+            if st is not None:
+                st.overlay = None
 
 
 def set_enabled(flag, context=None):
-    _cache.clear()
+    state.clear_field("overlay")
     if flag:
         for obj in _edit_objects(context or bpy.context):
             refresh(obj)
@@ -85,11 +86,10 @@ def _tag_redraw():
 
 
 def _refresh_pending():
-    names = set(_pending)
-    _pending.clear()
-    for name in names:
-        obj = bpy.data.objects.get(name)
-        if obj is not None and obj.type == 'MESH' and obj.data.is_editmode:
+    objs = state.objects_where("overlay_pending")
+    state.clear_field("overlay_pending", False)
+    for obj in objs:
+        if obj.type == 'MESH' and obj.data.is_editmode:
             try:
                 refresh(obj)
             except Exception as e:  # shown as a missing overlay, never as a traceback
@@ -129,10 +129,11 @@ def draw_edges():
     gpu.state.depth_test_set('LESS_EQUAL')
     try:
         for obj in _edit_objects(context):
-            entry = _cache.get(obj.name_full)
+            st = state.peek(obj)
+            entry = st.overlay if st is not None else None
             if entry is None:
-                if obj.name_full not in _pending:
-                    _pending.add(obj.name_full)
+                if st is None or not st.overlay_pending:
+                    state.of(obj).overlay_pending = True
                     bpy.app.timers.register(_refresh_pending, first_interval=0.0)
                 continue
             if entry["batch"] is None:
@@ -159,13 +160,14 @@ def draw_legend():
     context = bpy.context
     if not enabled(context):
         return
-    objs = [o for o in _edit_objects(context) if o.name_full in _cache]
-    if not objs:
+    entries = [st.overlay for st in map(state.peek, _edit_objects(context))
+               if st is not None and st.overlay is not None]
+    if not entries:
         return
     import blf
     import gpu
     from gpu_extras.batch import batch_for_shader
-    span = max(_cache[o.name_full]["span"] for o in objs)
+    span = max(e["span"] for e in entries)
     x0, y0, w, h, steps = 20, 40, 200, 12, 32
     verts, cols = [], []
     for i in range(steps):  # a few quads, not mesh data
@@ -203,8 +205,8 @@ def unregister():
     _failed.clear()
     while _handles:
         bpy.types.SpaceView3D.draw_handler_remove(_handles.pop(), 'WINDOW')
-    _cache.clear()
-    _pending.clear()
+    state.clear_field("overlay")
+    state.clear_field("overlay_pending", False)
     if bpy.app.timers.is_registered(_refresh_pending):
         bpy.app.timers.unregister(_refresh_pending)
 

@@ -23,7 +23,7 @@ import traceback
 import bpy
 import numpy as np
 
-from . import attrs, loose, memory, modifier, native, proxies
+from . import attrs, loose, memory, modifier, native, proxies, state
 from . import cage as cagemod
 
 # Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
@@ -32,16 +32,14 @@ from . import cage as cagemod
 stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "skipped": 0, "errors": 0,
          "internal_errors": 0, "render_frames": 0, "changed_only": 0}
 # changed_only: interval edits whose plan wrote only the outputs the edit changed
-_plans = {}      # (object name, kind) -> (topology key, native.Plan)
-_status = {}     # (object name, kind) -> Status
-_key_memo = {}   # (object name, kind) -> the last topology keys, their inputs (cage.py), and
-#                  "loose": the loose counts of that topology
+# Per cage and kind ('VIEW', 'RENDER'), in its state (state.py): plans (topology key, native.Plan),
+# status (Status), key_memo (the last topology keys, their inputs (cage.py), and "loose": the
+# loose counts of that topology).
 # Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
 # evaluation of the cage afterwards cost 5x the rest of an update): with
-# defer_normals the proxy gets Blender's own normals and this key suffix, and its cage is listed
-# in `pending_normals`; handlers.py writes the exact normals once editing pauses.
+# defer_normals the proxy gets Blender's own normals and this key suffix, and its state is marked
+# `pending_normals`; handlers.py writes the exact normals once editing pauses.
 PENDING = "|normals pending"
-pending_normals = set()  # names of cages whose viewport proxy waits for its exact normals
 
 
 class Status:
@@ -62,52 +60,31 @@ class Status:
 
 
 def status(obj, kind='VIEW'):
-    return _status.get((obj.name_full, kind))
+    st = state.peek(obj)
+    return st.status.get(kind) if st is not None else None
 
 
-def rename(old, new):
-    """A cage was renamed: its plans and status follow it."""
-    for kind in ('VIEW', 'RENDER'):
-        for table in (_plans, _status, _key_memo):
-            if (old, kind) in table:
-                table[(new, kind)] = table.pop((old, kind))
-
-
-def forget(name, kinds=('VIEW', 'RENDER')):
-    attrs.forget(name)
-    for kind in kinds:
-        entry = _plans.pop((name, kind), None)
-        if entry is not None:
-            entry[1].close()
-        _status.pop((name, kind), None)
-        _key_memo.pop((name, kind), None)
-
-
-def forget_all():
-    for _, plan in _plans.values():
-        plan.close()
-    _plans.clear()
-    _status.clear()
-    _key_memo.clear()
-    pending_normals.clear()
+def pending_normals():
+    """The cages whose viewport proxy waits for its exact normals."""
+    return state.objects_where("pending_normals")
 
 
 def free_render_plans():
-    for key in [k for k in _plans if k[1] == 'RENDER']:
-        _plans.pop(key)[1].close()
+    for _, st in state.items():
+        st.close_plans(['RENDER'])
 
 
-def _plan_for(key_name, topo, cage, s, levels, uv_chans):
-    cached = _plans.get(key_name)
+def _plan_for(ost, kind, topo, cage, s, levels, uv_chans):
+    cached = ost.plans.get(kind)
     if cached is not None and cached[0] == topo:
         return cached[1]
     old = None
     if cached is not None:
         old = cached[1]
-        del _plans[key_name]
+        del ost.plans[kind]
     try:
         why = memory.refusal(cage.face_sizes, levels,
-                             "Levels Viewport" if key_name[1] == 'VIEW' else "Render levels")
+                             "Levels Viewport" if kind == 'VIEW' else "Render levels")
         if why:  # before anything is allocated (memory.py)
             raise native.CCNError("CCN_ERR_MEMORY", why, reason="levels_refused")
         sharp = cagemod.sharpness(cage.edge_creases) if s.use_creases else None
@@ -132,7 +109,7 @@ def _plan_for(key_name, topo, cage, s, levels, uv_chans):
     plan.uv_channels = attrs.add_channels(plan, uv_chans, s.uv_smooth)
     plan.corner_channels = attrs.add_corner_channels(plan, cage.extras)
     plan.face_origin = plan.corner_edge_origin = None
-    _plans[key_name] = (topo, plan)
+    ost.plans[kind] = (topo, plan)
     return plan
 
 
@@ -158,36 +135,34 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     the Status; never raises."""
     s = obj.ccnurbs
     levels = s.levels if kind == 'VIEW' else s.render_levels
-    key_name = (obj.name_full, kind)
+    ost = state.of(obj)
     st = Status(kind, levels)
     t0 = time.perf_counter()
     p = None
     try:
-        uv_chans, uv_topo = attrs.uv_channels(obj.name_full, cage.extras, cage.face_verts)
+        uv_chans, uv_topo = attrs.uv_channels(ost, cage.extras, cage.face_verts)
         uv_topo += attrs.corner_layout(cage.extras)
-        memo = _key_memo.setdefault(key_name, {})
+        memo = ost.key_memo.setdefault(kind, {})
         topo, faces = (k + uv_topo for k in
                        cage.topology_keys(levels, *s.option_tuple(), creases=s.use_creases,
                                           memo=memo))
         if "loose" not in memo:  # a new topology (the memo starts afresh): count once
             memo["loose"] = cage.loose_counts()
         st.loose = memo["loose"]
-        old = _status.get(key_name)
+        old = ost.status.get(kind)
         p = modifier.proxy(obj, kind)
         if p is None:
             raise native.CCNError("CCN_ERR_ARGUMENT", "the modifier has no proxy (re-add it)")
         if levels == 0:  # as Subdivision Surface at Levels 0: the cage itself, no limit
             if proxies.show_cage(p):
                 stats["syncs"] += 1
-            entry = _plans.pop(key_name, None)
-            if entry is not None:
-                entry[1].close()
+            ost.close_plans([kind])
             st.num_verts, st.num_faces = len(cage.positions), len(cage.face_sizes)
             st.sizes = {}
             st.showing = "cage"
             st.key = proxies.CAGE_KEY
             st.seconds = time.perf_counter() - t0
-            _status[key_name] = st
+            ost.status[kind] = st
             return st
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
         key = topo + ":" + cage.position_key() + ":" + ekey
@@ -195,7 +170,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         me = p.data
         stored = me.get(proxies.KEY_PROP)
         if stored == key + PENDING and defer_normals:
-            pending_normals.add(obj.name_full)  # e.g. after undo: still waiting
+            ost.pending_normals = True  # e.g. after undo: still waiting
         if not force and (stored == key or stored == key + PENDING and defer_normals):
             stats["skipped"] += 1
             if old is None or old.error or old.key != key:  # file just loaded, or undo restored
@@ -203,13 +178,13 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
                 old.num_verts, old.num_faces = len(me.vertices), len(me.polygons)
                 old.loose = st.loose
                 old.key = key
-                cached = _plans.get(key_name)
+                cached = ost.plans.get(kind)
                 if cached is not None and cached[0] == topo:
                     old.sizes = dict(cached[1].sizes)
-                _status[key_name] = old
+                ost.status[kind] = old
             return old
         stats["syncs"] += 1
-        plan = _plan_for(key_name, topo, cage, s, levels, uv_chans)
+        plan = _plan_for(ost, kind, topo, cage, s, levels, uv_chans)
         me = proxies.own_mesh(p)
         # an interval edit changes the plan, not the output faces: positions (and normals)
         # are rewritten in place, the proxy keeps its topology
@@ -237,7 +212,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             stats["rebuilds"] += 1
         me[proxies.KEY_PROP] = key + PENDING if deferred else key
         if deferred:
-            pending_normals.add(obj.name_full)
+            ost.pending_normals = True
         me[proxies.TOPO_PROP] = faces
         me[proxies.PLAN_PROP] = topo
         st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
@@ -250,7 +225,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         stats["errors"] += 1
         if not len(cage.face_sizes) and p is not None:  # nothing to show but the cage itself
             proxies.clear(p)
-            forget(obj.name_full, (kind,))
+            state.forget(obj, [kind])
     except Exception as e:  # never let a handler raise: report it in the panel instead
         st.error = "internal error: %s: %s" % (type(e).__name__, e)
         stats["errors"] += 1
@@ -264,7 +239,7 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             st.num_verts, st.num_faces = len(shown.vertices), len(shown.polygons)
         else:
             st.showing = "cage"
-    _status[key_name] = st
+    ost.status[kind] = st
     return st
 
 
@@ -275,7 +250,7 @@ def missing_tap(obj, kind):
     p = modifier.proxy(obj, kind)
     st.showing = "last valid limit" if p is not None and p.data and len(p.data.vertices) \
         else "cage"
-    _status[(obj.name_full, kind)] = st
+    state.of(obj).status[kind] = st
     return st
 
 
@@ -288,7 +263,7 @@ def linked_cage(obj, kind):
                 "linked data, so the cage is shown" % (bpy.path.basename(lib) or "a library"))
     st.reason = "linked_data"
     st.showing = "cage"
-    _status[(obj.name_full, kind)] = st
+    state.of(obj).status[kind] = st
     return st
 
 

@@ -24,12 +24,12 @@ until Object Mode; both last cases put a note in the panel (`edit_note`).
 import numpy as np
 
 from . import cage as cagemod
-from . import compat, modifier
+from . import compat, modifier, state
 from .modifier import TAP_ATTR
 
-_object_mode = {}  # object name -> (edge_verts bytes, knots, edge creases, vertex creases,
-#                                    material indices, face_verts bytes, UV maps and attributes)
-edit_note = {}     # object name -> note shown in the panel
+# In each cage's state (state.py): object_mode, the last Object Mode read (edge_verts bytes,
+# knots, edge creases, vertex creases, material indices, face_verts bytes, UV maps and
+# attributes), and edit_note, the note shown in the panel.
 
 
 def _is_tap(me):
@@ -39,12 +39,12 @@ def _is_tap(me):
 
 
 def _read(obj, me):
-    name = obj.name_full
-    edit_note.pop(name, None)
+    ost = state.of(obj)
+    ost.edit_note = None
     if not getattr(me, "is_editmode", False):
         c = cagemod.read_mesh(me, extras=True)
-        _object_mode[name] = (c.edge_verts.tobytes(), c.knots, c.edge_creases, c.vertex_creases,
-                              c.material_index, c.face_verts.tobytes(), c.extras)
+        ost.object_mode = (c.edge_verts.tobytes(), c.knots, c.edge_creases, c.vertex_creases,
+                           c.material_index, c.face_verts.tobytes(), c.extras)
         return c
     own = cagemod.read_mesh(cagemod.source_mesh(obj), extras=True)  # the edit mesh itself:
     # right when the stack keeps its edges (UVs and attributes: its corners)
@@ -63,7 +63,7 @@ def _read(obj, me):
         if len(own.material_index) == len(c.material_index):
             c.material_index = own.material_index
         return c
-    cached = _object_mode.get(name)
+    cached = ost.object_mode
     if cached is not None and cached[5] == c.face_verts.tobytes() and c.extras is None:
         c.extras = cached[6]
     if cached is not None and cached[0] == c.edge_verts.tobytes():
@@ -72,7 +72,7 @@ def _read(obj, me):
             c.material_index = cached[4]
     else:
         c.knots = c.edge_creases = c.vertex_creases = None
-    edit_note[name] = ("Edit Mode: interval and crease edits through the modifiers above "
+    ost.edit_note = ("Edit Mode: interval and crease edits through the modifiers above "
                        "show in Object Mode (Blender %d.x Python limit)" % compat.VERSION[0])
     return c
 

@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import errors, hygiene, modifier, native, proxies, sync, tap, values
+from . import errors, modifier, native, proxies, state, sync, values
 
 
 def active_edge_interval(obj):
@@ -105,7 +105,8 @@ def _draw_status(layout, obj):
             box.label(text=lines[0], icon='INFO')
             for line in lines[1:]:
                 box.label(text=line, icon='BLANK1')
-        for note in (tap.edit_note.get(obj.name_full), hygiene.removed_note.get(obj.name_full)):
+        ost = state.peek(obj)
+        for note in ((ost.edit_note, ost.removed_note) if ost is not None else ()):
             if note:
                 for i, line in enumerate(_wrap(note, 48)):
                     box.label(text=line, icon='INFO' if i == 0 else 'BLANK1')

@@ -145,7 +145,7 @@ def bench(name, level):
         evaluated(ob)
         r[normals] = (time_positions(ob), time_edit_positions(ob), time_interval(ob),
                       time_topology(ob, me_a, me_b))
-        if normals == 'EXACT' and HANDLERS.sync.pending_normals:  # < 4.5: once editing pauses
+        if normals == 'EXACT' and HANDLERS.sync.pending_normals():  # < 4.5: once editing pauses
             t0 = time.perf_counter()
             HANDLERS.write_pending_normals()
             evaluated(ob)

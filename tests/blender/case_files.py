@@ -162,6 +162,39 @@ class TestFileHygiene(AddonTestCase):
         bpy.ops.wm.open_mainfile(filepath=path)
         self.assertOwnSurface(bpy.data.objects["New"])
 
+    def test_state_follows_the_object_not_its_name(self):
+        """The add-on's memory of a cage (plans, status, notes) is keyed by the object, not its
+        name: a rename keeps the plan (no new one is made), swapping two cages' names swaps
+        nothing, a copy starts with its own, and a deleted cage's state is dropped."""
+        a = add_modifier(grid(3, "A"), levels=1)
+        b = add_modifier(grid(4, "B"), levels=2)
+        plan_a = ccn.state.of(a).plans['VIEW'][1]
+        plan_b = ccn.state.of(b).plans['VIEW'][1]
+        made = ccn.sync.stats["rebuilds"]
+        a.name, b.name = "Tmp", "A"
+        a.name = "B"  # the two names swapped
+        for ob in (a, b):
+            ob.data.vertices[0].co.z += 0.25
+            ob.data.update()
+        update()
+        self.assertIs(ccn.state.of(a).plans['VIEW'][1], plan_a, "a rename made a new plan")
+        self.assertIs(ccn.state.of(b).plans['VIEW'][1], plan_b, "a rename made a new plan")
+        self.assertEqual(ccn.sync.stats["rebuilds"], made, "a rename rebuilt a proxy")
+        self.assertEqual(ccn.sync.status(a).levels, 1)
+        self.assertEqual(ccn.sync.status(b).levels, 2)
+        self.assertOwnSurface(a)
+        self.assertOwnSurface(b)
+        select_only(a)
+        bpy.ops.object.duplicate()
+        copy = bpy.context.object
+        update()
+        self.assertIsNot(ccn.state.of(copy), ccn.state.of(a), "a copy shares its source's state")
+        self.assertOwnSurface(copy)
+        gone = ccn.state.key(b)
+        bpy.data.objects.remove(b)
+        update()
+        self.assertNotIn(gone, [k for k, _ in ccn.state.items()], "a deleted cage's state stays")
+
     def test_copies_get_their_own_surface(self):
         for how in ("shift-d", "alt-d", "copy-modifiers", "copy-to-selected"):
             with self.subTest(how=how):

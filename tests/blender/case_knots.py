@@ -104,7 +104,7 @@ class TestKnotOperators(AddonTestCase):
         bpy.context.scene.ccnurbs_tools.show_overlay = True
         bpy.ops.mesh.ccnurbs_set_knot_interval(value=4.0)
         update()
-        entry = ccn.overlay._cache.get(ob.name_full)
+        entry = ccn.state.of(ob).overlay
         self.assertIsNotNone(entry, "overlay data not refreshed after an edit")
         self.assertEqual(entry["coords"].shape, (2 * len(ob.data.edges), 3))
         red = set(np.flatnonzero(np.all(np.abs(entry["colors"][::2] - ccn.overlay.LONG) < 1e-6,

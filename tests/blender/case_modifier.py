@@ -148,11 +148,11 @@ class TestModifier(AddonTestCase):
                 key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
                 if ccn.compat.FREE_NORMALS:
                     self.assertMatchesCLI(ob)
-                    self.assertEqual(ccn.sync.pending_normals, set())
+                    self.assertEqual(ccn.sync.pending_normals(), [])
                     self.assertFalse(key.endswith(ccn.sync.PENDING), key)
                     continue
                 self.assertMatchesCLI(ob, normals=False)  # positions exact at once
-                self.assertEqual(ccn.sync.pending_normals, {ob.name_full})
+                self.assertEqual(ccn.sync.pending_normals(), [ob])
                 self.assertTrue(key.endswith(ccn.sync.PENDING), key)
                 me = ccn.modifier.proxy(ob, 'VIEW').data
                 # < 4.1: custom normals are shown only with auto smooth, which is turned off;
@@ -164,7 +164,7 @@ class TestModifier(AddonTestCase):
             h.write_pending_normals()
             update()
             self.assertMatchesCLI(ob)  # the exact normals
-            self.assertEqual(ccn.sync.pending_normals, set())
+            self.assertEqual(ccn.sync.pending_normals(), [])
             key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
             self.assertFalse(key.endswith(ccn.sync.PENDING), key)
             self.assertLessEqual(ccn.sync.stats["syncs"] - st["syncs"],
@@ -175,7 +175,7 @@ class TestModifier(AddonTestCase):
                              0 if ccn.compat.FREE_NORMALS else 1)
         finally:
             h.DEFER_IN_BACKGROUND[0] = False
-            ccn.sync.pending_normals.clear()
+            ccn.state.clear_field("pending_normals", False)
 
     def test_edit_mode_updates(self):
         ob = add_modifier(grid(4))
