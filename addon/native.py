@@ -119,7 +119,9 @@ class ccn_limit_mesh(ctypes.Structure):
                 ("corner_normals", c_double_p),
                 ("corner_edge_origin", c_int32_p),
                 ("edge_verts", c_int32_p),
-                ("corner_edges", c_int32_p)]
+                ("corner_edges", c_int32_p),
+                ("curvatures", c_double_p),       # NULL: not computed
+                ("curvature_dirs", c_double_p)]
 
 
 class ccn_fvar_channel(ctypes.Structure):

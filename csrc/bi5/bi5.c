@@ -487,8 +487,8 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
 
 /* ---- evaluation (SPEC §1.4) ------------------------------------------------------------ */
 
-void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u, double v,
-                   double pos[3], double du[3], double dv[3]) {
+const double *ccn__bi5_locate(const ccn__bi5 *b, const double *patches, int32_t s, double u,
+                              double v, double *pu, double *pv, double *su, double *sv) {
     int32_t n = b->n;
     s = ((s % n) + n) % n;
     double scale = 1.0; /* level-r units per hole unit */
@@ -500,14 +500,20 @@ void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u
             int32_t kind = u >= rho ? (v <= rho ? 0 : 1) : 2; /* A, B, C */
             double u0 = kind == 2 ? 0.0 : rho, lu = kind == 2 ? rho : sg;
             double v0 = kind == 0 ? 0.0 : rho, lv = kind == 0 ? rho : sg;
-            const double *P = patches + (((size_t)(3 * r + kind) * n + s) * 36) * 3;
-            ccn__bi5_patch_eval(P, 3, (u - u0) / lu, (v - v0) / lv, pos, du, dv);
-            for (int c = 0; c < 3; c++) { du[c] *= scale / lu; dv[c] *= scale / lv; }
-            return;
+            *pu = (u - u0) / lu, *pv = (v - v0) / lv;
+            *su = scale / lu, *sv = scale / lv;
+            return patches + (((size_t)(3 * r + kind) * n + s) * 36) * 3;
         }
         u /= rho; v /= rho; scale /= rho;
     }
-    const double *P = patches + (((size_t)3 * b->nsig * n + s) * 36) * 3;
-    ccn__bi5_patch_eval(P, 3, u, v, pos, du, dv);
-    for (int c = 0; c < 3; c++) { du[c] *= scale; dv[c] *= scale; }
+    *pu = u, *pv = v, *su = *sv = scale;
+    return patches + (((size_t)3 * b->nsig * n + s) * 36) * 3;
+}
+
+void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u, double v,
+                   double pos[3], double du[3], double dv[3]) {
+    double pu, pv, su, sv;
+    const double *P = ccn__bi5_locate(b, patches, s, u, v, &pu, &pv, &su, &sv);
+    ccn__bi5_patch_eval(P, 3, pu, pv, pos, du, dv);
+    for (int c = 0; c < 3; c++) { du[c] *= su; dv[c] *= sv; }
 }

@@ -165,5 +165,9 @@ ccn_status ccn__bi5_apply_normal(const ccn__bi5 *b, const double *cnet, const do
  * and the derivatives with respect to u and v. */
 void ccn__bi5_eval(const ccn__bi5 *b, const double *patches, int32_t s, double u, double v,
                    double pos[3], double du[3], double dv[3]);
+/* The bi-5 patch (36 points, 3 doubles each) holding hole point (u, v) of sector s, the point's
+ * coordinates (pu, pv) in it and the hole's units per patch unit along each (su, sv). */
+const double *ccn__bi5_locate(const ccn__bi5 *b, const double *patches, int32_t s, double u,
+                              double v, double *pu, double *pv, double *su, double *sv);
 
 #endif

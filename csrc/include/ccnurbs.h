@@ -296,6 +296,15 @@ typedef struct {
                              first use them), may be NULL */
     int32_t *corner_edges;/* 4 * num_faces: the edge from corner k to corner k+1 of each face,
                              an index into edge_verts; may be NULL */
+    double *curvatures;   /* 2 * num_verts principal curvatures k1 >= k2 of the limit surface,
+                             positive where it bends away from its normal (a sphere with
+                             outward normals: 1/r), may be NULL (then nothing is computed).
+                             NaN is a flag, not a number: at an extraordinary vertex of the
+                             refined limit the curvature is unbounded; on creases and corners,
+                             boundary curves of smooth corners and boundary EVs, caps and the
+                             bicubic faces around them it is not computed */
+    double *curvature_dirs; /* 3 * num_verts unit direction of k1 (that of k2 is the normal
+                             cross it), NaN where the curvature is; may be NULL */
 } ccn_limit_mesh;
 
 /* Output topology: the level-L refinement of the cage, i.e. every cage quad sampled on a

@@ -203,6 +203,18 @@ void ccn__bspline_basis(int p, const double *U, double x, double *N) {
  *   A = f(t_-1,t_0,t_0) = P_-1 + a (P_0 - P_-1),  a = (D_-2 + D_-1)/(D_-2 + D_-1 + D_0)
  *   B = f(t_0,t_0,t_1)  = P_0 + b (P_1 - P_0),    b = D_-1/(D_-1 + D_0 + D_1)
  *   f(t_0) = A + g (B - A), g = D_-1/(D_-1 + D_0);  f'(t_0) = 3 (B - A)/(D_-1 + D_0). */
+/* The second derivative at t_0 (blossoms: f''(t_0) = 6 f(t_0, d, d), the derivative curve's
+ * control points Q = 3 (P_0 - P_-1) / (D_-2 + D_-1 + D_0) and 3 (P_1 - P_0) / (D_-1 + D_0 + D_1),
+ * f''(t_0) = 2 (Q_1 - Q_0) / (D_-1 + D_0)); uniform intervals give (1, -2, 1). */
+void ccn__curve_limit_weights2(double dm2, double dm1, double d0, double d1, double w[3],
+                               double dw[3], double ddw[3]) {
+    ccn__curve_limit_weights(dm2, dm1, d0, d1, w, dw);
+    double s = 6.0 / (dm1 + d0), a = 1.0 / (dm2 + dm1 + d0), b = 1.0 / (dm1 + d0 + d1);
+    ddw[0] = s * a;
+    ddw[1] = -s * (a + b);
+    ddw[2] = s * b;
+}
+
 void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
                                 double dw[3]) {
     double a = (dm2 + dm1) / (dm2 + dm1 + d0), b = dm1 / (dm1 + d0 + d1);

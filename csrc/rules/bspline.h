@@ -32,6 +32,9 @@ void ccn__bspline_basis(int p, const double *U, double x, double *N);
  * B-spline with intervals D_-2, D_-1, D_0, D_1 around it. */
 void ccn__curve_limit_weights(double dm2, double dm1, double d0, double d1, double w[3],
                               double dw[3]);
+/* The same and the second derivative weights ddw. */
+void ccn__curve_limit_weights2(double dm2, double dm1, double d0, double d1, double w[3],
+                               double dw[3], double ddw[3]);
 /* Curve edge point of edge(h) (knot insertion along the edge): its weight w (topology and
  * intervals only) and the blend (1-w) P_a + w P_b of the current positions. */
 void ccn__curve_edge_point(const ccn_mesh *m, int32_t h, int pinned, double out[3]);

@@ -414,14 +414,16 @@ static ccn_status ev_limit_ring(const ccn_mesh *m, int32_t v, int scheme, int ch
  * Around the vertex point of v every interval along a spoke is the spoke's (halved: only
  * ratios matter), so no level-(l+1) topology is needed. */
 
-static void child_regular(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+/* The 3 x 3 grid around the vertex point of v one level finer (level-(l+1) numbering) and
+ * its intervals along u and v (D_-2, D_-1, D_0, D_1), as child_regular uses them. */
+static void child_grid(const ccn_mesh *m, int32_t v, ccn__vpoint p[3][3], double du[4],
+                       double dv[4]) {
     int32_t sl[4];
     for (int k = 0; k < 4; k++) sl[k] = slot_edge(m, v, 0, k);
     int has2 = sl[2] >= 0, has3 = sl[3] >= 0;
     int32_t nf = m->nf, ne = m->ne;
 #define CE(k) vp1(nf + ccn__fan_edge(m, v, k))
 #define CF(k) vp1(m->hface[m->vfan[m->vfan_start[v] + (k)]])
-    ccn__vpoint p[3][3];
     p[1][1] = vp1(nf + ne + v);
     p[2][1] = CE(sl[0]);
     p[1][2] = CE(sl[1]);
@@ -440,10 +442,98 @@ static void child_regular(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
     double d0 = m->eknot[ccn__fan_edge(m, v, sl[0])], d1 = m->eknot[ccn__fan_edge(m, v, sl[1])];
     double d2 = has2 ? m->eknot[ccn__fan_edge(m, v, sl[2])] : d0;
     double d3 = has3 ? m->eknot[ccn__fan_edge(m, v, sl[3])] : d1;
-    double wu[3], dwu[3], wv[3], dwv[3];
-    ccn__curve_limit_weights(d2, d2, d0, d0, wu, dwu);
-    ccn__curve_limit_weights(d3, d3, d1, d1, wv, dwv);
+    du[0] = du[1] = d2; du[2] = du[3] = d0;
+    dv[0] = dv[1] = d3; dv[2] = dv[3] = d1;
+}
+
+static void child_regular(const ccn_mesh *m, int32_t v, ccn__stencil *s) {
+    ccn__vpoint p[3][3];
+    double du[4], dv[4], wu[3], dwu[3], wv[3], dwv[3];
+    child_grid(m, v, p, du, dv);
+    ccn__curve_limit_weights(du[0], du[1], du[2], du[3], wu, dwu);
+    ccn__curve_limit_weights(dv[0], dv[1], dv[2], dv[3], wv, dwv);
     tensor_stencil(p, wu, dwu, wv, dwv, s);
+}
+
+/* ---- second derivatives (curvature) ------------------------------------------------- */
+
+static void stencil2_add(ccn__stencil2 *s, int32_t v, const double w[5]) {
+    int k = 0;
+    while (k < s->n && s->v[k] != v) k++;
+    if (k == s->n) {
+        if (s->n == CCN_STENCIL2_MAX) return; /* cannot happen: 9 grid points of <= 4 vertices */
+        s->v[s->n++] = v;
+        for (int c = 0; c < 5; c++) s->w[c][k] = 0.0;
+    }
+    for (int c = 0; c < 5; c++) s->w[c][k] += w[c];
+}
+
+/* Tensor product of the 1-D weights of ccn__curve_limit_weights2 over the grid g: S_u, S_v,
+ * S_uu, S_uv, S_vv at the grid's centre. */
+static void tensor_stencil2(ccn__vpoint g[3][3], const double du[4], const double dv[4],
+                            ccn__stencil2 *s) {
+    double wu[3], dwu[3], ddwu[3], wv[3], dwv[3], ddwv[3];
+    ccn__curve_limit_weights2(du[0], du[1], du[2], du[3], wu, dwu, ddwu);
+    ccn__curve_limit_weights2(dv[0], dv[1], dv[2], dv[3], wv, dwv, ddwv);
+    s->n = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            for (int k = 0; k < g[i][j].n; k++) {
+                double c = g[i][j].w[k];
+                double w[5] = {c * dwu[i] * wv[j], c * wu[i] * dwv[j], c * ddwu[i] * wv[j],
+                               c * dwu[i] * dwv[j], c * wu[i] * ddwv[j]};
+                stencil2_add(s, g[i][j].v[k], w);
+            }
+}
+
+/* An interior valence-4 vertex without sharp edges: interior_stencil's grid, 9 distinct points
+ * (0 when two are one vertex: the general path merges them). */
+static int interior_stencil2(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil2 *s) {
+    int32_t g[3][3] = {{fan_diag(m, v, 2), fan_end(m, v, 2), fan_diag(m, v, 1)},
+                       {fan_end(m, v, 3), v, fan_end(m, v, 1)},
+                       {fan_diag(m, v, 3), fan_end(m, v, 0), fan_diag(m, v, 0)}};
+    const int32_t *gv = &g[0][0];
+    int dup = 0;
+    for (int a = 1; a < 9; a++)
+        for (int b = 0; b < a; b++) dup |= gv[a] == gv[b];
+    if (dup) return 0;
+    double wu[3], dwu[3], ddwu[3], wv[3], dwv[3], ddwv[3];
+    ccn__curve_limit_weights2(beyond_end(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
+                              m->eknot[ccn__fan_edge(m, v, 0)], beyond_end(m, v, 0, pinned), wu,
+                              dwu, ddwu);
+    ccn__curve_limit_weights2(beyond_end(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
+                              m->eknot[ccn__fan_edge(m, v, 1)], beyond_end(m, v, 1, pinned), wv,
+                              dwv, ddwv);
+    s->n = 9;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int k = 3 * i + j;
+            s->v[k] = g[i][j];
+            s->w[0][k] = dwu[i] * wv[j];
+            s->w[1][k] = wu[i] * dwv[j];
+            s->w[2][k] = ddwu[i] * wv[j];
+            s->w[3][k] = dwu[i] * dwv[j];
+            s->w[4][k] = wu[i] * ddwv[j];
+        }
+    return 1;
+}
+
+int ccn__curvature_stencil(const ccn_mesh *m, int32_t v, int pinned, int child,
+                           ccn__stencil2 *s) {
+    s->n = 0;
+    if (ccn__limit_kind(m, v, pinned) != CCN_LIMIT_REGULAR) return 0;
+    if (!child && !m->vboundary[v] && !m->esharp && interior_stencil2(m, v, pinned, s)) return 1;
+    ccn__vpoint p[3][3];
+    if (child) {
+        double du[4], dv[4];
+        child_grid(m, v, p, du, dv);
+        tensor_stencil2(p, du, dv, s);
+    } else {
+        ccn__vgrid g;
+        ccn__vertex_grid(m, v, 0, pinned, &g);
+        tensor_stencil2(g.p, g.du, g.dv, s);
+    }
+    return 1;
 }
 
 static void child_boundary_curve(const ccn_mesh *m, int32_t v, ccn__stencil *s) {

@@ -63,4 +63,18 @@ ccn_status ccn__ev_limit(const ccn_mesh *m, int32_t v, int scheme, int32_t ev_po
 ccn_status ccn__child_limit_stencil(const ccn_mesh *m, int32_t v, int pinned, int scheme,
                                     int crease_method, ccn__ring_work *w, ccn__stencil *s,
                                     ccn__ring_limit *ring, ccn_error *err);
+/* Weights of the first and second derivatives at a REGULAR vertex (the tensor B-spline of its
+ * 3 x 3 grid, ghosts included): w[0..4] = S_u, S_v, S_uu, S_uv, S_vv, with S_u x S_v along the
+ * outward normal as in ccn__limit_stencil. */
+#define CCN_STENCIL2_MAX 36
+typedef struct {
+    int n;
+    int32_t v[CCN_STENCIL2_MAX];
+    double w[5][CCN_STENCIL2_MAX];
+} ccn__stencil2;
+/* Fills s for a REGULAR vertex v of m (child = 0: over m's vertices, as ccn__limit_stencil;
+ * child = 1: over the level-(l+1) points around v's vertex point, as
+ * ccn__child_limit_stencil); returns 0 (s empty) for any other kind. */
+int ccn__curvature_stencil(const ccn_mesh *m, int32_t v, int pinned, int child,
+                           ccn__stencil2 *s);
 #endif

@@ -15,6 +15,7 @@
 #include "base/vec3.h"
 #include "bi5/bi5.h"
 #include "surface/caps.h"
+#include "surface/curvature.h"
 #include "surface/edit_region.h"
 #include "surface/plan_fvar.h"
 #include "surface/plan_levels.h"
@@ -343,6 +344,8 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "plan, out or out->positions is NULL");
     if (out->corner_normals && !out->normals)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "corner_normals needs normals too");
+    if (out->curvature_dirs && !out->curvatures)
+        return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "curvature_dirs needs curvatures too");
     struct ccn__edit_region *r = changed ? p->region : NULL;
     if (!changed && p->region) { /* the earlier plan's points are this plan's now: evaluate all */
         ccn__edit_region_free(p->region);
@@ -411,6 +414,10 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
     ccn_status st = ccn__caps_evaluate(p, out, written, err);
     if (st) { ccn__edit_region_free(r); return st; }
     if (out->corner_normals) eval_corner_normals(p, out);
+    if (out->curvatures && (st = ccn__curvature_evaluate(p, out, err))) {
+        ccn__edit_region_free(r);
+        return st;
+    }
     for (int32_t o = 0; o < p->nout_v; o++)
         if (!written || written[o])
             for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];

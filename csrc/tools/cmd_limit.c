@@ -1,5 +1,8 @@
 /* ccnurbs limit: the limit mesh (positions + exact normals) as OBJ with vn lines; the UV map
- * (vt) as limit values per face corner (f v/vt/vn, --fvar-linear). */
+ * (vt) as limit values per face corner (f v/vt/vn, --fvar-linear). An output named *.ply is
+ * written as PLY (MeshLab, CloudCompare) with vertex properties x y z nx ny nz, and with
+ * --curvature also k1 k2, the principal curvatures (k1 >= k2, positive where the surface bends
+ * away from its normal; nan where unbounded or not computed, see ccn_limit_mesh). */
 #include "cli.h"
 #include "commands.h"
 
@@ -41,6 +44,41 @@ static int write_limit(FILE *f, const ccn_sizes *s, const ccn_plan_stats *ps, co
     return ferror(f) ? -1 : 0;
 }
 
+static int ends_with(const char *s, const char *tail) {
+    size_t n = strlen(s), m = strlen(tail);
+    return n >= m && strcmp(s + n - m, tail) == 0;
+}
+
+/* ASCII PLY: per vertex x y z nx ny nz (k1 k2 with curvatures), quads as faces. */
+static int write_ply(FILE *f, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm) {
+    fprintf(f, "ply\nformat ascii 1.0\ncomment ccnurbs limit level %d\n", (int)ps->levels);
+    if (lm->curvatures)
+        fputs("comment k1 >= k2: principal curvatures, positive where the surface bends away from "
+              "its normal; nan where unbounded (an extraordinary vertex without a cap) or not "
+              "computed (creases, corners, caps)\n", f);
+    fprintf(f, "element vertex %d\n", (int)s->num_verts);
+    const char *props[] = {"x", "y", "z", "nx", "ny", "nz", "k1", "k2"};
+    for (int k = 0; k < (lm->curvatures ? 8 : 6); k++) fprintf(f, "property double %s\n", props[k]);
+    fprintf(f, "element face %d\nproperty list uchar int vertex_indices\nend_header\n", (int)s->num_faces);
+    for (int32_t v = 0; v < s->num_verts; v++) {
+        const double *x = lm->positions + 3 * (size_t)v, *n = lm->normals + 3 * (size_t)v;
+        fprintf(f, "%.17g %.17g %.17g %.17g %.17g %.17g", x[0], x[1], x[2], n[0], n[1], n[2]);
+        if (lm->curvatures) {
+            for (int k = 0; k < 2; k++) {
+                double c = lm->curvatures[2 * (size_t)v + k];
+                if (c != c) fputs(" nan", f);
+                else fprintf(f, " %.17g", c);
+            }
+        }
+        fputc('\n', f);
+    }
+    for (int32_t q = 0; q < s->num_faces; q++) {
+        const int32_t *fv = lm->face_verts + 4 * q;
+        fprintf(f, "4 %d %d %d %d\n", (int)fv[0], (int)fv[1], (int)fv[2], (int)fv[3]);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
 static int write_atomic(const char *path, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm,
                         const uv_out *uv) {
     size_t n = strlen(path);
@@ -48,7 +86,7 @@ static int write_atomic(const char *path, const ccn_sizes *s, const ccn_plan_sta
     if (!tmp) return 2;
     snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
-    int rc = f ? write_limit(f, s, ps, lm, uv) : -1;
+    int rc = !f ? -1 : ends_with(path, ".ply") ? write_ply(f, s, ps, lm) : write_limit(f, s, ps, lm, uv);
     if (f && fclose(f) != 0) rc = -1;
     if (rc == 0 && rename(tmp, path) != 0) rc = -1;
     if (rc) { remove(tmp); fprintf(stderr, "ccnurbs: cannot write %s\n", path); }
@@ -61,9 +99,11 @@ int ccn_cmd_limit(int argc, char **argv) {
     const char *in = NULL, *out = NULL;
     o.levels = 2;
     int corner_normals = 0; /* --corner-normals: one vn per face corner (creased surfaces) */
+    int curvature = 0;      /* --curvature: k1 k2 per vertex (PLY output) */
     for (int i = 1; i < argc; i++)
-        if (strcmp(argv[i], "--corner-normals") == 0) {
-            corner_normals = 1;
+        if (strcmp(argv[i], "--corner-normals") == 0 || strcmp(argv[i], "--curvature") == 0) {
+            if (strcmp(argv[i], "--corner-normals") == 0) corner_normals = 1;
+            else curvature = 1;
             for (int j = i; j + 1 < argc; j++) argv[j] = argv[j + 1];
             argc--;
             i--;
@@ -71,6 +111,10 @@ int ccn_cmd_limit(int argc, char **argv) {
     int fvar_linear = -1;
     int rc = ccn_cli_parse(argc, argv, CCN_CLI_LEVELS | CCN_CLI_CAP, 10, &o, &fvar_linear, &in, &out);
     if (rc) return rc;
+    if (curvature && !ends_with(out, ".ply")) {
+        fprintf(stderr, "ccnurbs limit: --curvature writes PLY: name the output *.ply\n");
+        return 2;
+    }
     ccn_obj *obj = NULL;
     ccn_cage cage;
     ccn_fvar_channel uvc;
@@ -106,7 +150,9 @@ int ccn_cmd_limit(int argc, char **argv) {
     lm.normals = malloc(sizeof(double) * 3 * (size_t)(s.num_verts ? s.num_verts : 1));
     lm.face_verts = malloc(sizeof(int32_t) * 4 * (size_t)(s.num_faces ? s.num_faces : 1));
     if (corner_normals) lm.corner_normals = malloc(sizeof(double) * 12 * (size_t)(s.num_faces ? s.num_faces : 1));
+    if (curvature) lm.curvatures = malloc(sizeof(double) * 2 * (size_t)(s.num_verts ? s.num_verts : 1));
     if (!lm.positions || !lm.normals || !lm.face_verts || (corner_normals && !lm.corner_normals) ||
+        (curvature && !lm.curvatures) ||
         (ch >= 0 && (!uv_values || !uv_faces))) {
         fprintf(stderr, "ccnurbs: out of memory\n");
         rc = 2;
@@ -117,6 +163,7 @@ int ccn_cmd_limit(int argc, char **argv) {
         rc = write_atomic(out, &s, &ps, &lm, ch >= 0 ? &uv : NULL);
     }
     free(lm.positions); free(lm.normals); free(lm.face_verts); free(lm.corner_normals);
+    free(lm.curvatures);
     free(uv_values); free(uv_faces);
     ccn_plan_destroy(plan);
     return rc;

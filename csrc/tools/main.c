@@ -30,7 +30,7 @@ static int usage(void) {
     fprintf(stderr,
             "usage:\n"
             "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] [--crease-method uniform|chaikin] [--polyhedron P] [--fvar-linear M] in.obj out.obj\n"
-            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--polyhedron P] [--fvar-linear M] in.obj out.obj\n"
+            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--curvature] [--polyhedron P] [--fvar-linear M] in.obj out.obj|out.ply\n"
             "  ccnurbs patches [--scheme ...] [--corners ...] in.obj out.bv\n"
             "  ccnurbs export --format step|iges [--unpacked] [--fill-levels N] [--name NAME] [--face-map F]\n"
             "                 [--scheme ...] [--cap bi5|refine] [--corners ...] in.obj out.step\n"

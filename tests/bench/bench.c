@@ -80,6 +80,17 @@ int main(int argc, char **argv) {
         double t1 = now() - t0;
         teval = t1 < teval ? t1 : teval;
     }
+    /* the same with principal curvatures (the add-on's analysis) */
+    double tcurv = 1e30, *curv = malloc(sizeof(double) * 2 * s.num_verts);
+    ccn_limit_mesh lmc = {.positions = pos, .normals = nrm, .curvatures = curv};
+    for (int r = 0; r < 3 * reps; r++) {
+        cp[0] += 1e-3;
+        double t0 = now();
+        if (ccn_plan_evaluate(plan, cp, &lmc, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
+        double t1 = now() - t0;
+        tcurv = t1 < tcurv ? t1 : tcurv;
+    }
+    free(curv);
     struct rusage ru; /* one plan alive at a time so far: its peak, with the cage and outputs */
     getrusage(RUSAGE_SELF, &ru);
     double tref = 1e30;
@@ -94,6 +105,8 @@ int main(int argc, char **argv) {
         ccn_mesh_destroy(out);
     }
     ccn_mesh_destroy(cm);
+    printf("ccn curvature %s L%d: evaluate %.4f s, with curvature %.4f s (%.2fx)\n", argv[1], levels,
+           teval, tcurv, tcurv / teval);
     printf("ccn %s L%d %s: cage %d faces -> %d verts; plan %.4f s, evaluate %.4f s, refine %.4f s; "
            "caps %d, cap fallbacks %d, EVs verified %d, outside G1 %d; peak RSS %ld kB; first plan %.4f s%s\n",
            argv[1], levels, o.cap == CCN_CAP_REFINE ? "refine" : "bi5", cage.num_faces, s.num_verts,

@@ -115,5 +115,22 @@ if "$CLI" refine --levels 1 "$T/vtpartial.obj" "$T/out.obj" 2> "$T/stderr" && gr
    ! grep -q '^vt' "$T/out.obj"; then ok "a partial UV map is ignored with a warning"
 else bad "partial UV map: $(cat "$T/stderr")"; fi
 
+printf 'v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' > "$T/cube.obj"
+# --curvature: PLY with k1 k2 per vertex; the limit of a cube is convex: k1 >= k2 >= 0 at every
+# vertex with caps (the caps' own curvature), nan at exactly its 8 extraordinary corners without
+# caps
+ply_check() { # FILE NAN-COUNT: header, k1 >= k2 >= 0 where a number, that many nan rows
+  awk -v want="$2" 'NR == 1 && $0 != "ply" { exit 1 }
+        /^element vertex/ { nv = $3 } /^property double k[12]$/ { props++ }
+        /^end_header/ { body = 1; next }
+        body && n < nv { n++; if ($7 == "nan") nan++; else if ($8 + 0 < -1e-9 || $7 + 0 < $8 + 0) exit 1 }
+        END { exit !(props == 2 && n == nv && nv == 386 && nan + 0 == want) }' "$1"
+}
+if "$CLI" limit --levels 3 --curvature "$T/cube.obj" "$T/out.ply" 2> "$T/stderr" && ply_check "$T/out.ply" 0 &&
+   "$CLI" limit --levels 3 --cap refine --curvature "$T/cube.obj" "$T/out.ply" 2> "$T/stderr" && ply_check "$T/out.ply" 8; then
+  ok "limit --curvature writes PLY: k1 >= k2 >= 0 on a cube's convex limit, nan only at its 8 corners without caps"
+else bad "limit --curvature: $(cat "$T/stderr")"; fi
+expect_error "curvature needs PLY" "name the output \*.ply" limit --curvature "$T/cube.obj" "$T/out.obj"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

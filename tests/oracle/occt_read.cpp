@@ -1,7 +1,7 @@
 // Independent oracle for the CAD writers (test-only): reads a STEP or IGES file with
 // OpenCASCADE and reports what a CAD system would see, as "key: value" lines on stdout.
 //
-//   occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]
+//   occt_read [--no-heal] [--grid N --points FILE [--curvature]] [--samples K] [--eval REQ --out RES]
 //             [--fallback FACES] [--edges FILE] model.step|model.igs
 //   occt_read --build SURF.txt --grid N --points FILE
 //
@@ -15,7 +15,9 @@
 // its pcurve, the oriented face normals from BRepLProp_SLProps, angle = atan2(|n1 x n2|,
 // n1.n2) (accurate near 0). With --points, every face is evaluated on an N x N grid of its
 // surface's parameter bounds: lines "face i j u v x y z nx ny nz" (normal of the oriented
-// face), in face order (TopExp_Explorer over the file's shape).
+// face), in face order (TopExp_Explorer over the file's shape); with --curvature each line ends
+// with the principal curvatures "k1 k2" (k1 >= k2, positive where the face bends away from its
+// oriented normal; nan where undefined).
 //
 // --eval REQ --out RES: REQ has lines "face u v" (face index in TopExp order, parameters of
 // its surface); RES gets "face u v x y z nx ny nz" (the oriented normal, 0 0 0 if undefined).
@@ -97,7 +99,7 @@
 #include <vector>
 
 static int usage() {
-    std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE] [--samples K] [--eval REQ --out RES]\n"
+    std::fprintf(stderr, "usage: occt_read [--no-heal] [--grid N --points FILE [--curvature]] [--samples K] [--eval REQ --out RES]\n"
                          "                 [--fallback FACES] [--edges FILE] FILE.step|FILE.igs\n"
                          "       occt_read --build SURF.txt --grid N --points FILE\n");
     return 2;
@@ -239,6 +241,22 @@ static void print_surface(int i, const TopoDS_Face &F) {
     std::printf("\n");
 }
 
+static int with_curvature; // --curvature: --points lines end with "k1 k2"
+
+// Principal curvatures at (u, v), positive where the face bends away from its oriented normal
+// (OpenCASCADE's are signed along the surface's D1U x D1V: positive bending towards it); NaN
+// where OpenCASCADE has none.
+static void face_curvature(const TopoDS_Face &F, const BRepAdaptor_Surface &S, double u, double v,
+                           double &k1, double &k2) {
+    BRepLProp_SLProps props(S, u, v, 2, 1e-12);
+    k1 = k2 = NAN;
+    if (!props.IsNormalDefined() || !props.IsCurvatureDefined()) return;
+    double s = F.Orientation() == TopAbs_REVERSED ? 1.0 : -1.0;
+    double a = s * props.MaxCurvature(), b = s * props.MinCurvature();
+    k1 = a > b ? a : b;
+    k2 = a > b ? b : a;
+}
+
 // N x N grid of the surface's parameter bounds of face F (index fi) into out.
 static void write_grid(FILE *out, int fi, const TopoDS_Face &F, int N) {
     BRepAdaptor_Surface S(F, Standard_False); // untrimmed surface parametrisation
@@ -250,9 +268,15 @@ static void write_grid(FILE *out, int fi, const TopoDS_Face &F, int N) {
             gp_Pnt P;
             gp_Dir D(0, 0, 1);
             bool ok = face_normal(F, S, u, v, P, D);
-            std::fprintf(out, "%d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", fi, i, j,
+            std::fprintf(out, "%d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g", fi, i, j,
                          u, v, P.X(), P.Y(), P.Z(), ok ? D.X() : 0.0, ok ? D.Y() : 0.0,
                          ok ? D.Z() : 0.0);
+            if (with_curvature) {
+                double k1, k2;
+                face_curvature(F, S, u, v, k1, k2);
+                std::fprintf(out, " %.17g %.17g", k1, k2);
+            }
+            std::fprintf(out, "\n");
         }
 }
 
@@ -464,6 +488,7 @@ int main(int argc, char **argv) {
         else if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) K = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--build") && i + 1 < argc) build = argv[++i];
         else if (!std::strcmp(argv[i], "--no-heal")) heal = 0;
+        else if (!std::strcmp(argv[i], "--curvature")) with_curvature = 1;
         else if (!std::strcmp(argv[i], "--eval") && i + 1 < argc) req = argv[++i];
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) res = argv[++i];
         else if (!std::strcmp(argv[i], "--edges") && i + 1 < argc) edges = argv[++i];
