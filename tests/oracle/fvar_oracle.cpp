@@ -286,7 +286,8 @@ int main(int argc, char **argv) {
                 ccn_plan_get_sizes(plan, &sz);
                 std::vector<double> lp(3 * (size_t)sz.num_verts);
                 std::vector<int32_t> lfv(4 * (size_t)sz.num_faces);
-                ccn_limit_mesh lm = {lp.data(), nullptr, lfv.data(), nullptr, nullptr, nullptr, nullptr, nullptr};
+                ccn_limit_mesh lm = {lp.data(), nullptr, lfv.data(), nullptr, nullptr, nullptr, nullptr, nullptr,
+                                      nullptr, nullptr};
                 if (ccn_plan_evaluate(plan, nullptr, &lm, &err)) ccnDie("ccn_plan_evaluate", err);
                 if ((size_t)ri.num_face_verts != osd[0].val.size() / 3 || 4 * (size_t)sz.num_faces != osd[0].val.size() / 3)
                     die("face corner counts differ from OpenSubdiv's");
