@@ -16,7 +16,7 @@ CACHE=${CCN_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/ccnurbs}
 LINES=${CCN_BPY_LINES:-"4.2 4.5 5.2 5.3"}
 SUBSET_LINES=${CCN_BPY_SUBSET_LINES-"4.2 5.2"}
 SUBSET_CASES=${CCN_SUBSET_CASES:-case_package,case_knots,case_modifier,case_creases,case_stack,\
-case_animation,case_files,case_objio,case_values,case_zenable}
+case_animation,case_files,case_scenes,case_objio,case_values,case_zenable}
 TIMEOUT=${CCN_BLENDER_TIMEOUT:-300}
 for f in "$ZIP" "$CLI"; do
   [ -f "$f" ] || { echo "run_blender: $f missing (make package build)"; echo "0 passed, 1 failed"; exit 1; }

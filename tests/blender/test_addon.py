@@ -24,7 +24,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bltest  # noqa: E402
 
 CASES = ("case_package", "case_knots", "case_modifier", "case_creases", "case_primitives",
-         "case_stack", "case_animation", "case_files", "case_objio", "case_values", "case_uv",
+         "case_stack", "case_animation", "case_files", "case_scenes", "case_objio", "case_values",
+         "case_uv",
          "case_cad_export", "case_storm", "case_zenable")
 
 
