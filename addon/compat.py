@@ -317,3 +317,18 @@ def has_evaluated_geometry():
     geometry, read on every update."""
     return hasattr(bpy.types.Object, "evaluated_geometry") and bpy.app.version >= (5, 0, 0)
 
+
+
+def set_active_color(me, name):
+    """Makes colour attribute `name` the one Solid shading's Attribute colour shows (3.2+:
+    color_attributes.active_color; 4.0+ also active_color_name)."""
+    ca = getattr(me, "color_attributes", None)
+    a = ca.get(name) if ca is not None else None
+    if a is None:
+        return
+    if hasattr(ca, "active_color_name"):
+        ca.active_color_name = name
+    else:
+        ca.active_color = a
+    if hasattr(ca, "render_color_index"):
+        ca.render_color_index = ca.active_color_index

@@ -30,7 +30,7 @@ REMOVED_NOTE = ("A second CCNURBS modifier (\"%s\") was removed: one per object.
                 "the limit again, apply this one first.")
 
 SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "uv_smooth",
-            "normals", "use_creases", "store_render_mesh")
+            "normals", "use_creases", "store_render_mesh", "curvature")
 PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
 
 

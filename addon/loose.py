@@ -127,14 +127,16 @@ class WithLoose:
     def __getattr__(self, name):  # everything else is the plan's
         return getattr(self._plan, name)
 
-    def evaluate(self, positions=None, topology=True):
-        res = self._plan.evaluate(positions, topology=topology)
+    def evaluate(self, positions=None, topology=True, curvature=False):
+        res = self._plan.evaluate(positions, topology=topology, curvature=curvature)
         P = self._cage_positions if positions is None else positions
         lz = self._loose
         out = dict(res)
         n = len(res["positions"])
         out["positions"] = np.concatenate([res["positions"], lz.positions(P)])
         out["normals"] = np.concatenate([res["normals"], np.zeros((lz.rows, 3))])
+        if "curvatures" in res:  # loose vertices and edge points: no surface
+            out["curvatures"] = np.concatenate([res["curvatures"], np.full((lz.rows, 2), np.nan)])
         if self._face_end_out is None and len(lz.on_face_ends):
             # the surface's vertex at a loose edge's end is a corner: the cage vertex itself
             # (to rounding), the limit vertex nearest to it

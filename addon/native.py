@@ -356,12 +356,13 @@ class Plan:
         self.sizes = {name: int(getattr(s, name)) for name, _ in ccn_sizes._fields_}
         self.sizes.update({name: int(getattr(t, name)) for name, _ in ccn_plan_stats._fields_})
 
-    def evaluate(self, positions=None, topology=True):
+    def evaluate(self, positions=None, topology=True, curvature=False):
         """Returns dict positions (N,3) f64, normals (N,3) f64, on creased surfaces
         corner_normals (F*4,3) f64 (each face corner's own side), and, if topology, face_verts
         (F,4) int32, face_origin (F,) int32, corner_edge_origin (F,4) int32 (the cage face
         corner whose edge each output corner's edge lies on, -1 inside a cage face), edge_verts
-        (E,2) int32 and corner_edges (F,4) int32 (the output edges). Without
+        (E,2) int32 and corner_edges (F,4) int32 (the output edges); with curvature,
+        curvatures (N,2) f64: k1 >= k2, NaN where unbounded or not computed. Without
         topology the arrays are the plan's own, overwritten by the next such call."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
@@ -398,6 +399,9 @@ class Plan:
                             corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32),
                             edge_verts=_ptr(out.get("edge_verts"), ctypes.c_int32),
                             corner_edges=_ptr(out.get("corner_edges"), ctypes.c_int32))
+        if curvature:
+            out["curvatures"] = np.empty((n, 2), np.float64)
+            lm.curvatures = _ptr(out["curvatures"], ctypes.c_double)
         pos = None
         if positions is not None:
             pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)

@@ -60,4 +60,22 @@ class OBJECT_OT_ccnurbs_remove(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (OBJECT_OT_ccnurbs_add, OBJECT_OT_ccnurbs_remove)
+class VIEW3D_OT_ccnurbs_highlight_lines(bpy.types.Operator):
+    """Show highlight lines (a stripe matcap in Solid shading) in the 3D views and Workbench
+    renders, or turn them off"""
+    bl_idname = "view3d.ccnurbs_highlight_lines"
+    bl_label = "Highlight Lines"
+    bl_options = {'REGISTER'}
+
+    show: bpy.props.BoolProperty(name="Show", default=True)
+
+    def execute(self, context):
+        from . import analysis
+        name = analysis.show_highlight_lines(context, self.show)
+        if self.show and not name:
+            self.report({'WARNING'}, "CCNURBS: the highlight-line matcap could not be loaded")
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+
+classes = (OBJECT_OT_ccnurbs_add, OBJECT_OT_ccnurbs_remove, VIEW3D_OT_ccnurbs_highlight_lines)

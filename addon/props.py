@@ -37,6 +37,12 @@ UV_SMOOTH_ITEMS = (
     ('PRESERVE_BOUNDARIES', "Keep Boundaries", "UVs are smoothed, boundaries are kept sharp"),
     ('SMOOTH_ALL', "All", "UVs and boundaries are smoothed"),
 )
+CURVATURE_ITEMS = (
+    ('NONE', "Off", "No curvature analysis (costs nothing)"),
+    ('GAUSSIAN', "Gaussian", "Colour by the Gaussian curvature k1 k2"),
+    ('MEAN', "Mean", "Colour by the mean curvature (k1 + k2) / 2"),
+    ('MAX', "Max |k|", "Colour by the largest principal curvature magnitude"),
+)
 NORMALS_ITEMS = (
     ('EXACT', "Exact", "Exact surface normals from the derivatives, as custom split normals "
      "(in Blender 3.x custom normals make each update several times slower)"),
@@ -78,6 +84,12 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
                             description="Controls how smoothing is applied to UVs (as in "
                             "Subdivision Surface)", update=_tag)
     normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default='EXACT', update=_tag)
+    curvature: EnumProperty(
+        name="Curvature", items=CURVATURE_ITEMS, default='NONE', update=_tag,
+        description="Analysis: the exact principal curvatures of the limit surface as point "
+        "attributes curvature_gaussian and curvature_mean, and the chosen one as the colour "
+        "attribute curvature_color (Solid shading > Attribute); magenta where the curvature is "
+        "unbounded or not computed")
     use_creases: BoolProperty(
         name="Use Creases", default=True, update=_tag,
         description="Use the mesh's edge and vertex creases (Shift+E) as sharpness, mapped as the "

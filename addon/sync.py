@@ -23,7 +23,7 @@ import traceback
 import bpy
 import numpy as np
 
-from . import attrs, loose, memory, modifier, native, proxies, state
+from . import analysis, attrs, loose, memory, modifier, native, proxies, state
 from . import cage as cagemod
 
 # Creases: edge and vertex sharpness 10 c^2 (Blender's Subdivision Surface mapping) go to
@@ -165,7 +165,8 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             ost.status[kind] = st
             return st
         ekey = attrs.data_key(cage.extras, s.uv_smooth)
-        key = topo + ":" + cage.position_key() + ":" + ekey
+        curv = s.curvature  # analysis: in the viewport and in renders (Workbench pictures)
+        key = topo + ":" + cage.position_key() + ":" + ekey + ":" + curv
         proxies.sync_materials(obj.data, p)
         me = p.data
         stored = me.get(proxies.KEY_PROP)
@@ -197,15 +198,18 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         if same_topology and me.get(proxies.KEY_PROP) == key:
             pass  # forced: the proxy is already right
         elif same_topology:
-            proxies.write_positions(me, plan.evaluate(cage.positions, topology=False), exact)
+            res = plan.evaluate(cage.positions, topology=False, curvature=curv != 'NONE')
+            proxies.write_positions(me, res, exact)
+            analysis.write(me, res.get("curvatures"), curv)
             stats["changed_only"] += plan.changed_only
             # a new plan (an interval edit) changes the limit UVs and attributes too
             _write_extras(me, plan, cage, uv_chans, ekey, me.get(proxies.PLAN_PROP) != topo)
             stats["position_updates"] += 1
         else:
-            res = plan.evaluate(cage.positions, topology=True)
+            res = plan.evaluate(cage.positions, topology=True, curvature=curv != 'NONE')
             plan.face_origin, plan.corner_edge_origin = res["face_origin"], res["corner_edge_origin"]
             proxies.write_topology(me, res, cage, exact)
+            analysis.write(me, res.get("curvatures"), curv)
             _write_extras(me, plan, cage, uv_chans, ekey, True)
             # the carried vertex groups' names live on the mesh, which the rebuild cleared
             modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))

@@ -3,7 +3,7 @@ import bmesh
 import bpy
 
 from . import cage as cagemod
-from . import errors, modifier, native, proxies, state, sync, values
+from . import analysis, errors, modifier, native, proxies, state, sync, values
 
 
 def active_edge_interval(obj):
@@ -193,6 +193,15 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         layout.prop(s, "normals")
         layout.prop(s, "store_render_mesh")
         layout.label(text=render_mesh_line(obj), icon='FILE_BLEND')
+        box = layout.box()
+        box.label(text="Analysis", icon='VIEWZOOM')
+        box.prop(s, "curvature")
+        line = curvature_legend(obj)
+        if line:
+            box.label(text=line, icon='COLOR')
+        row = box.row(align=True)
+        row.operator("view3d.ccnurbs_highlight_lines", text="Highlight Lines", icon='SHADING_SOLID').show = True
+        row.operator("view3d.ccnurbs_highlight_lines", text="Off").show = False
         _draw_status(layout, obj)
         rst = sync.status(obj, 'RENDER')
         if rst is not None and rst.error:
@@ -202,6 +211,20 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         op = layout.operator("export_scene.ccnurbs_cad", text="Export CAD", icon='EXPORT')
         op.active_only = True
         layout.operator("object.ccnurbs_remove", icon='X')
+
+
+def curvature_legend(obj):
+    """The colour scale of the curvature analysis, or None."""
+    s = obj.ccnurbs
+    p = modifier.proxy(obj, 'VIEW')
+    if s.curvature == 'NONE' or p is None or p.data is None:
+        return None
+    r = p.data.get(analysis.RANGE_PROP)
+    if r is None:
+        return None
+    name = {"GAUSSIAN": "Gaussian", "MEAN": "mean", "MAX": "max |k|"}[s.curvature]
+    return "%s: blue -%.3g, white 0, red +%.3g; magenta: undefined (Solid > Attribute)" % (
+        name, r, r)
 
 
 def edge_menu(self, context):

@@ -151,6 +151,15 @@ def bench(name, level):
             evaluated(ob)
             evaluated(ob)
             flush = time.perf_counter() - t0
+    ob.ccnurbs.normals = 'EXACT'  # Analysis > Curvature (mean) on: a vertex move
+    ob.ccnurbs.curvature = 'MEAN'
+    evaluated(ob)
+    evaluated(ob)
+    curv_pos = time_positions(ob)
+    ob.ccnurbs.curvature = 'NONE'
+    evaluated(ob)
+    print("bench %s L%d (Blender %s) ccnurbs analysis: pos with curvature %.4f s (%.2fx without)"
+          % (name, level, bpy.app.version_string, curv_pos, curv_pos / r['EXACT'][0]))
     print("bench %s L%d (Blender %s): %d vs %d verts | subsurf pos %.4f s edit %.4f s topo %.4f s"
           % (name, level, bpy.app.version_string, n_ccn, n_sub, sub_pos, sub_edit, sub_topo))
     if flush is not None:

@@ -140,6 +140,24 @@ def read_limit_obj(path):
     return np.array(V, np.float64).reshape(-1, 3), np.array(N, np.float64).reshape(-1, 3)
 
 
+def cli_curvature(cli, me, levels, scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL"):
+    """Runs `ccnurbs limit --curvature` (PLY) on the mesh; returns (positions, (N, 2) k1 k2)."""
+    with tempfile.TemporaryDirectory() as d:
+        src, dst = os.path.join(d, "cage.obj"), os.path.join(d, "limit.ply")
+        write_cage_obj(me, src)
+        cmd = [cli, "limit", "--levels", str(levels), "--scheme", CLI_SCHEME[scheme],
+               "--cap", CLI_CAP[cap], "--corners", CLI_CORNERS[boundary], "--curvature", src, dst]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("%s failed (%d): %s" % (" ".join(cmd), r.returncode, r.stderr))
+        with open(dst) as fh:
+            lines = fh.read().split("\n")
+        nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
+        start = lines.index("end_header") + 1
+        A = np.array([[float(x) for x in l.split()] for l in lines[start:start + nv]])
+        return A[:, :3], A[:, 6:8]
+
+
 def cli_limit(cli, me, levels, scheme="EIGEN", cap="GUIDED_BI5", boundary="ALL", creases=False):
     """Runs `ccnurbs limit` on the mesh; returns (positions, normals)."""
     with tempfile.TemporaryDirectory() as d:

@@ -323,6 +323,73 @@ class TestModifier(AddonTestCase):
         self.assertIsNone(ccn.handlers._show_render_errors())
         self.assertFalse(ccn.handlers._render_errors)
 
+    def test_curvature_analysis_equals_the_cli(self):
+        """Analysis > Curvature writes the exact principal curvatures as point attributes
+        (curvature_gaussian, curvature_mean, equal to `ccnurbs limit --curvature` of the same
+        cage), flags where they are undefined, colours the chosen one (the active colour
+        attribute), and Off removes them."""
+        ob = add_modifier(load_cage("Curv", os.path.join(DATA, "fig16_v6.obj")), levels=2)
+        names = ccn.analysis.NAMES
+        self.assertFalse(any(n in ob.evaluated_get(update()).data.attributes for n in names),
+                         "analysis attributes while it is off")
+        for mode in ('MEAN', 'GAUSSIAN', 'MAX'):
+            ob.ccnurbs.curvature = mode
+            me = ob.evaluated_get(update()).data
+            for n in names:
+                self.assertIn(n, me.attributes, "%s: no attribute %s" % (mode, n))
+            got = {}
+            for n in names[:2]:
+                a = np.empty(len(me.vertices), np.float32)
+                me.attributes[n].data.foreach_get("value", a)
+                got[n] = a.astype(np.float64)
+            flag = np.empty(len(me.vertices), bool)
+            me.attributes[names[2]].data.foreach_get("value", flag)
+            R, K = cagelib.cli_curvature(CLI, ob.data, 2)
+            self.assertEqual(len(R), len(me.vertices))
+            bad = ~np.isfinite(K).all(1)
+            np.testing.assert_array_equal(flag, bad, "undefined where the CLI writes nan")
+            self.assertGreater((~bad).sum(), len(bad) // 2, "hardly any curvature computed")
+            k1, k2 = K[~bad, 0], K[~bad, 1]
+            for n, want in ((names[0], k1 * k2), (names[1], 0.5 * (k1 + k2))):
+                err = np.abs(got[n][~bad] - want).max() / np.abs(want).max()
+                self.assertLessEqual(err, 1e-5, "%s %s differs from the CLI by %.3g" % (mode, n, err))
+            self.assertTrue((got[names[0]][bad] == 0).all() and (got[names[1]][bad] == 0).all())
+            self.assertTrue(ccn.ui.curvature_legend(ob), "no legend in the panel")
+        ob.ccnurbs.curvature = 'NONE'
+        me = ob.evaluated_get(update()).data
+        self.assertFalse(any(n in me.attributes for n in names), "Off left the attributes")
+        self.assertMatchesCLI(ob)
+
+    def test_highlight_lines(self):
+        """Analysis > Highlight Lines: Solid shading with the add-on's stripe matcap in the
+        scene's Workbench settings (and every 3D view), rendered as stripes; Off restores Studio
+        lighting. The matcap is a studio light, not data in the file."""
+        ob = add_modifier(load_cage("Stripes", os.path.join(DATA, "fig16_v6.obj")), levels=3)
+        res = bpy.ops.view3d.ccnurbs_highlight_lines(show=True)
+        self.assertEqual(res, {'FINISHED'})
+        sh = bpy.context.scene.display.shading
+        self.assertEqual((sh.light, sh.studio_light), ('MATCAP', ccn.analysis.MATCAP_NAME))
+        scene = bpy.context.scene
+        cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+        scene.collection.objects.link(cam)
+        cam.location, cam.rotation_euler = (0.0, 0.0, 12.0), (0.0, 0.0, 0.0)
+        scene.camera = cam
+        scene.render.engine = 'BLENDER_WORKBENCH'
+        scene.render.resolution_x = scene.render.resolution_y = 96
+        scene.render.filepath = os.path.join(TMP, "stripes.png")
+        bpy.ops.render.render(write_still=True)
+        im = bpy.data.images.load(scene.render.filepath)
+        v = np.array(im.pixels[:]).reshape(96, 96, 4)[24:72, 24:72, 0]
+        bpy.data.images.remove(im)
+        # stripes: light and dark bands alternate along a row through the surface
+        row = v[24]
+        flips = int(np.sum(np.abs(np.diff((row > row.mean()).astype(int)))))
+        self.assertGreaterEqual(flips, 4, "no stripes in the render (%d light/dark changes)" % flips)
+        self.assertNotIn(ccn.analysis.MATCAP_NAME, [i.name for i in bpy.data.images])
+        bpy.ops.view3d.ccnurbs_highlight_lines(show=False)
+        self.assertEqual(sh.light, 'STUDIO')
+        self.assertMatchesCLI(ob)
+
     def _reload_without_addon(self, path):
         """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender
         without the add-on."""

@@ -1,0 +1,160 @@
+"""Surface analysis on the limit mesh: the exact principal curvatures the library computes
+(ccn_limit_mesh.curvatures) as point attributes, and a colour attribute showing one of them.
+
+With the cage's Curvature setting (Analysis) on, every sync of a proxy writes:
+* `curvature_gaussian` = k1 k2 and `curvature_mean` = (k1 + k2) / 2 (FLOAT, POINT), with the
+  sign of the library: positive where the surface bends away from its normal;
+* `curvature_undefined` (BOOLEAN, POINT): the library's NaN flag (an extraordinary point without
+  a cap, where the curvature is unbounded; creases, corners); the two values are 0 there;
+* `curvature_color` (FLOAT_COLOR, POINT, the active colour attribute: Solid shading > Attribute
+  shows it): the chosen quantity (Gaussian, mean or max |k|) blue (negative) - white (0) - red
+  (positive) over a symmetric range, the 98th percentile of its magnitude (a few vertices near
+  an EV without a cap would otherwise take the whole scale); flagged vertices magenta.
+Turned off, the attributes are removed. The range is kept on the proxy mesh (RANGE_PROP) for the
+panel's legend.
+"""
+import numpy as np
+
+from . import compat
+
+NAMES = ("curvature_gaussian", "curvature_mean", "curvature_undefined", "curvature_color")
+RANGE_PROP = "ccnurbs_curvature_range"
+NEG = np.array((0.10, 0.35, 1.00, 1.0), np.float32)
+ZERO = np.array((1.00, 1.00, 1.00, 1.0), np.float32)
+POS = np.array((1.00, 0.15, 0.10, 1.0), np.float32)
+FLAG = np.array((1.00, 0.00, 1.00, 1.0), np.float32)
+
+
+def quantity(curv, mode):
+    """(values, undefined) of mode 'GAUSSIAN', 'MEAN' or 'MAX' (max |k|) from (N, 2) k1, k2."""
+    k1, k2 = curv[:, 0], curv[:, 1]
+    bad = ~(np.isfinite(k1) & np.isfinite(k2))
+    with np.errstate(invalid='ignore'):
+        q = {"GAUSSIAN": k1 * k2, "MEAN": 0.5 * (k1 + k2),
+             "MAX": np.maximum(np.abs(k1), np.abs(k2))}[mode]
+    return np.where(bad, 0.0, q), bad
+
+
+_T = np.linspace(-1.0, 1.0, 1025, dtype=np.float32)[:, None]
+LUT = np.where(_T < 0, ZERO + (NEG - ZERO) * -_T, ZERO + (POS - ZERO) * _T).astype(np.float32)
+
+
+def colors(q, bad):
+    """RGBA per vertex (a 1025-entry table: a gather, not arithmetic on N x 4 arrays) and the
+    symmetric range used."""
+    mag = np.abs(q[~bad])
+    if len(mag):
+        k = min(len(mag) - 1, int(0.98 * (len(mag) - 1) + 0.5))
+        r = float(np.partition(mag, k)[k])
+    else:
+        r = 0.0
+    if r > 0:
+        idx = np.rint((np.clip(q / r, -1.0, 1.0) + 1.0) * 512.0).astype(np.intp)
+    else:
+        idx = np.full(len(q), 512, np.intp)
+    c = LUT[idx]
+    c[bad] = FLAG
+    return c, r
+
+
+def _attr(me, name, kind, domain='POINT'):
+    a = me.attributes.get(name)
+    if a is not None and (a.data_type != kind or a.domain != domain):
+        me.attributes.remove(a)
+        a = None
+    return a if a is not None else me.attributes.new(name, kind, domain)
+
+
+def clear(me):
+    for name in NAMES:
+        a = me.attributes.get(name)
+        if a is not None:
+            me.attributes.remove(a)
+    if RANGE_PROP in me:
+        del me[RANGE_PROP]
+
+
+def write(me, curv, mode):
+    """The attributes of `mode` ('NONE' removes them) from the evaluation's (N, 2) curvatures."""
+    if mode == 'NONE' or curv is None:
+        clear(me)
+        return
+    k1, k2 = curv[:, 0], curv[:, 1]
+    bad = ~(np.isfinite(k1) & np.isfinite(k2))
+    with np.errstate(invalid='ignore'):
+        gauss = np.where(bad, 0.0, k1 * k2)
+        mean = np.where(bad, 0.0, 0.5 * (k1 + k2))
+    _attr(me, NAMES[0], 'FLOAT').data.foreach_set("value", gauss.astype(np.float32))
+    _attr(me, NAMES[1], 'FLOAT').data.foreach_set("value", mean.astype(np.float32))
+    _attr(me, NAMES[2], 'BOOLEAN').data.foreach_set("value", bad)
+    q, _ = quantity(curv, mode)
+    c, r = colors(q, bad)
+    _attr(me, NAMES[3], 'FLOAT_COLOR').data.foreach_set("color", c.ravel())
+    compat.set_active_color(me, NAMES[3])
+    me[RANGE_PROP] = r
+
+
+# ---- highlight lines ----------------------------------------------------------------------
+
+MATCAP_NAME = "ccnurbs_highlight_lines.png"
+
+
+def stripe_matcap(path, size=512, period_deg=6.0):
+    """A highlight-line matcap: light and dark stripes by the angle between the normal and the
+    view direction (period_deg degrees per stripe pair). Every point where the surface faces the
+    viewer sits in the middle of its own closed stripe, and kinks or wobbles in the stripes show
+    curvature defects the shading hides."""
+    import bpy
+    y, x = np.mgrid[0:size, 0:size]
+    nx, ny = (x + 0.5) / size * 2 - 1, (y + 0.5) / size * 2 - 1
+    r = np.sqrt(nx * nx + ny * ny)
+    theta = np.degrees(np.arcsin(np.clip(r, 0, 1)))
+    c = np.cos(2 * np.pi * theta / period_deg)
+    px = np.gradient(theta, axis=1)  # about one pixel in degrees: antialiased edges
+    band = np.clip(0.5 + c / (2 * np.pi / period_deg * np.maximum(np.abs(px), 1e-3) * 2), 0, 1)
+    v = np.where(r <= 1, 0.12 + 0.83 * band, 0.0)
+    rgba = np.dstack([v, v, v, np.ones_like(v)]).astype(np.float32)
+    img = bpy.data.images.new(".ccnurbs stripes", size, size, alpha=True, float_buffer=True)
+    try:
+        img.pixels.foreach_set(rgba.ravel())
+        img.filepath_raw = path
+        img.file_format = 'PNG'
+        img.save()
+    finally:
+        bpy.data.images.remove(img)
+    return path
+
+
+def highlight_matcap():
+    """The studio light name of the add-on's stripe matcap, made and loaded on first use (in
+    Blender's user data folder; nothing is stored in the .blend)."""
+    import os
+    import bpy
+    lights = bpy.context.preferences.studio_lights
+    for sl in lights:
+        if sl.name == MATCAP_NAME:
+            return sl.name
+    folder = bpy.utils.user_resource('DATAFILES', path="ccnurbs", create=True)
+    path = os.path.join(folder, MATCAP_NAME)
+    if not os.path.exists(path):
+        stripe_matcap(path)
+    sl = lights.load(path, 'MATCAP')
+    return sl.name if sl is not None else None
+
+
+def show_highlight_lines(context, on=True):
+    """Solid shading with the stripe matcap (on) or back to Studio lighting, in every 3D view
+    of the window and in the scene's Workbench render settings. Returns the matcap's name."""
+    name = highlight_matcap() if on else None
+    shadings = [context.scene.display.shading] if context.scene is not None else []
+    screen = getattr(context, "screen", None)
+    for area in (screen.areas if screen is not None else []):
+        if area.type == 'VIEW_3D':
+            shadings += [sp.shading for sp in area.spaces if sp.type == 'VIEW_3D']
+    for sh in shadings:
+        if on and name:
+            sh.light = 'MATCAP'
+            sh.studio_light = name
+        elif not on and sh.light == 'MATCAP' and sh.studio_light == MATCAP_NAME:
+            sh.light = 'STUDIO'
+    return name
