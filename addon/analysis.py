@@ -96,22 +96,34 @@ def write(me, curv, mode):
 
 # ---- highlight lines ----------------------------------------------------------------------
 
-MATCAP_NAME = "ccnurbs_highlight_lines.png"
+MATCAP_PREFIX = "ccnurbs_highlight_lines"
+DIRECTIONS = ('RINGS', 'HORIZONTAL', 'VERTICAL')
 
 
-def stripe_matcap(path, size=512, period_deg=6.0):
-    """A highlight-line matcap: light and dark stripes by the angle between the normal and the
-    view direction (period_deg degrees per stripe pair). Every point where the surface faces the
-    viewer sits in the middle of its own closed stripe, and kinks or wobbles in the stripes show
-    curvature defects the shading hides."""
+def matcap_name(direction='RINGS', stripes=15):
+    return "%s_%s_%d.png" % (MATCAP_PREFIX, direction.lower(), stripes)
+
+
+def stripe_matcap(path, direction='RINGS', stripes=15, size=512):
+    """A highlight-line matcap. RINGS: light and dark stripes by the angle between the normal
+    and the view direction (every point facing the viewer in the middle of its own closed
+    stripe); HORIZONTAL / VERTICAL: zebra stripes by the normal's up / sideways component (the
+    reflection of a striped wall). `stripes`: light-dark pairs across the hemisphere. Kinks or
+    wobbles in the stripes show curvature defects the shading hides."""
     import bpy
     y, x = np.mgrid[0:size, 0:size]
     nx, ny = (x + 0.5) / size * 2 - 1, (y + 0.5) / size * 2 - 1
     r = np.sqrt(nx * nx + ny * ny)
-    theta = np.degrees(np.arcsin(np.clip(r, 0, 1)))
-    c = np.cos(2 * np.pi * theta / period_deg)
-    px = np.gradient(theta, axis=1)  # about one pixel in degrees: antialiased edges
-    band = np.clip(0.5 + c / (2 * np.pi / period_deg * np.maximum(np.abs(px), 1e-3) * 2), 0, 1)
+    if direction == 'HORIZONTAL':
+        phase = np.degrees(np.arcsin(np.clip(ny, -1, 1))) + 90.0
+    elif direction == 'VERTICAL':
+        phase = np.degrees(np.arcsin(np.clip(nx, -1, 1))) + 90.0
+    else:
+        phase = np.degrees(np.arcsin(np.clip(r, 0, 1)))
+    period = (180.0 if direction != 'RINGS' else 90.0) / stripes
+    c = np.cos(2 * np.pi * phase / period)
+    px = np.abs(np.gradient(phase, axis=1)) + np.abs(np.gradient(phase, axis=0))
+    band = np.clip(0.5 + c / (2 * np.pi / period * np.maximum(px, 1e-3) * 2), 0, 1)  # antialiased
     v = np.where(r <= 1, 0.12 + 0.83 * band, 0.0)
     rgba = np.dstack([v, v, v, np.ones_like(v)]).astype(np.float32)
     img = bpy.data.images.new(".ccnurbs stripes", size, size, alpha=True, float_buffer=True)
@@ -125,27 +137,28 @@ def stripe_matcap(path, size=512, period_deg=6.0):
     return path
 
 
-def highlight_matcap():
-    """The studio light name of the add-on's stripe matcap, made and loaded on first use (in
-    Blender's user data folder; nothing is stored in the .blend)."""
+def highlight_matcap(direction='RINGS', stripes=15):
+    """The studio light name of the add-on's stripe matcap of that direction and density, made
+    and loaded on first use (in Blender's user data folder; nothing is stored in the .blend)."""
     import os
     import bpy
+    name = matcap_name(direction, stripes)
     lights = bpy.context.preferences.studio_lights
     for sl in lights:
-        if sl.name == MATCAP_NAME:
+        if sl.name == name:
             return sl.name
     folder = bpy.utils.user_resource('DATAFILES', path="ccnurbs", create=True)
-    path = os.path.join(folder, MATCAP_NAME)
+    path = os.path.join(folder, name)
     if not os.path.exists(path):
-        stripe_matcap(path)
+        stripe_matcap(path, direction, stripes)
     sl = lights.load(path, 'MATCAP')
     return sl.name if sl is not None else None
 
 
-def show_highlight_lines(context, on=True):
+def show_highlight_lines(context, on=True, direction='RINGS', stripes=15):
     """Solid shading with the stripe matcap (on) or back to Studio lighting, in every 3D view
     of the window and in the scene's Workbench render settings. Returns the matcap's name."""
-    name = highlight_matcap() if on else None
+    name = highlight_matcap(direction, stripes) if on else None
     shadings = [context.scene.display.shading] if context.scene is not None else []
     screen = getattr(context, "screen", None)
     for area in (screen.areas if screen is not None else []):
@@ -155,6 +168,6 @@ def show_highlight_lines(context, on=True):
         if on and name:
             sh.light = 'MATCAP'
             sh.studio_light = name
-        elif not on and sh.light == 'MATCAP' and sh.studio_light == MATCAP_NAME:
+        elif not on and sh.light == 'MATCAP' and sh.studio_light.startswith(MATCAP_PREFIX):
             sh.light = 'STUDIO'
     return name

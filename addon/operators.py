@@ -68,10 +68,18 @@ class VIEW3D_OT_ccnurbs_highlight_lines(bpy.types.Operator):
     bl_options = {'REGISTER'}
 
     show: bpy.props.BoolProperty(name="Show", default=True)
+    direction: bpy.props.EnumProperty(
+        name="Direction", default='RINGS',
+        items=(('RINGS', "Rings", "Stripes by the angle to the view direction: closed rings "
+                "around every point facing the viewer"),
+               ('HORIZONTAL', "Horizontal", "Zebra stripes of a horizontally striped wall"),
+               ('VERTICAL', "Vertical", "Zebra stripes of a vertically striped wall")))
+    stripes: bpy.props.IntProperty(name="Density", default=15, min=3, max=60,
+                                   description="Light-dark stripe pairs across the view")
 
     def execute(self, context):
         from . import analysis
-        name = analysis.show_highlight_lines(context, self.show)
+        name = analysis.show_highlight_lines(context, self.show, self.direction, self.stripes)
         if self.show and not name:
             self.report({'WARNING'}, "CCNURBS: the highlight-line matcap could not be loaded")
             return {'CANCELLED'}

@@ -368,7 +368,7 @@ class TestModifier(AddonTestCase):
         res = bpy.ops.view3d.ccnurbs_highlight_lines(show=True)
         self.assertEqual(res, {'FINISHED'})
         sh = bpy.context.scene.display.shading
-        self.assertEqual((sh.light, sh.studio_light), ('MATCAP', ccn.analysis.MATCAP_NAME))
+        self.assertEqual((sh.light, sh.studio_light), ('MATCAP', ccn.analysis.matcap_name()))
         scene = bpy.context.scene
         cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
         scene.collection.objects.link(cam)
@@ -385,7 +385,14 @@ class TestModifier(AddonTestCase):
         row = v[24]
         flips = int(np.sum(np.abs(np.diff((row > row.mean()).astype(int)))))
         self.assertGreaterEqual(flips, 4, "no stripes in the render (%d light/dark changes)" % flips)
-        self.assertNotIn(ccn.analysis.MATCAP_NAME, [i.name for i in bpy.data.images])
+        self.assertFalse([i.name for i in bpy.data.images if "stripes" in i.name],
+                         "the matcap left an image in the file")
+        # zebra stripes of the other directions and densities: other matcaps
+        for direction, n in (('HORIZONTAL', 8), ('VERTICAL', 30)):
+            bpy.ops.view3d.ccnurbs_highlight_lines(show=True, direction=direction, stripes=n)
+            self.assertEqual(sh.studio_light, ccn.analysis.matcap_name(direction, n))
+            names = [sl.name for sl in bpy.context.preferences.studio_lights]
+            self.assertIn(ccn.analysis.matcap_name(direction, n), names)
         bpy.ops.view3d.ccnurbs_highlight_lines(show=False)
         self.assertEqual(sh.light, 'STUDIO')
         self.assertMatchesCLI(ob)
