@@ -284,11 +284,13 @@ def has_custom_normals(mesh):
 _SHADERS_3X = {"POLYLINE_SMOOTH_COLOR": "3D_POLYLINE_SMOOTH_COLOR",
                "SMOOTH_COLOR": "3D_SMOOTH_COLOR",
                "UNIFORM_COLOR_2D": "2D_UNIFORM_COLOR",
-               "SMOOTH_COLOR_2D": "2D_SMOOTH_COLOR"}
+               "SMOOTH_COLOR_2D": "2D_SMOOTH_COLOR",
+               "FLAT_COLOR": "3D_FLAT_COLOR"}
 _SHADERS_4X = {"POLYLINE_SMOOTH_COLOR": "POLYLINE_SMOOTH_COLOR",
                "SMOOTH_COLOR": "SMOOTH_COLOR",
                "UNIFORM_COLOR_2D": "UNIFORM_COLOR",
-               "SMOOTH_COLOR_2D": "SMOOTH_COLOR"}
+               "SMOOTH_COLOR_2D": "SMOOTH_COLOR",
+               "FLAT_COLOR": "FLAT_COLOR"}
 
 
 def builtin_shader(name):

@@ -30,7 +30,8 @@ REMOVED_NOTE = ("A second CCNURBS modifier (\"%s\") was removed: one per object.
                 "the limit again, apply this one first.")
 
 SETTINGS = ("levels", "render_levels", "scheme", "cap", "boundary_smooth", "uv_smooth",
-            "normals", "use_creases", "store_render_mesh", "curvature")
+            "normals", "use_creases", "store_render_mesh", "curvature",
+            "cap_status")
 PROXY_ROLES = ('VIEW_PROXY', 'RENDER_PROXY')
 
 

@@ -153,6 +153,9 @@ class WithLoose:
             out["loose_edges"] = e.astype(np.int32)
         return out
 
+    def evs(self):
+        return self._plan.evs()  # loose elements come after the surface's vertices
+
     def evaluate_vertex_data(self, data):
         base = self._plan.evaluate_vertex_data(data)
         return np.concatenate([base, self._loose.data(data)])

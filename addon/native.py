@@ -179,6 +179,8 @@ def _bind(lib):
     lib.ccn_plan_get_sizes.restype = ctypes.c_int
     lib.ccn_plan_get_stats.argtypes = [P, ctypes.POINTER(ccn_plan_stats)]
     lib.ccn_plan_get_stats.restype = ctypes.c_int
+    lib.ccn_plan_get_evs.argtypes = [P, c_int32_p, c_int32_p, c_int32_p]
+    lib.ccn_plan_get_evs.restype = ctypes.c_int
     lib.ccn_plan_evaluate.argtypes = [P, c_double_p, ctypes.POINTER(ccn_limit_mesh),
                                       ctypes.POINTER(ccn_error)]
     lib.ccn_plan_evaluate.restype = ctypes.c_int
@@ -418,6 +420,24 @@ class Plan:
         if not topology:  # the plan's own arrays (a caller keeps topology=True results)
             self._last = {k: out[k] for k in ("positions", "normals", "corner_normals") if k in out}
         return out
+
+    EV_SURFACES = ("capped", "blended", "refined")  # ccn_ev_surface
+
+    def evs(self):
+        """The output's extraordinary points: (output vertex indices (K,) int32, how each is
+        made (K,) int32: 0 capped, 1 cap blended with the refined limit, 2 refined limit)."""
+        if self._handle is None:
+            raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
+        n = ctypes.c_int32(0)
+        st = self._lib.ccn_plan_get_evs(self._handle, ctypes.byref(n), None, None)
+        idx = np.empty(n.value, np.int32)
+        kind = np.empty(n.value, np.int32)
+        if st == 0 and n.value:
+            st = self._lib.ccn_plan_get_evs(self._handle, ctypes.byref(n), _ptr(idx, ctypes.c_int32),
+                                            _ptr(kind, ctypes.c_int32))
+        if st != 0:
+            _raise(st, ccn_error())
+        return idx, kind
 
     def add_fvar(self, values, indices, linear="PRESERVE_CORNERS"):
         """A face-varying channel: values (N, W), one value index per cage face corner (in

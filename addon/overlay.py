@@ -193,12 +193,41 @@ def draw_legend():
         blf.draw(font, text)
 
 
+@_guard
+def draw_ev_marks():
+    """Analysis > Cap Status: a dot at each extraordinary point (sync.ev_marks), drawn over the
+    surface."""
+    context = bpy.context
+    objs = [(o, st.ev_marks) for o in getattr(context, "visible_objects", ())
+            for st in (state.peek(o),) if st is not None and st.ev_marks is not None
+            and o.ccnurbs.cap_status and len(st.ev_marks["coords"])]
+    if not objs:
+        return
+    import gpu
+    from gpu_extras.batch import batch_for_shader
+    shader = compat.builtin_shader("FLAT_COLOR")
+    gpu.state.point_size_set(9.0)
+    gpu.state.depth_test_set('NONE')
+    try:
+        for obj, m in objs:
+            if m["batch"] is None:
+                m["batch"] = batch_for_shader(shader, 'POINTS', {"pos": m["coords"], "color": m["colors"]})
+            with gpu.matrix.push_pop():
+                gpu.matrix.multiply_matrix(obj.matrix_world)
+                shader.bind()
+                m["batch"].draw(shader)
+    finally:
+        gpu.state.point_size_set(1.0)
+
+
 def register():
     unregister()
     _handles.append(bpy.types.SpaceView3D.draw_handler_add(draw_edges, (), 'WINDOW',
                                                            'POST_VIEW'))
     _handles.append(bpy.types.SpaceView3D.draw_handler_add(draw_legend, (), 'WINDOW',
                                                            'POST_PIXEL'))
+    _handles.append(bpy.types.SpaceView3D.draw_handler_add(draw_ev_marks, (), 'WINDOW',
+                                                           'POST_VIEW'))
 
 
 def unregister():

@@ -90,6 +90,11 @@ class CCNURBS_ObjectSettings(bpy.types.PropertyGroup):
         "attributes curvature_gaussian and curvature_mean, and the chosen one as the colour "
         "attribute curvature_color (Solid shading > Attribute); magenta where the curvature is "
         "unbounded or not computed")
+    cap_status: BoolProperty(
+        name="Cap Status", default=False, update=_tag,
+        description="Analysis: mark each extraordinary point of the limit surface in the 3D "
+        "view: green, capped (G1, bounded curvature); yellow, a cap blended with the refined "
+        "limit; red, the refined limit (no cap: its curvature is unbounded there)")
     use_creases: BoolProperty(
         name="Use Creases", default=True, update=_tag,
         description="Use the mesh's edge and vertex creases (Shift+E) as sharpness, mapped as the "

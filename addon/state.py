@@ -15,6 +15,8 @@ What a state holds (each module reads and writes its own fields):
   extras, for Edit Mode reads) and `edit_note`;
 * hygiene.py: `removed_note` (a second CCNURBS modifier went);
 * overlay.py: `overlay` (the interval overlay's arrays and batch) and `overlay_pending`;
+  `ev_marks` (Analysis > Cap Status: the extraordinary points' positions and colours, written
+  by sync.py);
 * handlers.py: `render_dirty` (its stored render mesh is due) and `echo` (its next update is
   the save's own).
 
@@ -33,12 +35,13 @@ HAS_SESSION_UID = hasattr(bpy.types.ID, "session_uid")
 class ObjectState:
     __slots__ = ("plans", "status", "key_memo", "pending_normals", "uv", "object_mode",
                  "edit_note", "removed_note", "overlay", "overlay_pending", "render_dirty",
-                 "echo")
+                 "echo", "ev_marks")
 
     def __init__(self):
         self.plans, self.status, self.key_memo = {}, {}, {}
         self.pending_normals = self.overlay_pending = self.render_dirty = self.echo = False
         self.uv = self.object_mode = self.edit_note = self.removed_note = self.overlay = None
+        self.ev_marks = None
 
     def close_plans(self, kinds=None):
         for kind in list(self.plans) if kinds is None else kinds:

@@ -136,6 +136,10 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
     s = obj.ccnurbs
     levels = s.levels if kind == 'VIEW' else s.render_levels
     ost = state.of(obj)
+    if kind == 'VIEW' and s.cap_status and ost.ev_marks is None:
+        force = True  # e.g. a file just loaded: its proxy is right, the marks are not made yet
+    elif kind == 'VIEW' and not s.cap_status:
+        ost.ev_marks = None
     st = Status(kind, levels)
     t0 = time.perf_counter()
     p = None
@@ -214,6 +218,8 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             # the carried vertex groups' names live on the mesh, which the rebuild cleared
             modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))
             stats["rebuilds"] += 1
+        if kind == 'VIEW':
+            ost.ev_marks = ev_marks(plan, me) if s.cap_status else None
         me[proxies.KEY_PROP] = key + PENDING if deferred else key
         if deferred:
             ost.pending_normals = True
@@ -245,6 +251,20 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
             st.showing = "cage"
     ost.status[kind] = st
     return st
+
+
+EV_COLORS = np.array([(0.1, 0.85, 0.2, 1.0), (1.0, 0.85, 0.1, 1.0), (1.0, 0.1, 0.1, 1.0)],
+                     np.float32)  # capped, cap blended, refined (native.Plan.EV_SURFACES)
+
+
+def ev_marks(plan, me):
+    """Analysis > Cap Status: positions (the proxy's, local) and colours of the extraordinary
+    points, and how many are capped, blended, refined."""
+    idx, kind = plan.evs()
+    co = np.empty(3 * len(me.vertices), np.float32)
+    me.vertices.foreach_get("co", co)
+    return {"coords": co.reshape(-1, 3)[idx], "colors": EV_COLORS[kind],
+            "counts": tuple(int((kind == k).sum()) for k in range(3)), "batch": None}
 
 
 def missing_tap(obj, kind):

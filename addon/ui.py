@@ -199,6 +199,10 @@ class DATA_PT_ccnurbs_modifier(bpy.types.Panel):
         line = curvature_legend(obj)
         if line:
             box.label(text=line, icon='COLOR')
+        box.prop(s, "cap_status")
+        line = cap_status_line(obj)
+        if line:
+            box.label(text=line, icon='PMARKER_ACT')
         row = box.row(align=True)
         row.operator("view3d.ccnurbs_highlight_lines", text="Highlight Lines", icon='SHADING_SOLID').show = True
         row.operator("view3d.ccnurbs_highlight_lines", text="Off").show = False
@@ -225,6 +229,16 @@ def curvature_legend(obj):
     name = {"GAUSSIAN": "Gaussian", "MEAN": "mean", "MAX": "max |k|"}[s.curvature]
     return "%s: blue -%.3g, white 0, red +%.3g; magenta: undefined (Solid > Attribute)" % (
         name, r, r)
+
+
+def cap_status_line(obj):
+    """How the extraordinary points are made, or None (Cap Status off or not yet computed)."""
+    st = state.peek(obj)
+    if not obj.ccnurbs.cap_status or st is None or st.ev_marks is None:
+        return None
+    c, b, r = st.ev_marks["counts"]
+    return "Extraordinary points: %d capped (green), %d blended (yellow), %d refined (red: " \
+           "unbounded curvature)" % (c, b, r)
 
 
 def edge_menu(self, context):

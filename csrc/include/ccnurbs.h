@@ -332,6 +332,17 @@ ccn_status ccn_cache_create(ccn_cache **out, ccn_error *err);
 void ccn_cache_destroy(ccn_cache *cache);
 ccn_status ccn_plan_get_sizes(const ccn_plan *plan, ccn_sizes *sizes);
 ccn_status ccn_plan_get_stats(const ccn_plan *plan, ccn_plan_stats *stats);
+
+/* The extraordinary points of the output surface (interior smooth vertices of valence != 4 of
+ * the output level) and how each is made: CCN_EV_CAPPED, the guided bi-5 cap (G1, bounded
+ * curvature); CCN_EV_CAP_BLENDED, a cap blended with the refined limit at the end of the cap's
+ * range of knot ratios; CCN_EV_REFINED, the refined limit (no cap: knot intervals beyond the cap's
+ * range, cap = REFINE, a cap that would fold, or an output level not above the cap level): its
+ * curvature is unbounded there. Call with NULL arrays for *num, then with arrays of *num
+ * entries: output vertex indices and ccn_ev_surface values (either may be NULL). */
+typedef enum { CCN_EV_CAPPED = 0, CCN_EV_CAP_BLENDED, CCN_EV_REFINED } ccn_ev_surface;
+ccn_status ccn_plan_get_evs(const ccn_plan *plan, int32_t *num, int32_t *out_vertex,
+                            int32_t *surface);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs
  * (face_verts, face_origin) are the same on every call. */
 ccn_status ccn_plan_evaluate(ccn_plan *plan, const double *positions, ccn_limit_mesh *out,

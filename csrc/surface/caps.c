@@ -406,3 +406,29 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
     eval_ring_faces(p, out, written);
     return CCN_OK;
 }
+
+/* ---- the output's extraordinary points and their caps (ccn_plan_get_evs) ----------------- */
+
+ccn_status ccn_plan_get_evs(const ccn_plan *p, int32_t *num, int32_t *out_vertex, int32_t *surface) {
+    if (!p || !num) return CCN_ERR_ARGUMENT;
+    const ccn_mesh *mL = p->lev[p->L];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    int32_t n = 0;
+    for (int32_t o = 0; o < p->nout_v; o++) {
+        if (ccn__limit_kind(mL, p->out_vL[o], pinned) != CCN_LIMIT_EV) continue;
+        int32_t s = CCN_EV_REFINED;
+        for (int32_t c = 0; c < p->ncap; c++) { /* a cap's EV: its level-K vertex, carried to L */
+            int32_t v = p->caps[c].cnet[0];
+            for (int32_t l = p->K; l < p->L; l++) v += p->lev[l]->nf + p->lev[l]->ne;
+            if (v == p->out_vL[o]) {
+                s = p->caps[c].w >= 1 ? CCN_EV_CAPPED : CCN_EV_CAP_BLENDED;
+                break;
+            }
+        }
+        if (out_vertex) out_vertex[n] = o;
+        if (surface) surface[n] = s;
+        n++;
+    }
+    *num = n;
+    return CCN_OK;
+}

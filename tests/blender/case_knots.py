@@ -110,7 +110,7 @@ class TestKnotOperators(AddonTestCase):
         red = set(np.flatnonzero(np.all(np.abs(entry["colors"][::2] - ccn.overlay.LONG) < 1e-6,
                                         axis=1)))
         self.assertEqual(red, parallel_ring(ob, 0))
-        self.assertEqual(ccn.overlay.handle_count(), 2)
+        self.assertEqual(ccn.overlay.handle_count(), 3)
         bpy.context.scene.ccnurbs_tools.show_overlay = False
         bpy.ops.object.mode_set(mode='OBJECT')
 

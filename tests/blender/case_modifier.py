@@ -397,6 +397,30 @@ class TestModifier(AddonTestCase):
         self.assertEqual(sh.light, 'STUDIO')
         self.assertMatchesCLI(ob)
 
+    def test_cap_status(self):
+        """Analysis > Cap Status marks each extraordinary point: a cube's 8 corners capped
+        (uniform intervals), refined with Cap = Refine; the valence-7 point of Fig. 17 (spoke
+        ratio 8) refined; the marks sit on the surface's vertices; off, none."""
+        ob = add_modifier(cube("CapCube"), levels=3)
+        ob.ccnurbs.cap_status = True
+        update()
+        self.assertIn("8 capped (green), 0 blended (yellow), 0 refined", ccn.ui.cap_status_line(ob))
+        marks = ccn.state.of(ob).ev_marks
+        P = evaluated_positions(ob)
+        d = np.abs(marks["coords"][:, None, :] - P[None]).max(2).min(1)
+        self.assertLessEqual(d.max(), 1e-5, "a mark is not on a vertex of the surface")
+        ob.ccnurbs.cap = 'REFINE'
+        update()
+        self.assertIn("0 capped (green), 0 blended (yellow), 8 refined", ccn.ui.cap_status_line(ob))
+        fig = add_modifier(load_cage("Fig17", os.path.join(DATA, "fig17_v7.obj")), levels=3)
+        fig.ccnurbs.cap_status = True
+        update()
+        self.assertIn("0 capped (green), 0 blended (yellow), 1 refined", ccn.ui.cap_status_line(fig))
+        fig.ccnurbs.cap_status = False
+        update()
+        self.assertIsNone(ccn.ui.cap_status_line(fig))
+        self.assertIsNone(ccn.state.of(fig).ev_marks)
+
     def _reload_without_addon(self, path):
         """(viewport positions of Fig16, vertex counts of both proxies) in a fresh Blender
         without the add-on."""

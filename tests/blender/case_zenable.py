@@ -19,7 +19,7 @@ class TestZEnableDisable(unittest.TestCase):
             self.assertEqual(ccn.overlay.handle_count(), 0)
             enable()
             self.assertEqual(handler_counts(), enabled_counts, "handlers after re-enable")
-            self.assertEqual(ccn.overlay.handle_count(), 2)
+            self.assertEqual(ccn.overlay.handle_count(), 3)
         ob = add_modifier(grid(2))
         self.assertEqual(len(evaluated_positions(ob)), 81)
 

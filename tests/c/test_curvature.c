@@ -379,8 +379,56 @@ static void test_flags(void) {
     free(X3); free(K3); free(X4); free(K4);
 }
 
+/* ccn_plan_get_evs: a cube's 8 corners are capped with the default cap (their curvature a
+ * number), refined with cap = REFINE (their curvature NaN); a valence-5 fan with spoke ratio 4.2
+ * gets no cap. */
+static int32_t ev_statuses(const ccn_cage *cage, ccn_cap cap, int levels, int32_t *st, int32_t *finite) {
+    ccn_options o;
+    memset(&o, 0, sizeof o);
+    o.levels = levels;
+    o.cap = cap;
+    ccn_plan *p = NULL;
+    ccn_error err;
+    if (ccn_plan_create(cage, &o, &p, &err) != CCN_OK) return -1;
+    int32_t n = 0, vs[64];
+    ccn_plan_get_evs(p, &n, NULL, NULL);
+    if (n > 64) { ccn_plan_destroy(p); return -1; }
+    ccn_plan_get_evs(p, &n, vs, st);
+    ccn_sizes sz;
+    ccn_plan_get_sizes(p, &sz);
+    double *X = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), *K = malloc(sizeof(double) * 2 * (size_t)sz.num_verts);
+    ccn_limit_mesh out;
+    memset(&out, 0, sizeof out);
+    out.positions = X;
+    out.curvatures = K;
+    ccn_plan_evaluate(p, NULL, &out, &err);
+    for (int32_t i = 0; i < n; i++) finite[i] = isfinite(K[2 * vs[i]]);
+    free(X); free(K);
+    ccn_plan_destroy(p);
+    return n;
+}
+
+static void test_ev_status(void) {
+    double P[24] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
+    int32_t fsz[6] = {4, 4, 4, 4, 4, 4};
+    int32_t fv[24] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+    ccn_cage cube = {8, 6, 0, P, fsz, fv, NULL, NULL, NULL, NULL};
+    int32_t st[64], fin[64];
+    int32_t n = ev_statuses(&cube, CCN_CAP_GUIDED_BI5, 3, st, fin);
+    CHECK(n == 8, "cube: %d EVs, expected 8", (int)n);
+    for (int32_t i = 0; i < n; i++)
+        CHECK(st[i] == CCN_EV_CAPPED && fin[i], "cube EV %d: status %d, curvature %s", (int)i,
+              (int)st[i], fin[i] ? "a number" : "NaN");
+    n = ev_statuses(&cube, CCN_CAP_REFINE, 3, st, fin);
+    CHECK(n == 8, "cube, refine: %d EVs", (int)n);
+    for (int32_t i = 0; i < n; i++)
+        CHECK(st[i] == CCN_EV_REFINED && !fin[i], "cube (refine) EV %d: status %d", (int)i, (int)st[i]);
+    CHECK(ccn_plan_get_evs(NULL, &n, NULL, NULL) == CCN_ERR_ARGUMENT, "NULL plan accepted");
+}
+
 int main(void) {
     RUN(test_torus_equals_bspline);
     RUN(test_flags);
+    RUN(test_ev_status);
     return TEST_SUMMARY();
 }
