@@ -121,19 +121,35 @@ static void curv_range(void *ctx, int32_t begin, int32_t end) {
     for (int32_t o = begin; o < end; o++) {
         double *k = j->out->curvatures + 2 * (size_t)o;
         double *dir = j->out->curvature_dirs ? j->out->curvature_dirs + 3 * (size_t)o : NULL;
-        int32_t v = p->out_vL[o];
+        int32_t v = p->out_vL[o], set = p->st_w[o] < 0 ? -1 - p->st_w[o] : -1;
         int child = j->near[v];
-        if (j->skip[o] || !ccn__curvature_stencil(mL, v, pinned, child, &s)) {
+        double d[5][3] = {{0}};
+        if (j->skip[o]) {
             k[0] = k[1] = NAN;
             if (dir) dir[0] = dir[1] = dir[2] = NAN;
             continue;
         }
-        double d[5][3] = {{0}};
-        for (int e = 0; e < s.n; e++) {
-            int32_t i = child ? s.v[e] + nvL : s.v[e];
-            const double *q = SPOINT(i);
-            for (int c = 0; c < 5; c++)
-                for (int x = 0; x < 3; x++) d[c][x] += s.w[c][e] * q[x];
+        if (set >= 0 && p->curv_set[set] == 1 && !child) {
+            /* a regular row of a shared weight set: its indices, the set's weights */
+            const int32_t *idx = p->st_v + p->st_start[o];
+            const double *w = p->curv_ws + 45 * (size_t)set;
+            for (int e = 0; e < 9; e++) {
+                const double *q = SPOINT(idx[e]);
+                for (int c = 0; c < 5; c++)
+                    for (int x = 0; x < 3; x++) d[c][x] += w[9 * c + e] * q[x];
+            }
+        } else {
+            if (!ccn__curvature_stencil(mL, v, pinned, child, &s)) {
+                k[0] = k[1] = NAN;
+                if (dir) dir[0] = dir[1] = dir[2] = NAN;
+                continue;
+            }
+            for (int e = 0; e < s.n; e++) {
+                int32_t i = child ? s.v[e] + nvL : s.v[e];
+                const double *q = SPOINT(i);
+                for (int c = 0; c < 5; c++)
+                    for (int x = 0; x < 3; x++) d[c][x] += s.w[c][e] * q[x];
+            }
         }
         ccn__principal_curvatures((const double(*)[3])d, &k[0], &k[1], dir);
         /* the levels' points are in the unit box of evaluate: lengths scale by p->scale */
@@ -142,12 +158,51 @@ static void curv_range(void *ctx, int32_t begin, int32_t end) {
     }
 }
 
-ccn_status ccn__curvature_evaluate(const ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
+/* The second-derivative weights of every shared weight set (p->curv_ws), once per plan: the
+ * stencil of the first regular row using the set (identical first-derivative weights of a 3 x 3
+ * tensor row determine its knot intervals, so the set's rows share these too); a set whose
+ * first row's stencil is not in its row's order is left to the per-vertex path. */
+static int shared_sets(ccn_plan *p, const uint8_t *near) {
+    if (p->curv_set || p->nws == 0) return 0;
+    p->curv_ws = malloc(sizeof(double) * 45 * (size_t)p->nws);
+    p->curv_set = calloc((size_t)p->nws, 1);
+    if (!p->curv_ws || !p->curv_set) {
+        free(p->curv_ws); free(p->curv_set);
+        p->curv_ws = NULL, p->curv_set = NULL;
+        return -1;
+    }
+    const ccn_mesh *mL = p->lev[p->L];
+    int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    ccn__stencil2 s;
+    for (int32_t o = 0; o < p->nout_v; o++) {
+        if (p->st_w[o] >= 0 || near[p->out_vL[o]]) continue;
+        int32_t set = -1 - p->st_w[o];
+        if (p->curv_set[set]) continue;
+        p->curv_set[set] = 2;
+        const int32_t *idx = p->st_v + p->st_start[o];
+        if (p->st_start[o + 1] - p->st_start[o] != 9 ||
+            !ccn__curvature_stencil(mL, p->out_vL[o], pinned, 0, &s) || s.n != 9)
+            continue;
+        int same = 1;
+        for (int e = 0; e < 9; e++) same &= s.v[e] == idx[e];
+        if (!same) continue;
+        for (int c = 0; c < 5; c++)
+            for (int e = 0; e < 9; e++) p->curv_ws[45 * (size_t)set + 9 * c + e] = s.w[c][e];
+        p->curv_set[set] = 1;
+    }
+    return 0;
+}
+
+ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
     const ccn_mesh *mL = p->lev[p->L];
     uint8_t *near = calloc((size_t)mL->nv + (size_t)p->nout_v + 1, 1);
     if (!near) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (curvature)");
     uint8_t *skip = near + mL->nv;
     for (int32_t i = 0; i < p->nnear; i++) near[p->near[i]] = 1;
+    if (shared_sets(p, near)) {
+        free(near);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (curvature)");
+    }
     for (int32_t i = 0; i < p->nsv; i++) skip[p->sv_out[i]] = 1; /* creases, corners */
     for (int32_t i = 0; i < p->nhv; i++) skip[p->hv_out[i]] = 1; /* caps */
     for (int32_t i = 0; i < p->nbv; i++) /* bicubic faces around caps (not a patch: the limit) */

@@ -10,7 +10,8 @@
  * its normal S_u x S_v. */
 void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, double dir[3]);
 /* out->curvatures (and out->curvature_dirs if given) of every output vertex, after the levels'
- * points are evaluated; NaN where the value is unbounded or not computed (curvature.c). */
-ccn_status ccn__curvature_evaluate(const ccn_plan *p, ccn_limit_mesh *out, ccn_error *err);
+ * points are evaluated; NaN where the value is unbounded or not computed (curvature.c). The
+ * first call makes the plan's shared second-derivative weights (p->curv_ws). */
+ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err);
 
 #endif

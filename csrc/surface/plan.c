@@ -43,6 +43,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->out_ev); free(p->out_ce);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
     free(p->st_w); free(p->ws);
+    free(p->curv_ws); free(p->curv_set);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);

@@ -62,6 +62,12 @@ struct ccn_plan {
     double *ws;
     int32_t nws;
     int32_t st_nown;        /* entries of st_wp / st_wu / st_wv (the rows with their own weights) */
+    /* curvature (surface/curvature.c): for each shared weight set, its rows' first and second
+     * derivative weights (45 doubles: S_u, S_v, S_uu, S_uv, S_vv of 9 entries), made at the
+     * first evaluation that asks for curvatures; curv_set[k]: 1 made, 2 its rows take the
+     * per-vertex path. NULL until then. */
+    double *curv_ws;
+    uint8_t *curv_set;
     /* sharp features: output vertices whose faces see more than one tangent plane (creases,
      * corners). Their sectors' tangent stencils (indices as st_v), CSR; each output face
      * corner names its sector (-1: the vertex normal). The vertex normal of such a vertex is
