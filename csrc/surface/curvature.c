@@ -129,7 +129,7 @@ static void curv_range(void *ctx, int32_t begin, int32_t end) {
             if (dir) dir[0] = dir[1] = dir[2] = NAN;
             continue;
         }
-        if (set >= 0 && p->curv_set[set] == 1 && !child) {
+        if (set >= 0 && p->curv_set[set] == 1 && !child && p->st_start[o + 1] - p->st_start[o] == 9) {
             /* a regular row of a shared weight set: its indices, the set's weights */
             const int32_t *idx = p->st_v + p->st_start[o];
             const double *w = p->curv_ws + 45 * (size_t)set;
