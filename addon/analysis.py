@@ -15,7 +15,7 @@ panel's legend.
 """
 import numpy as np
 
-from . import compat
+from . import attrs, compat
 
 NAMES = ("curvature_gaussian", "curvature_mean", "curvature_undefined", "curvature_color")
 RANGE_PROP = "ccnurbs_curvature_range"
@@ -57,14 +57,6 @@ def colors(q, bad):
     return c, r
 
 
-def _attr(me, name, kind, domain='POINT'):
-    a = me.attributes.get(name)
-    if a is not None and (a.data_type != kind or a.domain != domain):
-        me.attributes.remove(a)
-        a = None
-    return a if a is not None else me.attributes.new(name, kind, domain)
-
-
 def clear(me):
     for name in NAMES:
         a = me.attributes.get(name)
@@ -84,12 +76,14 @@ def write(me, curv, mode):
     with np.errstate(invalid='ignore'):
         gauss = np.where(bad, 0.0, k1 * k2)
         mean = np.where(bad, 0.0, 0.5 * (k1 + k2))
-    _attr(me, NAMES[0], 'FLOAT').data.foreach_set("value", gauss.astype(np.float32))
-    _attr(me, NAMES[1], 'FLOAT').data.foreach_set("value", mean.astype(np.float32))
-    _attr(me, NAMES[2], 'BOOLEAN').data.foreach_set("value", bad)
+    for name, kind, prop, vals in ((NAMES[0], 'FLOAT', "value", gauss.astype(np.float32)),
+                                   (NAMES[1], 'FLOAT', "value", mean.astype(np.float32)),
+                                   (NAMES[2], 'BOOLEAN', "value", bad)):
+        attrs.attribute(me, name, kind, 'POINT').data.foreach_set(prop, vals)
     q, _ = quantity(curv, mode)
     c, r = colors(q, bad)
-    _attr(me, NAMES[3], 'FLOAT_COLOR').data.foreach_set("color", c.ravel())
+    attrs.attribute(me, NAMES[3], 'FLOAT_COLOR', 'POINT').data.foreach_set("color",
+                                                                          c.ravel())
     compat.set_active_color(me, NAMES[3])
     me[RANGE_PROP] = r
 

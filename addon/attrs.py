@@ -207,7 +207,8 @@ def add_channels(plan, chans, uv_smooth):
     return [plan.add_fvar(values, idx, uv_smooth) for values, idx in chans]
 
 
-def _attribute(me, name, data_type, domain):
+def attribute(me, name, data_type, domain):
+    """The attribute of that name, type and domain on me, made (or made again) if needed."""
     a = me.attributes.get(name)
     if a is not None and (a.data_type != data_type or a.domain != domain):
         me.attributes.remove(a)
@@ -261,7 +262,7 @@ def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None, edge_fr
             col += k
             if t == 'BYTE_COLOR':
                 vals = np.clip(vals, 0.0, 1.0)
-            att = _attribute(me, name, t, 'POINT')
+            att = attribute(me, name, t, 'POINT')
             att.data.foreach_set(TYPES[t][0], vals.astype(np.float32).ravel())
             written.append(name)
     for (name, t, a), cid in zip(x.corner if x is not None else [], corner_ids or []):
@@ -269,20 +270,20 @@ def write(me, x, plan, chans, channel_ids, face_origin, corner_ids=None, edge_fr
         vals = out[fv.ravel()]
         if t == 'BYTE_COLOR':
             vals = np.clip(vals, 0.0, 1.0)
-        _attribute(me, name, t, 'CORNER').data.foreach_set(_prop(t, 'CORNER'),
+        attribute(me, name, t, 'CORNER').data.foreach_set(_prop(t, 'CORNER'),
                                                            vals.astype(np.float32).ravel())
         written.append(name)
     if x is not None and x.face:
         origin = np.clip(face_origin, 0, len(x.face[0][2]) - 1)
         for name, t, a in x.face:
-            _attribute(me, name, t, 'FACE').data.foreach_set(TYPES[t][0], a[origin].ravel())
+            attribute(me, name, t, 'FACE').data.foreach_set(TYPES[t][0], a[origin].ravel())
             written.append(name)
     if needs_edge_origin(x) and edge_from is not None:
         on = edge_from >= 0
         for name, t, a in x.edge:
             vals = np.zeros((len(me.edges), a.shape[1]), a.dtype)
             vals[on] = a[edge_from[on]]
-            _attribute(me, name, t, 'EDGE').data.foreach_set(TYPES[t][0], vals.ravel())
+            attribute(me, name, t, 'EDGE').data.foreach_set(TYPES[t][0], vals.ravel())
             written.append(name)
     if x is not None and (x.seam is not None or me.get(SEAM_PROP)):
         seam = np.zeros(len(me.edges), bool)

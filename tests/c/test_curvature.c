@@ -155,6 +155,20 @@ static void torus_make(torus *T, int nu, int nv, double spread) {
 
 static void torus_free(torus *T) { free(T->P); free(T->du); free(T->dv); }
 
+/* A plan of cage at `levels` with `cap` (NULL, after a CHECK, when it cannot be made) and its
+ * sizes. */
+static ccn_plan *make_plan(const ccn_cage *cage, int levels, ccn_cap cap, ccn_sizes *sz) {
+    ccn_options o;
+    memset(&o, 0, sizeof o);
+    o.levels = levels;
+    o.cap = cap;
+    ccn_plan *p = NULL;
+    ccn_error err;
+    CHECK(ccn_plan_create(cage, &o, &p, &err) == CCN_OK, "plan: %s", err.message);
+    if (p) ccn_plan_get_sizes(p, sz);
+    return p;
+}
+
 /* The cage: quads (i, j) (i+1, j) (i+1, j+1) (i, j+1); u edges carry du[i], v edges dv[j]. */
 static ccn_cage torus_cage(const torus *T, int32_t *fsz, int32_t *fv, int32_t *ev, double *kn) {
     int n = T->nu, m = T->nv, ne = 0;
@@ -180,14 +194,10 @@ static void check_torus(int nu, int nv, double spread, int levels, double *worst
     int32_t *ev = malloc(sizeof(int32_t) * 4 * (size_t)nu * nv);
     double *kn = malloc(sizeof(double) * 2 * (size_t)nu * nv);
     ccn_cage cage = torus_cage(&T, fsz, fv, ev, kn);
-    ccn_options o;
-    memset(&o, 0, sizeof o);
-    o.levels = levels;
-    ccn_plan *p = NULL;
-    ccn_error err;
-    CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "plan: %s", err.message);
     ccn_sizes sz;
-    ccn_plan_get_sizes(p, &sz);
+    ccn_error err;
+    ccn_plan *p = make_plan(&cage, levels, CCN_CAP_GUIDED_BI5, &sz);
+    if (!p) return;
     int32_t N = sz.num_verts;
     double *X = malloc(sizeof(double) * 3 * (size_t)N), *K = malloc(sizeof(double) * 2 * (size_t)N);
     double *Dd = malloc(sizeof(double) * 3 * (size_t)N);
@@ -272,15 +282,10 @@ static void test_torus_equals_bspline(void) {
 
 /* Limit positions and curvatures of cage at `levels` (refined limit, no cap); malloc'ed. */
 static int32_t star_eval(const ccn_cage *cage, int levels, double **X, double **K) {
-    ccn_options o;
-    memset(&o, 0, sizeof o);
-    o.levels = levels;
-    o.cap = CCN_CAP_REFINE;
-    ccn_plan *p = NULL;
-    ccn_error err;
-    if (ccn_plan_create(cage, &o, &p, &err) != CCN_OK) return 0;
     ccn_sizes sz;
-    ccn_plan_get_sizes(p, &sz);
+    ccn_error err;
+    ccn_plan *p = make_plan(cage, levels, CCN_CAP_REFINE, &sz);
+    if (!p) return 0;
     *X = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
     *K = malloc(sizeof(double) * 2 * (size_t)sz.num_verts);
     ccn_limit_mesh out;
@@ -319,15 +324,10 @@ static void test_flags(void) {
         ev[2 * ne] = 1 + (k + 4) % 5, ev[2 * ne + 1] = 6 + (k + 4) % 5, kn[ne++] = d;
     }
     ccn_cage cage = {11, 5, ne, P, fsz, fv, ev, kn, NULL, NULL};
-    ccn_options o;
-    memset(&o, 0, sizeof o);
-    o.levels = 3;
-    o.cap = CCN_CAP_REFINE;
-    ccn_plan *p = NULL;
-    ccn_error err;
-    CHECK(ccn_plan_create(&cage, &o, &p, &err) == CCN_OK, "plan: %s", err.message);
     ccn_sizes sz;
-    ccn_plan_get_sizes(p, &sz);
+    ccn_error err;
+    ccn_plan *p = make_plan(&cage, 3, CCN_CAP_REFINE, &sz);
+    if (!p) return;
     double *X = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), *K = malloc(sizeof(double) * 2 * (size_t)sz.num_verts);
     double D[3];
     ccn_limit_mesh out;
@@ -383,19 +383,14 @@ static void test_flags(void) {
  * number), refined with cap = REFINE (their curvature NaN); a valence-5 fan with spoke ratio 4.2
  * gets no cap. */
 static int32_t ev_statuses(const ccn_cage *cage, ccn_cap cap, int levels, int32_t *st, int32_t *finite) {
-    ccn_options o;
-    memset(&o, 0, sizeof o);
-    o.levels = levels;
-    o.cap = cap;
-    ccn_plan *p = NULL;
+    ccn_sizes sz;
     ccn_error err;
-    if (ccn_plan_create(cage, &o, &p, &err) != CCN_OK) return -1;
+    ccn_plan *p = make_plan(cage, levels, cap, &sz);
+    if (!p) return -1;
     int32_t n = 0, vs[64];
     ccn_plan_get_evs(p, &n, NULL, NULL);
     if (n > 64) { ccn_plan_destroy(p); return -1; }
     ccn_plan_get_evs(p, &n, vs, st);
-    ccn_sizes sz;
-    ccn_plan_get_sizes(p, &sz);
     double *X = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), *K = malloc(sizeof(double) * 2 * (size_t)sz.num_verts);
     ccn_limit_mesh out;
     memset(&out, 0, sizeof out);
