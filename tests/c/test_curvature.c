@@ -12,8 +12,8 @@
  * parameter by position. Checked: k1, k2 within 1e-8 of the largest |k|, the k1 direction
  * parallel where the two differ, the sign (positive at the point farthest from the axis, where
  * the surface bends away from its outward normal), and that without the option nothing is
- * written. Plus flags: a star's EV gives
- * NaN. */
+ * written. Open grids (corners pinned) likewise, against the B-spline of the net extended by
+ * mirror ghosts. Plus flags: a star's EV gives NaN. */
 #include "ccnurbs.h"
 #include "testlib.h"
 
@@ -157,11 +157,14 @@ static void torus_free(torus *T) { free(T->P); free(T->du); free(T->dv); }
 
 /* A plan of cage at `levels` with `cap` (NULL, after a CHECK, when it cannot be made) and its
  * sizes. */
+static int plan_corners = CCN_CORNERS_SMOOTH; /* boundary_corners of make_plan's plans */
+
 static ccn_plan *make_plan(const ccn_cage *cage, int levels, ccn_cap cap, ccn_sizes *sz) {
     ccn_options o;
     memset(&o, 0, sizeof o);
     o.levels = levels;
     o.cap = cap;
+    o.boundary_corners = plan_corners;
     ccn_plan *p = NULL;
     ccn_error err;
     CHECK(ccn_plan_create(cage, &o, &p, &err) == CCN_OK, "plan: %s", err.message);
@@ -421,8 +424,181 @@ static void test_ev_status(void) {
     CHECK(ccn_plan_get_evs(NULL, &n, NULL, NULL) == CCN_ERR_ARGUMENT, "NULL plan accepted");
 }
 
+/* ---- an open grid: the B-spline of the mirror extension ------------------------------------ */
+
+/* The blossom f(x1, x2, x3) of segment [t_i, t_i+1] of an open curve whose control points C[m]
+ * (dim each) are given for m = -1 .. n (ghosts at both ends) and whose knots t[k + 2] = t_k,
+ * k = -2 .. n + 1. */
+static void open_blossom(const double *C, int dim, const double *t, int i, const double x[3],
+                         double *out) {
+    double P[4][12], T[8];
+    for (int a = 0; a < 8; a++) T[a] = t[i - 3 + a + 2];
+    for (int a = 0; a < 4; a++)
+        for (int c = 0; c < dim; c++) P[a][c] = C[dim * (i - 1 + a + 1) + c];
+    for (int r = 0; r < 3; r++)
+        for (int a = 0; a < 3 - r; a++) {
+            double lo = T[a + 1 + r], hi = T[a + 4], w = (x[r] - lo) / (hi - lo);
+            for (int c = 0; c < dim; c++) P[a][c] = (1 - w) * P[a][c] + w * P[a + 1][c];
+        }
+    for (int c = 0; c < dim; c++) out[c] = P[0][c];
+}
+
+static void open_derivs(const double *C, int dim, const double *t, int i, double u, double *f,
+                        double *f1, double *f2) {
+    double a[12], b[12], c[12], e[12];
+    double x0[3] = {u, u, u}, x1[3] = {u, u, u + 1}, x2[3] = {u, u + 1, u + 1}, x3[3] = {u, u + 1, u};
+    open_blossom(C, dim, t, i, x0, a);
+    open_blossom(C, dim, t, i, x1, b);
+    open_blossom(C, dim, t, i, x2, c);
+    open_blossom(C, dim, t, i, x3, e);
+    for (int k = 0; k < dim; k++) {
+        f[k] = a[k];
+        f1[k] = 3 * (b[k] - a[k]);
+        f2[k] = 6 * (c[k] - b[k] - e[k] + a[k]);
+    }
+}
+
+/* Knots of an open sequence of intervals d[0..n-2] between n points, extended by the mirror:
+ * t[k + 2] = t_k for k = -2 .. n + 1, the intervals beyond each end those inside it in mirror
+ * order (D_-1 = D_0, D_-2 = D_1; likewise at the far end), as the boundary's ghost points have. */
+static void open_knots(const double *d, int n, double *t) {
+    t[2] = 0;
+    for (int k = 1; k < n; k++) t[k + 2] = t[k + 1] + d[k - 1];
+    t[1] = t[2] - d[0];
+    t[0] = t[1] - d[n > 2 ? 1 : 0];
+    t[n + 2] = t[n + 1] + d[n - 2];
+    t[n + 3] = t[n + 2] + d[n > 2 ? n - 3 : 0];
+}
+
+/* An nu x nv grid of control points (random heights, random intervals on its rings), corners
+ * pinned (Blender's Keep Corners): its limit is the tensor B-spline of the net extended by
+ * mirror ghosts (P_-1 = 2 P_0 - P_1 on each side, corners mirrored twice); the curvature at
+ * every output vertex, boundaries included, against it. */
+static void check_open_grid(int nu, int nv, int levels, double *worst) {
+    double *du = malloc(sizeof(double) * (size_t)nu), *dv = malloc(sizeof(double) * (size_t)nv);
+    for (int i = 0; i + 1 < nu; i++) du[i] = exp(1.2 * (2 * tl_rand01() - 1));
+    for (int j = 0; j + 1 < nv; j++) dv[j] = exp(1.2 * (2 * tl_rand01() - 1));
+    int NU = nu + 2, NV = nv + 2; /* with ghosts: index (i + 1, j + 1) */
+    double *G = malloc(sizeof(double) * 3 * (size_t)NU * NV), *P = malloc(sizeof(double) * 3 * (size_t)nu * nv);
+#define GP(i, j) (G + 3 * ((size_t)((j) + 1) * NU + (size_t)((i) + 1)))
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            double *q = GP(i, j), *r = P + 3 * ((size_t)j * nu + i);
+            q[0] = i + 0.2 * (tl_rand01() - 0.5);
+            q[1] = j + 0.2 * (tl_rand01() - 0.5);
+            q[2] = 0.8 * (tl_rand01() - 0.5);
+            memcpy(r, q, sizeof(double) * 3);
+        }
+    for (int j = 0; j < nv; j++)
+        for (int c = 0; c < 3; c++) {
+            GP(-1, j)[c] = 2 * GP(0, j)[c] - GP(1, j)[c];
+            GP(nu, j)[c] = 2 * GP(nu - 1, j)[c] - GP(nu - 2, j)[c];
+        }
+    for (int i = -1; i <= nu; i++)
+        for (int c = 0; c < 3; c++) {
+            GP(i, -1)[c] = 2 * GP(i, 0)[c] - GP(i, 1)[c];
+            GP(i, nv)[c] = 2 * GP(i, nv - 1)[c] - GP(i, nv - 2)[c];
+        }
+    double *tu = malloc(sizeof(double) * (size_t)(nu + 4)), *tv = malloc(sizeof(double) * (size_t)(nv + 4));
+    open_knots(du, nu, tu);
+    open_knots(dv, nv, tv);
+    /* the cage */
+    int nf = (nu - 1) * (nv - 1), ne = 0;
+    int32_t *fsz = malloc(sizeof(int32_t) * (size_t)nf), *fv = malloc(sizeof(int32_t) * 4 * (size_t)nf);
+    int32_t *ev = malloc(sizeof(int32_t) * 4 * (size_t)nu * nv);
+    double *kn = malloc(sizeof(double) * 2 * (size_t)nu * nv);
+    for (int j = 0; j + 1 < nv; j++)
+        for (int i = 0; i + 1 < nu; i++) {
+            int f = j * (nu - 1) + i;
+            fsz[f] = 4;
+            fv[4 * f] = j * nu + i, fv[4 * f + 1] = j * nu + i + 1;
+            fv[4 * f + 2] = (j + 1) * nu + i + 1, fv[4 * f + 3] = (j + 1) * nu + i;
+        }
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            if (i + 1 < nu) ev[2 * ne] = j * nu + i, ev[2 * ne + 1] = j * nu + i + 1, kn[ne++] = du[i];
+            if (j + 1 < nv) ev[2 * ne] = j * nu + i, ev[2 * ne + 1] = (j + 1) * nu + i, kn[ne++] = dv[j];
+        }
+    ccn_cage cage = {nu * nv, nf, ne, P, fsz, fv, ev, kn, NULL, NULL};
+    ccn_sizes sz;
+    ccn_error err;
+    plan_corners = CCN_CORNERS_PINNED; /* corners pinned: the mirror extension everywhere */
+    ccn_plan *p = make_plan(&cage, levels, CCN_CAP_GUIDED_BI5, &sz);
+    plan_corners = CCN_CORNERS_SMOOTH;
+    double *X = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), *K = malloc(sizeof(double) * 2 * (size_t)sz.num_verts);
+    ccn_limit_mesh out;
+    memset(&out, 0, sizeof out);
+    out.positions = X;
+    out.curvatures = K;
+    CHECK(p && ccn_plan_evaluate(p, NULL, &out, &err) == CCN_OK, "evaluate");
+    /* the oracle on the output's parameter grid, each output vertex matched by position */
+    int S = 1 << levels, nu2 = (nu - 1) * S + 1, nv2 = (nv - 1) * S + 1;
+    double (*ref)[5] = malloc(sizeof(double[5]) * (size_t)nu2 * nv2), kmax = 0, pos_err = 0;
+    double *R = malloc(sizeof(double) * 9 * (size_t)NV);
+    for (int a = 0; a < nu2; a++) {
+        int i = a / S < nu - 1 ? a / S : nu - 2;
+        double u = tu[i + 2] + (a - i * S) * (tu[i + 3] - tu[i + 2]) / S;
+        for (int r = -1; r <= nv; r++) { /* each row of the extended net as a curve in u */
+            double f[3], f1[3], f2[3], row[3 * 64];
+            for (int m = -1; m <= nu; m++) memcpy(row + 3 * (m + 1), GP(m, r), sizeof(double) * 3);
+            open_derivs(row, 3, tu, i, u, f, f1, f2);
+            memcpy(R + 9 * (r + 1), f, sizeof f);
+            memcpy(R + 9 * (r + 1) + 3, f1, sizeof f1);
+            memcpy(R + 9 * (r + 1) + 6, f2, sizeof f2);
+        }
+        for (int b = 0; b < nv2; b++) {
+            int j = b / S < nv - 1 ? b / S : nv - 2;
+            double v = tv[j + 2] + (b - j * S) * (tv[j + 3] - tv[j + 2]) / S;
+            double f[9], f1[9], f2[9], D[6][3], k1, k2, dir[3];
+            open_derivs(R, 9, tv, j, v, f, f1, f2);
+            for (int c = 0; c < 3; c++) {
+                D[0][c] = f[c], D[1][c] = f[3 + c], D[2][c] = f1[c];
+                D[3][c] = f[6 + c], D[4][c] = f1[3 + c], D[5][c] = f2[c];
+            }
+            oracle_curvature(D, &k1, &k2, dir);
+            double *q = ref[b * nu2 + a];
+            memcpy(q, D[0], sizeof(double) * 3);
+            q[3] = k1, q[4] = k2;
+            kmax = fmax(kmax, fmax(fabs(k1), fabs(k2)));
+        }
+    }
+    int compared = 0, flagged = 0;
+    double wk = 0;
+    for (int32_t o = 0; p && o < sz.num_verts; o++) {
+        int best = 0;
+        double bd = INFINITY;
+        for (int r = 0; r < nu2 * nv2; r++) {
+            double dx = X[3 * o] - ref[r][0], dy = X[3 * o + 1] - ref[r][1], dz = X[3 * o + 2] - ref[r][2];
+            double dd = dx * dx + dy * dy + dz * dz;
+            if (dd < bd) bd = dd, best = r;
+        }
+        pos_err = fmax(pos_err, sqrt(bd));
+        if (!isfinite(K[2 * o])) { flagged++; continue; }
+        wk = fmax(wk, fmax(fabs(K[2 * o] - ref[best][3]), fabs(K[2 * o + 1] - ref[best][4])) / kmax);
+        compared++;
+    }
+    CHECK(pos_err < 1e-9, "open grid: positions off the mirror-extended B-spline by %.3g", pos_err);
+    CHECK(wk <= 1e-8, "open grid %dx%d level %d: curvature off by %.3g of max |k|", nu, nv, levels, wk);
+    CHECK(flagged <= 4 && compared + flagged == sz.num_verts, "open grid: %d flagged (the 4 "
+          "corners at most), %d compared", flagged, compared);
+    *worst = fmax(*worst, wk);
+#undef GP
+    free(ref); free(R); free(X); free(K); free(G); free(P); free(du); free(dv); free(tu); free(tv);
+    free(fsz); free(fv); free(ev); free(kn);
+    if (p) ccn_plan_destroy(p);
+}
+
+static void test_open_grid_equals_bspline(void) {
+    double worst = 0;
+    for (int rep = 0; rep < 3; rep++)
+        for (int levels = 1; levels <= 3; levels++) check_open_grid(5 + rep, 4 + 2 * rep, levels, &worst);
+    printf("# 9 random open grids (boundaries, intervals up to e^2.4 : 1), levels 1-3: principal "
+           "curvatures within %.3g of max |k| of the mirror-extended tensor B-spline\n", worst);
+}
+
 int main(void) {
     RUN(test_torus_equals_bspline);
+    RUN(test_open_grid_equals_bspline);
     RUN(test_flags);
     RUN(test_ev_status);
     return TEST_SUMMARY();
