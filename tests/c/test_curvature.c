@@ -431,8 +431,8 @@ static void test_ev_status(void) {
  * k = -2 .. n + 1. */
 static void open_blossom(const double *C, int dim, const double *t, int i, const double x[3],
                          double *out) {
-    double P[4][12], T[8];
-    for (int a = 0; a < 8; a++) T[a] = t[i - 3 + a + 2];
+    double P[4][12], T[8] = {0};
+    for (int a = 1; a < 7; a++) T[a] = t[i - 3 + a + 2]; /* t_{i-2} .. t_{i+3}: the ones used */
     for (int a = 0; a < 4; a++)
         for (int c = 0; c < dim; c++) P[a][c] = C[dim * (i - 1 + a + 1) + c];
     for (int r = 0; r < 3; r++)
