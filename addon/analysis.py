@@ -25,16 +25,6 @@ POS = np.array((1.00, 0.15, 0.10, 1.0), np.float32)
 FLAG = np.array((1.00, 0.00, 1.00, 1.0), np.float32)
 
 
-def quantity(curv, mode):
-    """(values, undefined) of mode 'GAUSSIAN', 'MEAN' or 'MAX' (max |k|) from (N, 2) k1, k2."""
-    k1, k2 = curv[:, 0], curv[:, 1]
-    bad = ~(np.isfinite(k1) & np.isfinite(k2))
-    with np.errstate(invalid='ignore'):
-        q = {"GAUSSIAN": k1 * k2, "MEAN": 0.5 * (k1 + k2),
-             "MAX": np.maximum(np.abs(k1), np.abs(k2))}[mode]
-    return np.where(bad, 0.0, q), bad
-
-
 _T = np.linspace(-1.0, 1.0, 1025, dtype=np.float32)[:, None]
 LUT = np.where(_T < 0, ZERO + (NEG - ZERO) * -_T, ZERO + (POS - ZERO) * _T).astype(np.float32)
 
@@ -76,11 +66,12 @@ def write(me, curv, mode):
     with np.errstate(invalid='ignore'):
         gauss = np.where(bad, 0.0, k1 * k2)
         mean = np.where(bad, 0.0, 0.5 * (k1 + k2))
+        q = gauss if mode == 'GAUSSIAN' else mean if mode == 'MEAN' else \
+            np.where(bad, 0.0, np.maximum(k1, -k2))  # max |k| (k1 >= k2)
     for name, kind, prop, vals in ((NAMES[0], 'FLOAT', "value", gauss.astype(np.float32)),
                                    (NAMES[1], 'FLOAT', "value", mean.astype(np.float32)),
                                    (NAMES[2], 'BOOLEAN', "value", bad)):
         attrs.attribute(me, name, kind, 'POINT').data.foreach_set(prop, vals)
-    q, _ = quantity(curv, mode)
     c, r = colors(q, bad)
     attrs.attribute(me, NAMES[3], 'FLOAT_COLOR', 'POINT').data.foreach_set("color",
                                                                           c.ravel())

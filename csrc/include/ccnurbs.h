@@ -339,7 +339,8 @@ ccn_status ccn_plan_get_stats(const ccn_plan *plan, ccn_plan_stats *stats);
  * range of knot ratios; CCN_EV_REFINED, the refined limit (no cap: knot intervals beyond the cap's
  * range, cap = REFINE, a cap that would fold, or an output level not above the cap level): its
  * curvature is unbounded there. Call with NULL arrays for *num, then with arrays of *num
- * entries: output vertex indices and ccn_ev_surface values (either may be NULL). */
+ * entries: output vertex indices and ccn_ev_surface values (either may be NULL). CCN_OK, or
+ * CCN_ERR_ARGUMENT (no plan or num), CCN_ERR_MEMORY. */
 typedef enum { CCN_EV_CAPPED = 0, CCN_EV_CAP_BLENDED, CCN_EV_REFINED } ccn_ev_surface;
 ccn_status ccn_plan_get_evs(const ccn_plan *plan, int32_t *num, int32_t *out_vertex,
                             int32_t *surface);

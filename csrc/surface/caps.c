@@ -17,6 +17,7 @@
 #include "surface/surround.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define CCN_CAP_MAX_VALENCE 32
@@ -413,22 +414,25 @@ ccn_status ccn_plan_get_evs(const ccn_plan *p, int32_t *num, int32_t *out_vertex
     if (!p || !num) return CCN_ERR_ARGUMENT;
     const ccn_mesh *mL = p->lev[p->L];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
+    /* each cap's EV: its level-K vertex carried to level L (vertex point v -> nf + ne + v) */
+    uint8_t *capped = p->ncap ? calloc((size_t)mL->nv, 1) : NULL;
+    if (p->ncap && !capped) return CCN_ERR_MEMORY;
+    for (int32_t c = 0; c < p->ncap; c++) {
+        int32_t v = p->caps[c].cnet[0];
+        for (int32_t l = p->K; l < p->L; l++) v += p->lev[l]->nf + p->lev[l]->ne;
+        capped[v] = p->caps[c].w >= 1 ? 1 : 2;
+    }
     int32_t n = 0;
     for (int32_t o = 0; o < p->nout_v; o++) {
-        if (ccn__limit_kind(mL, p->out_vL[o], pinned) != CCN_LIMIT_EV) continue;
-        int32_t s = CCN_EV_REFINED;
-        for (int32_t c = 0; c < p->ncap; c++) { /* a cap's EV: its level-K vertex, carried to L */
-            int32_t v = p->caps[c].cnet[0];
-            for (int32_t l = p->K; l < p->L; l++) v += p->lev[l]->nf + p->lev[l]->ne;
-            if (v == p->out_vL[o]) {
-                s = p->caps[c].w >= 1 ? CCN_EV_CAPPED : CCN_EV_CAP_BLENDED;
-                break;
-            }
-        }
+        int32_t v = p->out_vL[o];
+        if (ccn__limit_kind(mL, v, pinned) != CCN_LIMIT_EV) continue;
         if (out_vertex) out_vertex[n] = o;
-        if (surface) surface[n] = s;
+        if (surface)
+            surface[n] = !capped || !capped[v] ? CCN_EV_REFINED
+                         : capped[v] == 1 ? CCN_EV_CAPPED : CCN_EV_CAP_BLENDED;
         n++;
     }
+    free(capped);
     *num = n;
     return CCN_OK;
 }

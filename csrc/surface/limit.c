@@ -193,19 +193,30 @@ void ccn__vertex_grid(const ccn_mesh *m, int32_t v, int32_t k0, int pinned, ccn_
  * edge 0 (no ghosts, no sectors: its edges are smooth), its weights in tensor_stencil's order
  * and arithmetic (the same numbers); 0 when two grid points are one vertex (a tiny closed
  * mesh), which the general path merges. */
-static int interior_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
-    int32_t g[3][3] = {{fan_diag(m, v, 2), fan_end(m, v, 2), fan_diag(m, v, 1)},
+/* The 3 x 3 grid g of an interior valence-4 vertex with +u along fan edge 0 and its intervals
+ * (D_-2 .. D_1) along u and v; 0 when two grid points are one vertex. */
+static inline int interior_grid(const ccn_mesh *m, int32_t v, int pinned, int32_t g[3][3],
+                                double du[4], double dv[4]) {
+    int32_t q[3][3] = {{fan_diag(m, v, 2), fan_end(m, v, 2), fan_diag(m, v, 1)},
                        {fan_end(m, v, 3), v, fan_end(m, v, 1)},
                        {fan_diag(m, v, 3), fan_end(m, v, 0), fan_diag(m, v, 0)}};
-    const int32_t *gv = &g[0][0];
+    const int32_t *gv = &q[0][0];
     int dup = 0; /* without branches: the compiler compares in vectors */
     for (int a = 1; a < 9; a++)
         for (int b = 0; b < a; b++) dup |= gv[a] == gv[b];
     if (dup) return 0;
-    double du[4] = {beyond_end(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
-                    m->eknot[ccn__fan_edge(m, v, 0)], beyond_end(m, v, 0, pinned)};
-    double dv[4] = {beyond_end(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
-                    m->eknot[ccn__fan_edge(m, v, 1)], beyond_end(m, v, 1, pinned)};
+    memcpy(g, q, sizeof q);
+    du[0] = beyond_end(m, v, 2, pinned), du[1] = m->eknot[ccn__fan_edge(m, v, 2)];
+    du[2] = m->eknot[ccn__fan_edge(m, v, 0)], du[3] = beyond_end(m, v, 0, pinned);
+    dv[0] = beyond_end(m, v, 3, pinned), dv[1] = m->eknot[ccn__fan_edge(m, v, 3)];
+    dv[2] = m->eknot[ccn__fan_edge(m, v, 1)], dv[3] = beyond_end(m, v, 1, pinned);
+    return 1;
+}
+
+static int interior_stencil(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil *s) {
+    int32_t g[3][3];
+    double du[4], dv[4];
+    if (!interior_grid(m, v, pinned, g, du, dv)) return 0;
     double wu[3], dwu[3], wv[3], dwv[3];
     ccn__curve_limit_weights(du[0], du[1], du[2], du[3], wu, dwu);
     ccn__curve_limit_weights(dv[0], dv[1], dv[2], dv[3], wv, dwv);
@@ -489,21 +500,11 @@ static void tensor_stencil2(ccn__vpoint g[3][3], const double du[4], const doubl
 /* An interior valence-4 vertex without sharp edges: interior_stencil's grid, 9 distinct points
  * (0 when two are one vertex: the general path merges them). */
 static int interior_stencil2(const ccn_mesh *m, int32_t v, int pinned, ccn__stencil2 *s) {
-    int32_t g[3][3] = {{fan_diag(m, v, 2), fan_end(m, v, 2), fan_diag(m, v, 1)},
-                       {fan_end(m, v, 3), v, fan_end(m, v, 1)},
-                       {fan_diag(m, v, 3), fan_end(m, v, 0), fan_diag(m, v, 0)}};
-    const int32_t *gv = &g[0][0];
-    int dup = 0;
-    for (int a = 1; a < 9; a++)
-        for (int b = 0; b < a; b++) dup |= gv[a] == gv[b];
-    if (dup) return 0;
-    double wu[3], dwu[3], ddwu[3], wv[3], dwv[3], ddwv[3];
-    ccn__curve_limit_weights2(beyond_end(m, v, 2, pinned), m->eknot[ccn__fan_edge(m, v, 2)],
-                              m->eknot[ccn__fan_edge(m, v, 0)], beyond_end(m, v, 0, pinned), wu,
-                              dwu, ddwu);
-    ccn__curve_limit_weights2(beyond_end(m, v, 3, pinned), m->eknot[ccn__fan_edge(m, v, 3)],
-                              m->eknot[ccn__fan_edge(m, v, 1)], beyond_end(m, v, 1, pinned), wv,
-                              dwv, ddwv);
+    int32_t g[3][3];
+    double du[4], dv[4], wu[3], dwu[3], ddwu[3], wv[3], dwv[3], ddwv[3];
+    if (!interior_grid(m, v, pinned, g, du, dv)) return 0;
+    ccn__curve_limit_weights2(du[0], du[1], du[2], du[3], wu, dwu, ddwu);
+    ccn__curve_limit_weights2(dv[0], dv[1], dv[2], dv[3], wv, dwv, ddwv);
     s->n = 9;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {

@@ -38,6 +38,20 @@ static char *slurp(const char *path, size_t *len) {
     return b;
 }
 
+/* The shortest of reps evaluations, each after a move of cage vertex 0; -1 on an error. */
+static double min_evaluate(ccn_plan *plan, double *cp, ccn_limit_mesh *lm, int reps) {
+    double best = 1e30;
+    ccn_error err;
+    for (int r = 0; r < reps; r++) {
+        cp[0] += 1e-3;
+        double t0 = now();
+        if (ccn_plan_evaluate(plan, cp, lm, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+        double t1 = now() - t0;
+        best = t1 < best ? t1 : best;
+    }
+    return best;
+}
+
 int main(int argc, char **argv) {
     if (argc < 3) { fprintf(stderr, "usage: bench in.obj levels [cap: bi5|refine] [repeats] [ev_polyhedron] [threads] [cached]\n"); return 2; }
     int levels = atoi(argv[2]), reps = argc > 4 ? atoi(argv[4]) : 5;
@@ -73,24 +87,13 @@ int main(int argc, char **argv) {
     double *cp = malloc(sizeof(double) * 3 * cage.num_verts);
     memcpy(cp, cage.positions, sizeof(double) * 3 * cage.num_verts);
     ccn_limit_mesh lm = {.positions = pos, .normals = nrm};
-    for (int r = 0; r < 3 * reps; r++) {
-        cp[0] += 1e-3;
-        double t0 = now();
-        if (ccn_plan_evaluate(plan, cp, &lm, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
-        double t1 = now() - t0;
-        teval = t1 < teval ? t1 : teval;
-    }
+    teval = min_evaluate(plan, cp, &lm, 3 * reps);
     /* the same with principal curvatures (the add-on's analysis) */
-    double tcurv = 1e30, *curv = malloc(sizeof(double) * 2 * s.num_verts);
+    double *curv = malloc(sizeof(double) * 2 * s.num_verts);
     ccn_limit_mesh lmc = {.positions = pos, .normals = nrm, .curvatures = curv};
-    for (int r = 0; r < 3 * reps; r++) {
-        cp[0] += 1e-3;
-        double t0 = now();
-        if (ccn_plan_evaluate(plan, cp, &lmc, &err)) { fprintf(stderr, "%s\n", err.message); return 2; }
-        double t1 = now() - t0;
-        tcurv = t1 < tcurv ? t1 : tcurv;
-    }
+    double tcurv = min_evaluate(plan, cp, &lmc, 3 * reps);
     free(curv);
+    if (teval < 0 || tcurv < 0) return 2;
     struct rusage ru; /* one plan alive at a time so far: its peak, with the cage and outputs */
     getrusage(RUSAGE_SELF, &ru);
     double tref = 1e30;

@@ -155,6 +155,20 @@ static void torus_make(torus *T, int nu, int nv, double spread) {
 
 static void torus_free(torus *T) { free(T->P); free(T->du); free(T->dv); }
 
+/* The row of ref (n rows of `stride` doubles, a position first) nearest to x; *dist its
+ * distance. */
+static int nearest(const double *ref, int stride, int n, const double *x, double *dist) {
+    int best = 0;
+    double bd = INFINITY;
+    for (int r = 0; r < n; r++) {
+        const double *q = ref + (size_t)stride * r;
+        double dx = x[0] - q[0], dy = x[1] - q[1], dz = x[2] - q[2], dd = dx * dx + dy * dy + dz * dz;
+        if (dd < bd) bd = dd, best = r;
+    }
+    *dist = sqrt(bd);
+    return best;
+}
+
 /* A plan of cage at `levels` with `cap` (NULL, after a CHECK, when it cannot be made) and its
  * sizes. */
 static int plan_corners = CCN_CORNERS_SMOOTH; /* boundary_corners of make_plan's plans */
@@ -231,15 +245,9 @@ static void check_torus(int nu, int nv, double spread, int levels, double *worst
         }
     double wk = 0, wd = 0, far = -1, k_far = 0;
     for (int32_t q = 0; q < N; q++) {
-        int best = -1;
-        double bd = INFINITY;
-        for (int r = 0; r < nu2 * nv2; r++) {
-            double dx = X[3 * q] - ref[r][0], dy = X[3 * q + 1] - ref[r][1], dz = X[3 * q + 2] - ref[r][2];
-            double dd = dx * dx + dy * dy + dz * dz;
-            if (dd < bd) bd = dd, best = r;
-        }
-        pos_err = fmax(pos_err, sqrt(bd));
-        double *r = ref[best];
+        double dist;
+        double *r = ref[nearest(&ref[0][0], 9, nu2 * nv2, X + 3 * q, &dist)];
+        pos_err = fmax(pos_err, dist);
         wk = fmax(wk, fmax(fabs(K[2 * q] - r[3]), fabs(K[2 * q + 1] - r[4])) / kmax);
         if (r[3] - r[4] > 1e-3 * kmax) {
             double c = fabs(Dd[3 * q] * r[5] + Dd[3 * q + 1] * r[6] + Dd[3 * q + 2] * r[7]);
@@ -565,14 +573,9 @@ static void check_open_grid(int nu, int nv, int levels, double *worst) {
     int compared = 0, flagged = 0;
     double wk = 0;
     for (int32_t o = 0; p && o < sz.num_verts; o++) {
-        int best = 0;
-        double bd = INFINITY;
-        for (int r = 0; r < nu2 * nv2; r++) {
-            double dx = X[3 * o] - ref[r][0], dy = X[3 * o + 1] - ref[r][1], dz = X[3 * o + 2] - ref[r][2];
-            double dd = dx * dx + dy * dy + dz * dz;
-            if (dd < bd) bd = dd, best = r;
-        }
-        pos_err = fmax(pos_err, sqrt(bd));
+        double dist;
+        int best = nearest(&ref[0][0], 5, nu2 * nv2, X + 3 * o, &dist);
+        pos_err = fmax(pos_err, dist);
         if (!isfinite(K[2 * o])) { flagged++; continue; }
         wk = fmax(wk, fmax(fabs(K[2 * o] - ref[best][3]), fabs(K[2 * o + 1] - ref[best][4])) / kmax);
         compared++;
