@@ -26,25 +26,32 @@ FLAG = np.array((1.00, 0.00, 1.00, 1.0), np.float32)
 
 
 _T = np.linspace(-1.0, 1.0, 1025, dtype=np.float32)[:, None]
-LUT = np.where(_T < 0, ZERO + (NEG - ZERO) * -_T, ZERO + (POS - ZERO) * _T).astype(np.float32)
+# the colour table: 1025 steps from -1 to 1, then the flag's colour (index 1025)
+LUT = np.vstack([np.where(_T < 0, ZERO + (NEG - ZERO) * -_T, ZERO + (POS - ZERO) * _T),
+                 FLAG[None, :]]).astype(np.float32)
+RANGE_SAMPLES = 16384  # the range is the percentile of at most this many evenly spaced vertices
 
 
 def colors(q, bad):
-    """RGBA per vertex (a 1025-entry table: a gather, not arithmetic on N x 4 arrays) and the
-    symmetric range used."""
-    mag = np.abs(q[~bad])
+    """RGBA per vertex (N, 4) float32 and the symmetric range used: the 98th percentile of |q|
+    over the defined vertices (of an even subsample of at most RANGE_SAMPLES on big meshes, the
+    same value to a fraction of a colour step; a full sort would cost more than the evaluation);
+    a gather from the table, not arithmetic on N x 4 arrays."""
+    step = max(1, len(q) // RANGE_SAMPLES)
+    mag = np.abs(q[::step][~bad[::step]])
     if len(mag):
         k = min(len(mag) - 1, int(0.98 * (len(mag) - 1) + 0.5))
         r = float(np.partition(mag, k)[k])
     else:
         r = 0.0
     if r > 0:
-        idx = np.rint((np.clip(q / r, -1.0, 1.0) + 1.0) * 512.0).astype(np.intp)
+        t = q.astype(np.float32) * np.float32(512.0 / r) + np.float32(512.5)
+        np.clip(t, 0.0, 1024.0, out=t)
+        idx = t.astype(np.int32)
     else:
-        idx = np.full(len(q), 512, np.intp)
-    c = LUT[idx]
-    c[bad] = FLAG
-    return c, r
+        idx = np.full(len(q), 512, np.int32)
+    idx[bad] = len(LUT) - 1
+    return np.take(LUT, idx, axis=0), r
 
 
 def clear(me):

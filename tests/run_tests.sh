@@ -65,6 +65,14 @@ done
 reap
 while [ "$left" -gt 0 ]; do sleep 0.5; reap; done
 wait
+# what failed, again at the end (a CI that keeps only the tail of the output shows it): each
+# failed suite's failure lines, at most 8 (its full log: build/test-logs)
+for x in $failed; do
+  case $x in test_*) x=build/tests/$x ;; esac
+  echo "-- $(name_of "$x"), what failed:"
+  grep -E -i '(^|[^a-z_])([a-z]*error|fail(ed)?|not ok|traceback|exited with|timed? ?out)([^a-z_]|$)' \
+      "$LOG/$(id_of "$x").log" | grep -Ev '(^|[^0-9])0 failed|^ok ' | tail -n 8 | cut -c1-300
+done
 [ -n "$failed" ] && echo "failed suites:$failed"
 echo "wall time: $(( $(date +%s) - wall0 ))s with $JOBS suites at a time"
 echo "suites: $pass passed, $fail failed"

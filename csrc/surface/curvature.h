@@ -9,9 +9,16 @@
  * (d[0..4]); NaN when the tangents are degenerate. Positive where the surface bends away from
  * its normal S_u x S_v. */
 void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, double dir[3]);
-/* out->curvatures (and out->curvature_dirs if given) of every output vertex, after the levels'
- * points are evaluated; NaN where the value is unbounded or not computed (curvature.c). The
- * first call makes the plan's shared second-derivative weights (p->curv_ws). */
+/* The plan's curvature tables (plan_types.h: curv_mode and the second-derivative weights
+ * aligned with the stencil rows), once per plan, before the first stencil pass that computes
+ * curvatures. */
+ccn_status ccn__curvature_prepare(ccn_plan *p, ccn_error *err);
+/* Output o's curvatures (and direction) from its derivatives in the unit box of evaluate. */
+void ccn__curvature_at(const ccn_plan *p, const double d[5][3], ccn_limit_mesh *out, int32_t o);
+/* Output o: NaN, the flag (no bounded single value, or its cap's patch gives it later). */
+void ccn__curvature_flag(ccn_limit_mesh *out, int32_t o);
+/* After the stencil pass (which computed the CCN__CURV_ROW outputs and flagged the others) and
+ * the caps: the outputs with stencils of their own, and the caps' and their rings' patches. */
 ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err);
 
 #endif

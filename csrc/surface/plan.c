@@ -43,7 +43,8 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->out_ev); free(p->out_ce);
     free(p->st_start); free(p->st_v); free(p->st_wp); free(p->st_wu); free(p->st_wv);
     free(p->st_w); free(p->ws);
-    free(p->curv_ws); free(p->curv_set);
+    free(p->curv_ws); free(p->curv_set); free(p->curv_mode);
+    free(p->curv_wuu); free(p->curv_wuv); free(p->curv_wvv); free(p->curv_other);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
     free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
@@ -254,23 +255,25 @@ ccn_status ccn_plan_get_stats(const ccn_plan *p, ccn_plan_stats *s) {
 
 typedef struct { const ccn_plan *p; ccn_limit_mesh *out; const int32_t *rows; } stencil_job; /* rows: NULL = all */
 
-static void stencil_range(void *ctx, int32_t begin, int32_t end) {
-    const stencil_job *j = ctx;
-    const ccn_plan *p = j->p;
-    ccn_limit_mesh *out = j->out;
+/* Row o of the stencil table applied to the points: the limit position x and the tangents du,
+ * dv; with e (the row's second-derivative weights wuu, wuv, wvv aligned with its entries, or
+ * NULL) also S_uu, S_uv, S_vv into dd, from the same loads. x, du and dv do not depend on e:
+ * the same products and sums either way. */
+static inline void apply_row(const ccn_plan *p, int32_t o, const double *const e[3], double x[3],
+                             double du[3], double dv[3], double dd[3][3]) {
     const double *PL = p->lev[p->L]->pos, *PS = p->posS;
     int32_t nvL = p->lev[p->L]->nv;
-    for (int32_t i = begin; i < end; i++) {
-        int32_t o = j->rows ? j->rows[i] : i;
-        const double *wp, *wu, *wv;
-        ccn__plan_row_weights(p, o, &wp, &wu, &wv);
-        const int32_t *idx = p->st_v + p->st_start[o];
+    const double *wp, *wu, *wv;
+    ccn__plan_row_weights(p, o, &wp, &wu, &wv);
+    const int32_t *idx = p->st_v + p->st_start[o];
+    int32_t n = p->st_start[o + 1] - p->st_start[o];
 #ifdef CCN_V2D
-        /* x and y in one register pair, z alone: each lane the same products and sums as
-         * the scalar loop, so the result is bit-identical */
-        ccn__v2d xy = {0, 0}, uxy = {0, 0}, vxy = {0, 0};
-        double x2 = 0, u2 = 0, v2 = 0;
-        for (int32_t k = 0, n = p->st_start[o + 1] - p->st_start[o]; k < n; k++) {
+    /* x and y in one register pair, z alone: each lane the same products and sums as the
+     * scalar loop, so the result is bit-identical */
+    ccn__v2d xy = {0, 0}, uxy = {0, 0}, vxy = {0, 0};
+    double x2 = 0, u2 = 0, v2 = 0;
+    if (!e) {
+        for (int32_t k = 0; k < n; k++) {
             const double *q = SPOINT(idx[k]);
             ccn__v2d qxy;
             memcpy(&qxy, q, sizeof qxy);
@@ -280,22 +283,66 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
             uxy += bv * qxy; u2 += b * q[2];
             vxy += cv * qxy; v2 += c * q[2];
         }
-        double x[3] = {xy[0], xy[1], x2}, du[3] = {uxy[0], uxy[1], u2}, dv[3] = {vxy[0], vxy[1], v2};
-#else
-        double x0 = 0, x1 = 0, x2 = 0, u0 = 0, u1 = 0, u2 = 0, v0 = 0, v1 = 0, v2 = 0;
-        for (int32_t k = 0, n = p->st_start[o + 1] - p->st_start[o]; k < n; k++) {
+    } else {
+        ccn__v2d fxy = {0, 0}, gxy = {0, 0}, hxy = {0, 0};
+        double f2 = 0, g2 = 0, h2 = 0;
+        for (int32_t k = 0; k < n; k++) {
             const double *q = SPOINT(idx[k]);
-            double a = wp[k], b = wu[k], c = wv[k];
-            x0 += a * q[0]; x1 += a * q[1]; x2 += a * q[2];
-            u0 += b * q[0]; u1 += b * q[1]; u2 += b * q[2];
-            v0 += c * q[0]; v1 += c * q[1]; v2 += c * q[2];
+            ccn__v2d qxy;
+            memcpy(&qxy, q, sizeof qxy);
+            double a = wp[k], b = wu[k], c = wv[k], f = e[0][k], g = e[1][k], h = e[2][k];
+            ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c}, fv = {f, f}, gv = {g, g}, hv = {h, h};
+            xy += av * qxy; x2 += a * q[2];
+            uxy += bv * qxy; u2 += b * q[2];
+            vxy += cv * qxy; v2 += c * q[2];
+            fxy += fv * qxy; f2 += f * q[2];
+            gxy += gv * qxy; g2 += g * q[2];
+            hxy += hv * qxy; h2 += h * q[2];
         }
-        double x[3] = {x0, x1, x2}, du[3] = {u0, u1, u2}, dv[3] = {v0, v1, v2};
+        dd[0][0] = fxy[0], dd[0][1] = fxy[1], dd[0][2] = f2;
+        dd[1][0] = gxy[0], dd[1][1] = gxy[1], dd[1][2] = g2;
+        dd[2][0] = hxy[0], dd[2][1] = hxy[1], dd[2][2] = h2;
+    }
+    x[0] = xy[0], x[1] = xy[1], x[2] = x2;
+    du[0] = uxy[0], du[1] = uxy[1], du[2] = u2;
+    dv[0] = vxy[0], dv[1] = vxy[1], dv[2] = v2;
+#else
+    double x0 = 0, x1 = 0, x2 = 0, u0 = 0, u1 = 0, u2 = 0, v0 = 0, v1 = 0, v2 = 0;
+    for (int32_t k = 0; k < n; k++) {
+        const double *q = SPOINT(idx[k]);
+        double a = wp[k], b = wu[k], c = wv[k];
+        x0 += a * q[0]; x1 += a * q[1]; x2 += a * q[2];
+        u0 += b * q[0]; u1 += b * q[1]; u2 += b * q[2];
+        v0 += c * q[0]; v1 += c * q[1]; v2 += c * q[2];
+        if (e)
+            for (int t = 0; t < 3; t++)
+                for (int c3 = 0; c3 < 3; c3++) dd[t][c3] += e[t][k] * q[c3];
+    }
+    x[0] = x0, x[1] = x1, x[2] = x2;
+    du[0] = u0, du[1] = u1, du[2] = u2;
+    dv[0] = v0, dv[1] = v1, dv[2] = v2;
 #endif
+}
+
+static void stencil_range(void *ctx, int32_t begin, int32_t end) {
+    const stencil_job *j = ctx;
+    const ccn_plan *p = j->p;
+    ccn_limit_mesh *out = j->out;
+    for (int32_t i = begin; i < end; i++) {
+        int32_t o = j->rows ? j->rows[i] : i;
+        double d[5][3] = {{0}}, x[3];
+        /* with curvatures: the second derivatives from the same points, where the row's
+         * curvature stencil is its own points (curvature.c), else flagged or made later */
+        int curv = out->curvatures && p->curv_mode[o] == CCN__CURV_ROW;
+        const double *e[3] = {NULL, NULL, NULL};
+        if (curv) ccn__plan_row_curv_weights(p, o, &e[0], &e[1], &e[2]);
+        apply_row(p, o, curv ? e : NULL, x, d[0], d[1], d + 2);
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
+        if (curv) ccn__curvature_at(p, (const double(*)[3])d, out, o);
+        else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG) ccn__curvature_flag(out, o);
         if (!out->normals) continue;
         double *n = out->normals + 3 * (size_t)o;
-        ccn__unit_normal(du, dv, n);
+        ccn__unit_normal(d[0], d[1], n);
     }
 }
 
@@ -378,6 +425,15 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
             ccn__edit_region_free(r);
             r = NULL;
         }
+    /* curvatures are not kept between evaluations: every row's are made again */
+    if (r && out->curvatures) {
+        ccn__edit_region_free(r);
+        r = NULL;
+    }
+    if (out->curvatures) {
+        ccn_status st = ccn__curvature_prepare(p, err);
+        if (st) { ccn__edit_region_free(r); return st; }
+    }
     for (int32_t l = 0; l < p->R; l++) {
         if (r)
             ccn__level_points_lists(&p->prep[l], r->lists[l].f, r->lists[l].nf, r->lists[l].e,

@@ -62,12 +62,18 @@ struct ccn_plan {
     double *ws;
     int32_t nws;
     int32_t st_nown;        /* entries of st_wp / st_wu / st_wv (the rows with their own weights) */
-    /* curvature (surface/curvature.c): for each shared weight set, its rows' first and second
-     * derivative weights (45 doubles: S_u, S_v, S_uu, S_uv, S_vv of 9 entries), made at the
-     * first evaluation that asks for curvatures; curv_set[k]: 1 made, 2 its rows take the
-     * per-vertex path. NULL until then. */
-    double *curv_ws;
-    uint8_t *curv_set;
+    /* curvature (surface/curvature.c), made by the first evaluation that asks for curvatures
+     * (NULL until then). Where a row's curvature stencil has the row's own points, its second
+     * derivative weights S_uu, S_uv, S_vv are kept aligned with the row (its wu, wv are S_u,
+     * S_v: the same grid), and the stencil pass computes positions, normals and curvatures
+     * together: curv_ws 27 doubles per shared weight set (curv_set[k] 1: made), curv_wuu /
+     * curv_wuv / curv_wvv st_nown entries for the rows with their own weights. curv_mode per
+     * output: CCN__CURV_FLAG (NaN, or a cap's patch gives it), _ROW (the aligned weights),
+     * _OWN / _OWN_CHILD (a stencil of other points, made per evaluation: curv_other lists
+     * them). */
+    uint8_t *curv_mode, *curv_set;
+    double *curv_ws, *curv_wuu, *curv_wuv, *curv_wvv;
+    int32_t ncurv_other, *curv_other;
     /* sharp features: output vertices whose faces see more than one tangent plane (creases,
      * corners). Their sectors' tangent stencils (indices as st_v), CSR; each output face
      * corner names its sector (-1: the vertex normal). The vertex normal of such a vertex is
@@ -122,6 +128,21 @@ struct ccn_plan {
      * evaluation: the earlier plan's level points (moved into lev[]) and what the edit changed */
     struct ccn__edit_region *region;
 };
+
+enum { CCN__CURV_FLAG = 0, CCN__CURV_ROW = 1, CCN__CURV_OWN = 2, CCN__CURV_OWN_CHILD = 3 };
+
+/* The second-derivative weights of output o's stencil row, aligned with its entries
+ * (curv_mode[o] == CCN__CURV_ROW). */
+static inline void ccn__plan_row_curv_weights(const ccn_plan *p, int32_t o, const double **wuu,
+                                              const double **wuv, const double **wvv) {
+    int32_t w = p->st_w[o];
+    if (w >= 0) {
+        *wuu = p->curv_wuu + w; *wuv = p->curv_wuv + w; *wvv = p->curv_wvv + w;
+    } else {
+        const double *s = p->curv_ws + 27 * (size_t)(-1 - w);
+        *wuu = s; *wuv = s + 9; *wvv = s + 18;
+    }
+}
 
 /* The weights of output o's stencil row (see ccn_plan.st_w); entry k of the row is index
  * st_v[st_start[o] + k]. */

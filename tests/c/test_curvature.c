@@ -599,10 +599,83 @@ static void test_open_grid_equals_bspline(void) {
            "curvatures within %.3g of max |k| of the mirror-extended tensor B-spline\n", worst);
 }
 
+/* Asking for curvatures computes them in the same pass as the positions (the rows' second
+ * derivative weights beside their first): positions, normals and corner normals must be those
+ * of an evaluation without them, to the bit, and every evaluation the same numbers; a
+ * changed-only evaluation after an interval edit (which evaluates in full when curvatures are
+ * asked) equals a new plan's. A cube (its corners capped or refined) with non-uniform rings
+ * and a creased edge. */
+static void test_curvature_leaves_the_surface_alone(void) {
+    static const double P[24] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
+                                 -1, -1, 1,  1, -1, 1,  1, 1, 1,  -1, 1, 1};
+    static const int32_t fsz[6] = {4, 4, 4, 4, 4, 4};
+    static const int32_t fv[24] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4,
+                                   1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+    static const int32_t ev[8] = {0, 1, 1, 2, 4, 5, 0, 4};
+    double kn[4] = {2.5, 1, 1.75, 1}, cr[4] = {0, 0, 0, 2.5};
+    for (int variant = 0; variant < 4; variant++) {
+        ccn_cage cage = {8, 6, 4, P, fsz, fv, ev, kn, variant & 1 ? cr : NULL, NULL};
+        ccn_cap cap = variant & 2 ? CCN_CAP_REFINE : CCN_CAP_GUIDED_BI5;
+        ccn_sizes sz;
+        ccn_error err;
+        ccn_plan *p = make_plan(&cage, 3, cap, &sz);
+        if (!p) return;
+        size_t n = (size_t)sz.num_verts, nc = 4 * (size_t)sz.num_faces;
+        double *X0 = malloc(sizeof(double) * 3 * n), *N0 = malloc(sizeof(double) * 3 * n);
+        double *C0 = malloc(sizeof(double) * 3 * nc), *X1 = malloc(sizeof(double) * 3 * n);
+        double *N1 = malloc(sizeof(double) * 3 * n), *C1 = malloc(sizeof(double) * 3 * nc);
+        double *K1 = malloc(sizeof(double) * 2 * n), *K2 = malloc(sizeof(double) * 2 * n);
+        double *D1 = malloc(sizeof(double) * 3 * n);
+        ccn_limit_mesh plain = {.positions = X0, .normals = N0, .corner_normals = C0};
+        ccn_limit_mesh curv = {.positions = X1, .normals = N1, .corner_normals = C1,
+                               .curvatures = K1, .curvature_dirs = D1};
+        CHECK(ccn_plan_evaluate(p, NULL, &curv, &err) == CCN_OK, "evaluate: %s", err.message);
+        CHECK(ccn_plan_evaluate(p, NULL, &plain, &err) == CCN_OK, "evaluate: %s", err.message);
+        CHECK(!memcmp(X0, X1, sizeof(double) * 3 * n) && !memcmp(N0, N1, sizeof(double) * 3 * n) &&
+              !memcmp(C0, C1, sizeof(double) * 3 * nc),
+              "variant %d: positions or normals change when curvatures are asked", variant);
+        curv.curvatures = K2;
+        CHECK(ccn_plan_evaluate(p, NULL, &curv, &err) == CCN_OK, "evaluate: %s", err.message);
+        int32_t finite = 0;
+        for (size_t i = 0; i < 2 * n; i++) {
+            finite += isfinite(K1[i]) != 0;
+            CHECK(K1[i] == K2[i] || (isnan(K1[i]) && isnan(K2[i])), "variant %d: curvature %d differs "
+                  "between evaluations", variant, (int)(i / 2));
+        }
+        CHECK(finite > (int32_t)n, "variant %d: %d of %d curvatures are numbers", variant, (int)finite,
+              (int)(2 * n));
+        /* an interval edit: the plan made with options.previous, evaluated changed-only with
+         * curvatures, against a new plan's full evaluation */
+        kn[0] = 1.25;
+        ccn_options o = {0};
+        o.levels = 3, o.cap = cap, o.previous = p;
+        ccn_plan *q = NULL, *r = make_plan(&cage, 3, cap, &sz);
+        CHECK(ccn_plan_create(&cage, &o, &q, &err) == CCN_OK, "previous: %s", err.message);
+        p = NULL; /* destroyed by the call */
+        if (q && r) {
+            double *K3 = malloc(sizeof(double) * 2 * n);
+            curv.curvatures = K3;
+            CHECK(ccn_plan_evaluate(r, NULL, &curv, &err) == CCN_OK, "evaluate: %s", err.message);
+            curv.curvatures = K2;
+            CHECK(ccn_plan_evaluate_changed(q, NULL, &curv, &err) == CCN_OK, "changed: %s", err.message);
+            for (size_t i = 0; i < 2 * n; i++)
+                CHECK(K3[i] == K2[i] || (isnan(K3[i]) && isnan(K2[i])), "variant %d: curvature %d of "
+                      "the changed-only evaluation differs from a new plan's", variant, (int)(i / 2));
+            free(K3);
+        }
+        kn[0] = 2.5;
+        ccn_plan_destroy(q);
+        ccn_plan_destroy(r);
+        ccn_plan_destroy(p);
+        free(X0); free(N0); free(C0); free(X1); free(N1); free(C1); free(K1); free(K2); free(D1);
+    }
+}
+
 int main(void) {
     RUN(test_torus_equals_bspline);
     RUN(test_open_grid_equals_bspline);
     RUN(test_flags);
     RUN(test_ev_status);
+    RUN(test_curvature_leaves_the_surface_alone);
     return TEST_SUMMARY();
 }
