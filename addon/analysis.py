@@ -45,7 +45,8 @@ def colors(q, bad):
     else:
         r = 0.0
     if r > 0:
-        t = q.astype(np.float32) * np.float32(512.0 / r) + np.float32(512.5)
+        t = np.asarray(q, np.float32) * np.float32(512.0 / r)
+        t += np.float32(512.5)
         np.clip(t, 0.0, 1024.0, out=t)
         idx = t.astype(np.int32)
     else:
@@ -68,15 +69,21 @@ def write(me, curv, mode):
     if mode == 'NONE' or curv is None:
         clear(me)
         return
-    k1, k2 = curv[:, 0], curv[:, 1]
-    bad = ~(np.isfinite(k1) & np.isfinite(k2))
-    with np.errstate(invalid='ignore'):
-        gauss = np.where(bad, 0.0, k1 * k2)
-        mean = np.where(bad, 0.0, 0.5 * (k1 + k2))
+    # float32, what the attributes hold, each curvature a contiguous row (NaN: flagged; both are
+    # NaN together, and a value beyond float32 is flagged with them)
+    with np.errstate(invalid='ignore', over='ignore'):
+        k = curv.T.astype(np.float32)
+        k1, k2 = k[0], k[1]
+        mean = k1 + k2
+        bad = ~np.isfinite(mean)
+        mean *= np.float32(0.5)
+        gauss = k1 * k2
         q = gauss if mode == 'GAUSSIAN' else mean if mode == 'MEAN' else \
-            np.where(bad, 0.0, np.maximum(k1, -k2))  # max |k| (k1 >= k2)
-    for name, kind, prop, vals in ((NAMES[0], 'FLOAT', "value", gauss.astype(np.float32)),
-                                   (NAMES[1], 'FLOAT', "value", mean.astype(np.float32)),
+            np.maximum(k1, -k2)  # max |k| (k1 >= k2)
+        for a in {id(gauss): gauss, id(mean): mean, id(q): q}.values():
+            np.copyto(a, 0.0, where=bad)
+    for name, kind, prop, vals in ((NAMES[0], 'FLOAT', "value", gauss),
+                                   (NAMES[1], 'FLOAT', "value", mean),
                                    (NAMES[2], 'BOOLEAN', "value", bad)):
         attrs.attribute(me, name, kind, 'POINT').data.foreach_set(prop, vals)
     c, r = colors(q, bad)

@@ -130,6 +130,22 @@ void ccn__curvature_at(const ccn_plan *p, const double d[5][3], ccn_limit_mesh *
     k[1] /= p->scale;
 }
 
+void ccn__curvature_at_unit(const ccn_plan *p, const double d[5][3], const double nh[3],
+                            ccn_limit_mesh *out, int32_t o) {
+    double *k = out->curvatures + 2 * (size_t)o;
+    const double *su = d[0], *sv = d[1];
+    double E = dot3(su, su), F = dot3(su, sv), G = dot3(sv, sv), det = E * G - F * F;
+    if (!(det > 1e-300 * (E * G + 1e-300))) { /* (and the fallback normal of degenerate tangents) */
+        k[0] = k[1] = NAN;
+        return;
+    }
+    double L = -dot3(d[2], nh), M = -dot3(d[3], nh), N = -dot3(d[4], nh), idet = 1.0 / det;
+    double K = (L * N - M * M) * idet, H = (E * N - 2 * F * M + G * L) * (0.5 * idet);
+    double q = H * H - K, disc = q > 0 ? sqrt(q) : 0.0, s = 1.0 / p->scale;
+    k[0] = (H + disc) * s;
+    k[1] = (H - disc) * s;
+}
+
 void ccn__curvature_flag(ccn_limit_mesh *out, int32_t o) {
     out->curvatures[2 * (size_t)o] = out->curvatures[2 * (size_t)o + 1] = NAN;
     if (out->curvature_dirs)

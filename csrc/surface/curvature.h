@@ -15,6 +15,10 @@ void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, dou
 ccn_status ccn__curvature_prepare(ccn_plan *p, ccn_error *err);
 /* Output o's curvatures (and direction) from its derivatives in the unit box of evaluate. */
 void ccn__curvature_at(const ccn_plan *p, const double d[5][3], ccn_limit_mesh *out, int32_t o);
+/* The same from the unit normal of S_u x S_v (ccn__unit_normal of d[0], d[1]): one square
+ * root and one division fewer; no direction. */
+void ccn__curvature_at_unit(const ccn_plan *p, const double d[5][3], const double nh[3],
+                            ccn_limit_mesh *out, int32_t o);
 /* Output o: NaN, the flag (no bounded single value, or its cap's patch gives it later). */
 void ccn__curvature_flag(ccn_limit_mesh *out, int32_t o);
 /* After the stencil pass (which computed the CCN__CURV_ROW outputs and flagged the others) and

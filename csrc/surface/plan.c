@@ -272,29 +272,26 @@ static inline void apply_row(const ccn_plan *p, int32_t o, const double *const e
      * scalar loop, so the result is bit-identical */
     ccn__v2d xy = {0, 0}, uxy = {0, 0}, vxy = {0, 0};
     double x2 = 0, u2 = 0, v2 = 0;
-    if (!e) {
-        for (int32_t k = 0; k < n; k++) {
-            const double *q = SPOINT(idx[k]);
-            ccn__v2d qxy;
-            memcpy(&qxy, q, sizeof qxy);
-            double a = wp[k], b = wu[k], c = wv[k];
-            ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c};
-            xy += av * qxy; x2 += a * q[2];
-            uxy += bv * qxy; u2 += b * q[2];
-            vxy += cv * qxy; v2 += c * q[2];
-        }
-    } else {
+    for (int32_t k = 0; k < n; k++) {
+        const double *q = SPOINT(idx[k]);
+        ccn__v2d qxy;
+        memcpy(&qxy, q, sizeof qxy);
+        double a = wp[k], b = wu[k], c = wv[k];
+        ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c};
+        xy += av * qxy; x2 += a * q[2];
+        uxy += bv * qxy; u2 += b * q[2];
+        vxy += cv * qxy; v2 += c * q[2];
+    }
+    if (e) { /* a second pass over the same points (in cache): twelve accumulators in one
+              * pass would not fit the sixteen vector registers */
         ccn__v2d fxy = {0, 0}, gxy = {0, 0}, hxy = {0, 0};
         double f2 = 0, g2 = 0, h2 = 0;
         for (int32_t k = 0; k < n; k++) {
             const double *q = SPOINT(idx[k]);
             ccn__v2d qxy;
             memcpy(&qxy, q, sizeof qxy);
-            double a = wp[k], b = wu[k], c = wv[k], f = e[0][k], g = e[1][k], h = e[2][k];
-            ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c}, fv = {f, f}, gv = {g, g}, hv = {h, h};
-            xy += av * qxy; x2 += a * q[2];
-            uxy += bv * qxy; u2 += b * q[2];
-            vxy += cv * qxy; v2 += c * q[2];
+            double f = e[0][k], g = e[1][k], h = e[2][k];
+            ccn__v2d fv = {f, f}, gv = {g, g}, hv = {h, h};
             fxy += fv * qxy; f2 += f * q[2];
             gxy += gv * qxy; g2 += g * q[2];
             hxy += hv * qxy; h2 += h * q[2];
@@ -338,11 +335,13 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
         if (curv) ccn__plan_row_curv_weights(p, o, &e[0], &e[1], &e[2]);
         apply_row(p, o, curv ? e : NULL, x, d[0], d[1], d + 2);
         memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
-        if (curv) ccn__curvature_at(p, (const double(*)[3])d, out, o);
-        else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG) ccn__curvature_flag(out, o);
-        if (!out->normals) continue;
-        double *n = out->normals + 3 * (size_t)o;
-        ccn__unit_normal(d[0], d[1], n);
+        if (out->normals) ccn__unit_normal(d[0], d[1], out->normals + 3 * (size_t)o);
+        if (curv && out->normals && !out->curvature_dirs) /* the unit normal made just now */
+            ccn__curvature_at_unit(p, (const double(*)[3])d, out->normals + 3 * (size_t)o, out, o);
+        else if (curv)
+            ccn__curvature_at(p, (const double(*)[3])d, out, o);
+        else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG)
+            ccn__curvature_flag(out, o);
     }
 }
 
