@@ -255,69 +255,45 @@ ccn_status ccn_plan_get_stats(const ccn_plan *p, ccn_plan_stats *s) {
 
 typedef struct { const ccn_plan *p; ccn_limit_mesh *out; const int32_t *rows; } stencil_job; /* rows: NULL = all */
 
-/* Row o of the stencil table applied to the points: the limit position x and the tangents du,
- * dv; with e (the row's second-derivative weights wuu, wuv, wvv aligned with its entries, or
- * NULL) also S_uu, S_uv, S_vv into dd, from the same loads. x, du and dv do not depend on e:
- * the same products and sums either way. */
-static inline void apply_row(const ccn_plan *p, int32_t o, const double *const e[3], double x[3],
-                             double du[3], double dv[3], double dd[3][3]) {
+/* Three weighted sums of row o's points: s[t] = sum_k w[t][k] P(st_v[st_start[o] + k]) (the
+ * position and tangents with the row's weights; its second derivatives with the curvature
+ * weights, a second pass over the same points, in cache: twelve accumulators in one pass would
+ * not fit the sixteen vector registers). */
+static inline void row_sums(const ccn_plan *p, int32_t o, const double *const w[3], double s[3][3]) {
     const double *PL = p->lev[p->L]->pos, *PS = p->posS;
     int32_t nvL = p->lev[p->L]->nv;
-    const double *wp, *wu, *wv;
-    ccn__plan_row_weights(p, o, &wp, &wu, &wv);
     const int32_t *idx = p->st_v + p->st_start[o];
     int32_t n = p->st_start[o + 1] - p->st_start[o];
 #ifdef CCN_V2D
     /* x and y in one register pair, z alone: each lane the same products and sums as the
      * scalar loop, so the result is bit-identical */
-    ccn__v2d xy = {0, 0}, uxy = {0, 0}, vxy = {0, 0};
-    double x2 = 0, u2 = 0, v2 = 0;
+    ccn__v2d axy = {0, 0}, bxy = {0, 0}, cxy = {0, 0};
+    double a2 = 0, b2 = 0, c2 = 0;
     for (int32_t k = 0; k < n; k++) {
         const double *q = SPOINT(idx[k]);
         ccn__v2d qxy;
         memcpy(&qxy, q, sizeof qxy);
-        double a = wp[k], b = wu[k], c = wv[k];
+        double a = w[0][k], b = w[1][k], c = w[2][k];
         ccn__v2d av = {a, a}, bv = {b, b}, cv = {c, c};
-        xy += av * qxy; x2 += a * q[2];
-        uxy += bv * qxy; u2 += b * q[2];
-        vxy += cv * qxy; v2 += c * q[2];
+        axy += av * qxy; a2 += a * q[2];
+        bxy += bv * qxy; b2 += b * q[2];
+        cxy += cv * qxy; c2 += c * q[2];
     }
-    if (e) { /* a second pass over the same points (in cache): twelve accumulators in one
-              * pass would not fit the sixteen vector registers */
-        ccn__v2d fxy = {0, 0}, gxy = {0, 0}, hxy = {0, 0};
-        double f2 = 0, g2 = 0, h2 = 0;
-        for (int32_t k = 0; k < n; k++) {
-            const double *q = SPOINT(idx[k]);
-            ccn__v2d qxy;
-            memcpy(&qxy, q, sizeof qxy);
-            double f = e[0][k], g = e[1][k], h = e[2][k];
-            ccn__v2d fv = {f, f}, gv = {g, g}, hv = {h, h};
-            fxy += fv * qxy; f2 += f * q[2];
-            gxy += gv * qxy; g2 += g * q[2];
-            hxy += hv * qxy; h2 += h * q[2];
-        }
-        dd[0][0] = fxy[0], dd[0][1] = fxy[1], dd[0][2] = f2;
-        dd[1][0] = gxy[0], dd[1][1] = gxy[1], dd[1][2] = g2;
-        dd[2][0] = hxy[0], dd[2][1] = hxy[1], dd[2][2] = h2;
-    }
-    x[0] = xy[0], x[1] = xy[1], x[2] = x2;
-    du[0] = uxy[0], du[1] = uxy[1], du[2] = u2;
-    dv[0] = vxy[0], dv[1] = vxy[1], dv[2] = v2;
+    s[0][0] = axy[0], s[0][1] = axy[1], s[0][2] = a2;
+    s[1][0] = bxy[0], s[1][1] = bxy[1], s[1][2] = b2;
+    s[2][0] = cxy[0], s[2][1] = cxy[1], s[2][2] = c2;
 #else
-    double x0 = 0, x1 = 0, x2 = 0, u0 = 0, u1 = 0, u2 = 0, v0 = 0, v1 = 0, v2 = 0;
+    double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0, c0 = 0, c1 = 0, c2 = 0;
     for (int32_t k = 0; k < n; k++) {
         const double *q = SPOINT(idx[k]);
-        double a = wp[k], b = wu[k], c = wv[k];
-        x0 += a * q[0]; x1 += a * q[1]; x2 += a * q[2];
-        u0 += b * q[0]; u1 += b * q[1]; u2 += b * q[2];
-        v0 += c * q[0]; v1 += c * q[1]; v2 += c * q[2];
-        if (e)
-            for (int t = 0; t < 3; t++)
-                for (int c3 = 0; c3 < 3; c3++) dd[t][c3] += e[t][k] * q[c3];
+        double a = w[0][k], b = w[1][k], c = w[2][k];
+        a0 += a * q[0]; a1 += a * q[1]; a2 += a * q[2];
+        b0 += b * q[0]; b1 += b * q[1]; b2 += b * q[2];
+        c0 += c * q[0]; c1 += c * q[1]; c2 += c * q[2];
     }
-    x[0] = x0, x[1] = x1, x[2] = x2;
-    du[0] = u0, du[1] = u1, du[2] = u2;
-    dv[0] = v0, dv[1] = v1, dv[2] = v2;
+    s[0][0] = a0, s[0][1] = a1, s[0][2] = a2;
+    s[1][0] = b0, s[1][1] = b1, s[1][2] = b2;
+    s[2][0] = c0, s[2][1] = c1, s[2][2] = c2;
 #endif
 }
 
@@ -327,19 +303,25 @@ static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     ccn_limit_mesh *out = j->out;
     for (int32_t i = begin; i < end; i++) {
         int32_t o = j->rows ? j->rows[i] : i;
-        double d[5][3] = {{0}}, x[3];
-        /* with curvatures: the second derivatives from the same points, where the row's
-         * curvature stencil is its own points (curvature.c), else flagged or made later */
+        /* s: x, S_u, S_v; with curvatures S_uu, S_uv, S_vv from the same points, where the
+         * row's curvature stencil is its own points (curvature.c), else flagged or made later;
+         * s + 1 holds the five derivatives in the order of the curvature functions */
+        double s[6][3];
+        const double *w[3];
+        ccn__plan_row_weights(p, o, &w[0], &w[1], &w[2]);
+        row_sums(p, o, w, s);
         int curv = out->curvatures && p->curv_mode[o] == CCN__CURV_ROW;
-        const double *e[3] = {NULL, NULL, NULL};
-        if (curv) ccn__plan_row_curv_weights(p, o, &e[0], &e[1], &e[2]);
-        apply_row(p, o, curv ? e : NULL, x, d[0], d[1], d + 2);
-        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
-        if (out->normals) ccn__unit_normal(d[0], d[1], out->normals + 3 * (size_t)o);
+        if (curv) {
+            ccn__plan_row_curv_weights(p, o, &w[0], &w[1], &w[2]);
+            row_sums(p, o, w, s + 3);
+        }
+        const double(*d)[3] = (const double(*)[3])(s + 1);
+        memcpy(out->positions + 3 * (size_t)o, s[0], sizeof s[0]);
+        if (out->normals) ccn__unit_normal(s[1], s[2], out->normals + 3 * (size_t)o);
         if (curv && out->normals && !out->curvature_dirs) /* the unit normal made just now */
-            ccn__curvature_at_unit(p, (const double(*)[3])d, out->normals + 3 * (size_t)o, out, o);
+            ccn__curvature_at_unit(p, d, out->normals + 3 * (size_t)o, out, o);
         else if (curv)
-            ccn__curvature_at(p, (const double(*)[3])d, out, o);
+            ccn__curvature_at(p, d, out, o);
         else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG)
             ccn__curvature_flag(out, o);
     }
