@@ -80,7 +80,7 @@ def write(me, curv, mode):
         gauss = k1 * k2
         q = gauss if mode == 'GAUSSIAN' else mean if mode == 'MEAN' else \
             np.maximum(k1, -k2)  # max |k| (k1 >= k2)
-        for a in {id(gauss): gauss, id(mean): mean, id(q): q}.values():
+        for a in (gauss, mean, q) if mode == 'MAX' else (gauss, mean):  # q is one of them
             np.copyto(a, 0.0, where=bad)
     for name, kind, prop, vals in ((NAMES[0], 'FLOAT', "value", gauss),
                                    (NAMES[1], 'FLOAT', "value", mean),

@@ -50,11 +50,20 @@ typedef struct {
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+/* k1 >= k2 from the first fundamental form (E, F, G, det = EG - F^2) and the second (L, M, N,
+ * against the unit normal): K = (LN - M^2) / det, H = (EN - 2FM + GL) / (2 det). */
+static void forms_to_k(double E, double F, double G, double det, double L, double M, double N,
+                       double *k1, double *k2) {
+    double idet = 1.0 / det;
+    double K = (L * N - M * M) * idet, H = (E * N - 2 * F * M + G * L) * (0.5 * idet);
+    double q = H * H - K, disc = q > 0 ? sqrt(q) : 0.0;
+    *k1 = H + disc;
+    *k2 = H - disc;
+}
+
 void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, double dir[3]) {
     const double *su = d[0], *sv = d[1];
-    /* n = S_u x S_v unnormalised: |n|^2 = EG - F^2 (Lagrange), so the forms need one square
-     * root and one division: K = L'N' - M'^2 / det^2, H = (E N' - 2F M' + G L') / (2 det^1.5)
-     * with L' = -S_uu.n and so on */
+    /* det from the cross product (|S_u x S_v|^2 = EG - F^2, without the cancellation) */
     double n[3] = {su[1] * sv[2] - su[2] * sv[1], su[2] * sv[0] - su[0] * sv[2],
                    su[0] * sv[1] - su[1] * sv[0]};
     double E = dot3(su, su), F = dot3(su, sv), G = dot3(sv, sv), det = dot3(n, n);
@@ -63,14 +72,11 @@ void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, dou
         if (dir) dir[0] = dir[1] = dir[2] = NAN;
         return;
     }
-    double ln = sqrt(det), idet = 1.0 / det;
+    double ln = sqrt(det);
+    for (int i = 0; i < 3; i++) n[i] /= ln;
     double L = -dot3(d[2], n), M = -dot3(d[3], n), N = -dot3(d[4], n);
-    double K = (L * N - M * M) * idet * idet, H = (E * N - 2 * F * M + G * L) * (0.5 * idet / ln);
-    double q = H * H - K, disc = q > 0 ? sqrt(q) : 0.0;
-    *k1 = H + disc;
-    *k2 = H - disc;
+    forms_to_k(E, F, G, det, L, M, N, k1, k2);
     if (!dir) return;
-    L /= ln, M /= ln, N /= ln; /* the second fundamental form of the unit normal */
     /* (II - k1 I)(du, dv) = 0: the row of larger norm gives the kernel */
     double a = L - *k1 * E, b = M - *k1 * F, c = N - *k1 * G;
     double du, dv;
@@ -139,11 +145,9 @@ void ccn__curvature_at_unit(const ccn_plan *p, const double d[5][3], const doubl
         k[0] = k[1] = NAN;
         return;
     }
-    double L = -dot3(d[2], nh), M = -dot3(d[3], nh), N = -dot3(d[4], nh), idet = 1.0 / det;
-    double K = (L * N - M * M) * idet, H = (E * N - 2 * F * M + G * L) * (0.5 * idet);
-    double q = H * H - K, disc = q > 0 ? sqrt(q) : 0.0, s = 1.0 / p->scale;
-    k[0] = (H + disc) * s;
-    k[1] = (H - disc) * s;
+    forms_to_k(E, F, G, det, -dot3(d[2], nh), -dot3(d[3], nh), -dot3(d[4], nh), &k[0], &k[1]);
+    k[0] /= p->scale;
+    k[1] /= p->scale;
 }
 
 void ccn__curvature_flag(ccn_limit_mesh *out, int32_t o) {
@@ -306,8 +310,7 @@ static void other_range(void *ctx, int32_t begin, int32_t end) {
     }
 }
 
-ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err) {
-    (void)err;
+void ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out) {
     curv_job j = {p, out, NULL, NULL};
     ccn__parallel_for(p->threads, p->ncurv_other, other_range, &j);
     /* the patches: after ccn__caps_evaluate, which filled them */
@@ -334,5 +337,4 @@ ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *
         }
         ccn__curvature_at(p, (const double(*)[3])d, out, o);
     }
-    return CCN_OK;
 }

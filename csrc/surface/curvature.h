@@ -23,6 +23,6 @@ void ccn__curvature_at_unit(const ccn_plan *p, const double d[5][3], const doubl
 void ccn__curvature_flag(ccn_limit_mesh *out, int32_t o);
 /* After the stencil pass (which computed the CCN__CURV_ROW outputs and flagged the others) and
  * the caps: the outputs with stencils of their own, and the caps' and their rings' patches. */
-ccn_status ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out, ccn_error *err);
+void ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out);
 
 #endif

@@ -452,10 +452,7 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
     ccn_status st = ccn__caps_evaluate(p, out, written, err);
     if (st) { ccn__edit_region_free(r); return st; }
     if (out->corner_normals) eval_corner_normals(p, out);
-    if (out->curvatures && (st = ccn__curvature_evaluate(p, out, err))) {
-        ccn__edit_region_free(r);
-        return st;
-    }
+    if (out->curvatures) ccn__curvature_evaluate(p, out);
     for (int32_t o = 0; o < p->nout_v; o++)
         if (!written || written[o])
             for (int k = 0; k < 3; k++) out->positions[3 * (size_t)o + k] = centre[k] + scale * out->positions[3 * (size_t)o + k];

@@ -131,16 +131,18 @@ struct ccn_plan {
 
 enum { CCN__CURV_FLAG = 0, CCN__CURV_ROW = 1, CCN__CURV_OWN = 2, CCN__CURV_OWN_CHILD = 3 };
 
-/* The second-derivative weights of output o's stencil row, aligned with its entries
- * (curv_mode[o] == CCN__CURV_ROW). */
-static inline void ccn__plan_row_curv_weights(const ccn_plan *p, int32_t o, const double **wuu,
-                                              const double **wuv, const double **wvv) {
+/* Row o's three weight arrays in a table of own rows (own[t] + st_w[o]) and shared sets (27
+ * doubles per set in sets: 9 per array): the position weights wp, wu, wv (st_wp.., ws) or the
+ * curvature weights wuu, wuv, wvv aligned with them (curv_wuu.., curv_ws). */
+static inline void ccn__plan_row_table(const ccn_plan *p, int32_t o, const double *const own[3],
+                                       const double *sets, const double **w0, const double **w1,
+                                       const double **w2) {
     int32_t w = p->st_w[o];
     if (w >= 0) {
-        *wuu = p->curv_wuu + w; *wuv = p->curv_wuv + w; *wvv = p->curv_wvv + w;
+        *w0 = own[0] + w; *w1 = own[1] + w; *w2 = own[2] + w;
     } else {
-        const double *s = p->curv_ws + 27 * (size_t)(-1 - w);
-        *wuu = s; *wuv = s + 9; *wvv = s + 18;
+        const double *s = sets + 27 * (size_t)(-1 - w);
+        *w0 = s; *w1 = s + 9; *w2 = s + 18;
     }
 }
 
@@ -148,13 +150,16 @@ static inline void ccn__plan_row_curv_weights(const ccn_plan *p, int32_t o, cons
  * st_v[st_start[o] + k]. */
 static inline void ccn__plan_row_weights(const ccn_plan *p, int32_t o, const double **wp,
                                          const double **wu, const double **wv) {
-    int32_t w = p->st_w[o];
-    if (w >= 0) {
-        *wp = p->st_wp + w; *wu = p->st_wu + w; *wv = p->st_wv + w;
-    } else {
-        const double *s = p->ws + 27 * (size_t)(-1 - w);
-        *wp = s; *wu = s + 9; *wv = s + 18;
-    }
+    const double *own[3] = {p->st_wp, p->st_wu, p->st_wv};
+    ccn__plan_row_table(p, o, own, p->ws, wp, wu, wv);
+}
+
+/* The second-derivative weights of output o's stencil row, aligned with its entries
+ * (curv_mode[o] == CCN__CURV_ROW). */
+static inline void ccn__plan_row_curv_weights(const ccn_plan *p, int32_t o, const double **wuu,
+                                              const double **wuv, const double **wvv) {
+    const double *own[3] = {p->curv_wuu, p->curv_wuv, p->curv_wvv};
+    ccn__plan_row_table(p, o, own, p->curv_ws, wuu, wuv, wvv);
 }
 
 #endif
