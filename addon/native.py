@@ -296,6 +296,7 @@ class Plan:
         self._lib = lib
         self._handle = None
         self._buffers = None  # evaluate(topology=False)'s output arrays, reused
+        self._curv = None  # evaluate(topology=False, curvature=True)'s curvatures, reused
         self._last = None  # the own arrays the last evaluate(topology=False) wrote, else None
         # an interval edit's plan starts from the output of the plan it replaces: its first
         # evaluate writes only what the edit changed (ccn_plan_evaluate_changed)
@@ -401,9 +402,14 @@ class Plan:
                             corner_edge_origin=_ptr(out.get("corner_edge_origin"), ctypes.c_int32),
                             edge_verts=_ptr(out.get("edge_verts"), ctypes.c_int32),
                             corner_edges=_ptr(out.get("corner_edges"), ctypes.c_int32))
-        if curvature:
-            out["curvatures"] = np.empty((n, 2), np.float64)
-            lm.curvatures = _ptr(out["curvatures"], ctypes.c_double)
+        if curvature:  # position updates reuse the plan's array too (no fresh pages)
+            kept = self._curv if not topology else None
+            if kept is None or len(kept) != n:
+                kept = np.empty((n, 2), np.float64)
+                if not topology:
+                    self._curv = kept
+            out["curvatures"] = kept
+            lm.curvatures = _ptr(kept, ctypes.c_double)
         pos = None
         if positions is not None:
             pos = np.ascontiguousarray(positions, dtype=np.float64).reshape(-1)

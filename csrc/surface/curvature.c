@@ -50,17 +50,6 @@ typedef struct {
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* k1 >= k2 from the first fundamental form (E, F, G, det = EG - F^2) and the second (L, M, N,
- * against the unit normal): K = (LN - M^2) / det, H = (EN - 2FM + GL) / (2 det). */
-static void forms_to_k(double E, double F, double G, double det, double L, double M, double N,
-                       double *k1, double *k2) {
-    double idet = 1.0 / det;
-    double K = (L * N - M * M) * idet, H = (E * N - 2 * F * M + G * L) * (0.5 * idet);
-    double q = H * H - K, disc = q > 0 ? sqrt(q) : 0.0;
-    *k1 = H + disc;
-    *k2 = H - disc;
-}
-
 void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, double dir[3]) {
     const double *su = d[0], *sv = d[1];
     /* det from the cross product (|S_u x S_v|^2 = EG - F^2, without the cancellation) */
@@ -75,7 +64,7 @@ void ccn__principal_curvatures(const double d[5][3], double *k1, double *k2, dou
     double ln = sqrt(det);
     for (int i = 0; i < 3; i++) n[i] /= ln;
     double L = -dot3(d[2], n), M = -dot3(d[3], n), N = -dot3(d[4], n);
-    forms_to_k(E, F, G, det, L, M, N, k1, k2);
+    ccn__forms_to_k(E, F, G, det, L, M, N, 1.0, k1, k2);
     if (!dir) return;
     /* (II - k1 I)(du, dv) = 0: the row of larger norm gives the kernel */
     double a = L - *k1 * E, b = M - *k1 * F, c = N - *k1 * G;
@@ -132,20 +121,6 @@ void ccn__curvature_at(const ccn_plan *p, const double d[5][3], ccn_limit_mesh *
     ccn__principal_curvatures(d, &k[0], &k[1],
                               out->curvature_dirs ? out->curvature_dirs + 3 * (size_t)o : NULL);
     /* the levels' points are in the unit box of evaluate: lengths scale by p->scale */
-    k[0] /= p->scale;
-    k[1] /= p->scale;
-}
-
-void ccn__curvature_at_unit(const ccn_plan *p, const double d[5][3], const double nh[3],
-                            ccn_limit_mesh *out, int32_t o) {
-    double *k = out->curvatures + 2 * (size_t)o;
-    const double *su = d[0], *sv = d[1];
-    double E = dot3(su, su), F = dot3(su, sv), G = dot3(sv, sv), det = E * G - F * F;
-    if (!(det > 1e-300 * (E * G + 1e-300))) { /* (and the fallback normal of degenerate tangents) */
-        k[0] = k[1] = NAN;
-        return;
-    }
-    forms_to_k(E, F, G, det, -dot3(d[2], nh), -dot3(d[3], nh), -dot3(d[4], nh), &k[0], &k[1]);
     k[0] /= p->scale;
     k[1] /= p->scale;
 }

@@ -297,33 +297,45 @@ static inline void row_sums(const ccn_plan *p, int32_t o, const double *const w[
 #endif
 }
 
+/* In blocks of STENCIL_BLOCK rows: the sums of every row of the block first, then the normals
+ * and curvatures (square roots and divisions on the sums' results), so that the processor
+ * overlaps the rows' long dependency chains instead of waiting on each. */
+#define STENCIL_BLOCK 16
 static void stencil_range(void *ctx, int32_t begin, int32_t end) {
     const stencil_job *j = ctx;
     const ccn_plan *p = j->p;
     ccn_limit_mesh *out = j->out;
-    for (int32_t i = begin; i < end; i++) {
-        int32_t o = j->rows ? j->rows[i] : i;
-        /* s: x, S_u, S_v; with curvatures S_uu, S_uv, S_vv from the same points, where the
-         * row's curvature stencil is its own points (curvature.c), else flagged or made later;
-         * s + 1 holds the five derivatives in the order of the curvature functions */
-        double s[6][3];
-        const double *w[3];
-        ccn__plan_row_weights(p, o, &w[0], &w[1], &w[2]);
-        row_sums(p, o, w, s);
-        int curv = out->curvatures && p->curv_mode[o] == CCN__CURV_ROW;
-        if (curv) {
-            ccn__plan_row_curv_weights(p, o, &w[0], &w[1], &w[2]);
-            row_sums(p, o, w, s + 3);
+    double inv_scale = 1.0 / p->scale;
+    /* s: x, S_u, S_v; with curvatures S_uu, S_uv, S_vv from the same points, where the row's
+     * curvature stencil is its own points (curvature.c), else flagged or made later; s + 1
+     * holds the five derivatives in the order of the curvature functions */
+    double s[STENCIL_BLOCK][6][3];
+    for (int32_t i0 = begin; i0 < end; i0 += STENCIL_BLOCK) {
+        int32_t nb = end - i0 < STENCIL_BLOCK ? end - i0 : STENCIL_BLOCK;
+        for (int32_t b = 0; b < nb; b++) {
+            int32_t o = j->rows ? j->rows[i0 + b] : i0 + b;
+            const double *w[3];
+            ccn__plan_row_weights(p, o, &w[0], &w[1], &w[2]);
+            row_sums(p, o, w, s[b]);
+            if (out->curvatures && p->curv_mode[o] == CCN__CURV_ROW) {
+                ccn__plan_row_curv_weights(p, o, &w[0], &w[1], &w[2]);
+                row_sums(p, o, w, s[b] + 3);
+            }
         }
-        const double(*d)[3] = (const double(*)[3])(s + 1);
-        memcpy(out->positions + 3 * (size_t)o, s[0], sizeof s[0]);
-        if (out->normals) ccn__unit_normal(s[1], s[2], out->normals + 3 * (size_t)o);
-        if (curv && out->normals && !out->curvature_dirs) /* the unit normal made just now */
-            ccn__curvature_at_unit(p, d, out->normals + 3 * (size_t)o, out, o);
-        else if (curv)
-            ccn__curvature_at(p, d, out, o);
-        else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG)
-            ccn__curvature_flag(out, o);
+        for (int32_t b = 0; b < nb; b++) {
+            int32_t o = j->rows ? j->rows[i0 + b] : i0 + b;
+            int curv = out->curvatures && p->curv_mode[o] == CCN__CURV_ROW;
+            const double(*d)[3] = (const double(*)[3])(s[b] + 1);
+            memcpy(out->positions + 3 * (size_t)o, s[b][0], sizeof s[b][0]);
+            if (out->normals) ccn__unit_normal(s[b][1], s[b][2], out->normals + 3 * (size_t)o);
+            if (curv && out->normals && !out->curvature_dirs) /* the unit normal made just now */
+                ccn__curvature_at_unit(d, out->normals + 3 * (size_t)o, inv_scale,
+                                       out->curvatures + 2 * (size_t)o);
+            else if (curv)
+                ccn__curvature_at(p, d, out, o);
+            else if (out->curvatures && p->curv_mode[o] == CCN__CURV_FLAG)
+                ccn__curvature_flag(out, o);
+        }
     }
 }
 
