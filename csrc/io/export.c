@@ -13,6 +13,7 @@
 #include "io/export_model.h"
 #include "io/export_topo.h"
 #include "io/fill.h"
+#include "io/knot_removal.h"
 #include "io/packs.h"
 
 #include "base/error.h"
@@ -252,6 +253,11 @@ static void face_map(const ccn_export_options *o, const ccn__xmodel *xm) {
 
 /* ---- the export -------------------------------------------------------------------- */
 
+/* Knots the surface does not need are removed while each face moves by at most this much of
+ * its own size (io/knot_removal.c): far below the 1e-12 of the model's size the export keeps to
+ * the limit. */
+#define KNOT_TOLERANCE 1e-13
+
 static ccn_status build_faces(ccn__xmodel *xm, const ccn__plan_view *v, const rec_list *rl,
                               const ccn_export_options *o, ccn_export_info *inf, ccn_error *err) {
     const ccn_mesh *cage = v->lev[0];
@@ -395,6 +401,10 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (rl.oom) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (patches)"); goto done; }
     progress(&o, 0.15);
     if ((st = build_faces(&xm, &v, &rl, &o, &inf, err))) goto done;
+    if (!(o.flags & CCN_EXPORT_UNPACKED) && ccn__xm_remove_knots(&xm, KNOT_TOLERANCE) < 0) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (knot removal)");
+        goto done;
+    }
     if (xm.num_faces == 0) {
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_NONE, -1, "the cage has no surface to export");
         goto done;

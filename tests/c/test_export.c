@@ -11,6 +11,7 @@
  * and a message naming the problem, a failing sink gives CCN_ERR_IO, output is deterministic.
  */
 #include "ccnurbs.h"
+#include "io/knot_removal.h"
 #include "surface/patches.h"
 #include "testlib.h"
 
@@ -325,6 +326,176 @@ static void test_cages(void) {
     check_cage("fig18_v8", 0, 9); /* 8 boundary corners + the centre: a cap fallback (kappa) */
     check_cage("fig16_v6", 0, 7);
     check_cage("mixed_boundary", 0, 11);
+    check_cage("torus_semi", 1, 0);
+}
+
+/* Largest number of distinct interior knots of an exported face in one direction. */
+static int max_interior_knots(const char *name) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 3;
+    ccn_plan *p = load(name, &obj, &cage, &o);
+    if (!p) return -1;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    int most = -1;
+    if (run(p, &eo, &F, &s, &info, &err) == CCN_OK) {
+        most = 0;
+        for (int i = 0; i < F.n; i++)
+            for (int d = 0; d < 2; d++) {
+                int distinct = 0;
+                for (int k = 1; k < F.f[i].nt[d]; k++) distinct += F.f[i].t[d][k] != F.f[i].t[d][k - 1];
+                if (distinct - 1 > most) most = distinct - 1;
+            }
+        faces_free(&F);
+    }
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+    return most;
+}
+
+/* Along a ring of semi-sharp edges of constant sharpness the limit is the cage's own B-spline
+ * (the crease rules are the cubic's along it), and across it only the knots at 2^-j of a cage
+ * interval (j <= ceil(sharpness)) are new: the refined bands around the crease rings of
+ * torus_semi (8 x 6 cage edges, sharpness 2 and 2.5) need at most 8 + 2 x 2 x 3 = 20 interior
+ * knots in a direction, where the level-3 pieces carry 8 x 8 = 64 along a ring. */
+static void test_semi_sharp_knots(void) {
+    int most = max_interior_knots("torus_semi");
+    CHECK(most >= 0 && most <= 20, "torus_semi: a face with %d interior knots in one direction", most);
+    printf("# torus_semi: at most %d interior knots per face and direction\n", most);
+}
+
+/* ---- knot removal (io/knot_removal.c), against a refinement made here ----------------------- */
+
+/* Boehm: u inserted into flat knots t (n + p + 1) of a row of n poles (3 each; room for n + 1). */
+static void boehm(double *t, int p, int *n, double *P, double u) {
+    int k = p;
+    while (k + 1 < *n && t[k + 1] <= u) k++;
+    for (int i = *n; i > k; i--) memcpy(P + 3 * i, P + 3 * (i - 1), sizeof(double) * 3);
+    for (int i = k; i >= k - p + 1; i--) {
+        double a = (u - t[i]) / (t[i + p] - t[i]);
+        for (int c = 0; c < 3; c++) P[3 * i + c] = a * P[3 * i + c] + (1 - a) * P[3 * (i - 1) + c];
+    }
+    memmove(t + k + 2, t + k + 1, sizeof(double) * (size_t)(*n + p - k));
+    t[k + 1] = u;
+    (*n)++;
+}
+
+/* A random bicubic surface on clamped knots with random intervals, refined here by inserting
+ * random knots along u (one row at a time: the tensor product), handed to the removal: it must
+ * give back exactly the coarse knots (the random poles make the surface only C2 at those) and
+ * the same surface (evaluated by this file's Cox-de Boor) within its tolerance. */
+static void test_knot_removal(void) {
+    for (int trial = 0; trial < 20; trial++) {
+        int p = 3, n0 = 4 + trial % 5, nv = 4 + trial % 3, extra = 1 + 7 * (trial % 4);
+        double t0[64], tv[16];
+        for (int i = 0; i <= p; i++) t0[i] = 0;
+        for (int i = p + 1; i <= n0 + p; i++) t0[i] = i <= n0 ? t0[i - 1] + 0.2 + tl_rand01() : t0[n0];
+        for (int i = 0; i < nv + p + 1; i++) tv[i] = i <= p ? 0 : i >= nv ? nv - p : i - p;
+        double *P0 = malloc(sizeof(double) * 3 * (size_t)n0 * nv);
+        for (int i = 0; i < 3 * n0 * nv; i++) P0[i] = tl_rand01();
+        /* refine: the same insertions in every v column (pole (i, j) at 3 (i nv + j)) */
+        double ins[40];
+        for (int e = 0; e < extra; e++) ins[e] = t0[p] + (t0[n0] - t0[p]) * (0.02 + 0.96 * tl_rand01());
+        int nf = n0 + extra;
+        double *Pf = malloc(sizeof(double) * 3 * (size_t)nf * nv), tf[64];
+        for (int j = 0; j < nv; j++) {
+            double row[3 * 64], t[64];
+            int n = n0;
+            memcpy(t, t0, sizeof(double) * (size_t)(n0 + p + 1));
+            for (int i = 0; i < n0; i++) memcpy(row + 3 * i, P0 + 3 * (i * nv + j), sizeof(double) * 3);
+            for (int e = 0; e < extra; e++) boehm(t, p, &n, row, ins[e]);
+            for (int i = 0; i < nf; i++) memcpy(Pf + 3 * (i * nv + j), row + 3 * i, sizeof(double) * 3);
+            memcpy(tf, t, sizeof(double) * (size_t)(nf + p + 1));
+        }
+        ccn__xmodel xm;
+        memset(&xm, 0, sizeof xm);
+        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_PACK, p, p, nf, nv, 1, 1);
+        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
+        if (f != 0) return;
+        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        int64_t got = ccn__xm_remove_knots(&xm, 1e-12);
+        const ccn__cad_surface *S = &xm.faces[0].s;
+        int same = S->num_poles[0] == n0 && S->num_poles[1] == nv && got == extra;
+        for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k == 0 ? 0 : k + p];
+        CHECK(same, "trial %d: %lld of %d inserted knots removed, %d poles along u for %d", trial,
+              (long long)got, extra, (int)S->num_poles[0], n0);
+        face a = {0}, b = {0};
+        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
+        a.np[0] = nf, a.np[1] = nv, a.t[0] = tf, a.t[1] = tv, a.P = Pf;
+        double tr[64];
+        int m = 0;
+        for (int k = 0; k < S->num_knots[0]; k++)
+            for (int c = 0; c < S->mults[0][k]; c++) tr[m++] = S->knots[0][k];
+        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = tr, b.t[1] = tv, b.P = (double *)S->poles;
+        double worst = 0;
+        for (int k = 0; k < 200; k++) {
+            double u = t0[p] + (t0[n0] - t0[p]) * tl_rand01(), v = tv[nv] * tl_rand01(), x[3], y[3];
+            feval(&a, u, v, x);
+            feval(&b, u, v, y);
+            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
+        }
+        CHECK(worst <= 1e-12, "trial %d: the surface moved %g", trial, worst);
+        ccn__xm_free(&xm);
+        free(P0);
+        free(Pf);
+    }
+    /* closed: a periodic cubic (integer knots, m spans, random poles) refined by the curve's
+     * own midpoint rules (vertex (1,6,1)/8, edge (1,1)/2: half the knot spacing) along u; the
+     * removal gives back the periodic face of m spans and the same surface */
+    for (int trial = 0; trial < 6; trial++) {
+        int p = 3, m = 4 + trial, nv = 4, n0 = m + p, nf = 2 * m + p;
+        double t0[64], tf[64], tv[16];
+        for (int k = 0; k <= n0 + p; k++) t0[k] = k - p;
+        for (int k = 0; k <= nf + p; k++) tf[k] = 0.5 * (k - p);
+        for (int i = 0; i < nv + p + 1; i++) tv[i] = i <= p ? 0 : i >= nv ? nv - p : i - p;
+        double P0[3 * 16 * 4], Pf[3 * 32 * 4];
+        for (int i = 0; i < m; i++)
+            for (int j = 0; j < nv; j++)
+                for (int c = 0; c < 3; c++) P0[3 * (i * nv + j) + c] = tl_rand01();
+        for (int i = m; i < n0; i++) memcpy(P0 + 3 * i * nv, P0 + 3 * (i - m) * nv, sizeof(double) * 3 * nv);
+        for (int jj = 0; jj < 2 * m; jj++)
+            for (int j = 0; j < nv; j++)
+                for (int c = 0; c < 3; c++) {
+                    int i = (jj + 1) / 2;
+#define CP(k) P0[3 * ((((k) % m + m) % m) * nv + j) + c]
+                    Pf[3 * (jj * nv + j) + c] = jj % 2 ? (CP(i - 1) + 6 * CP(i) + CP(i + 1)) / 8 : (CP(i) + CP(i + 1)) / 2;
+#undef CP
+                }
+        for (int i = 2 * m; i < nf; i++) memcpy(Pf + 3 * i * nv, Pf + 3 * (i - 2 * m) * nv, sizeof(double) * 3 * nv);
+        ccn__xmodel xm;
+        memset(&xm, 0, sizeof xm);
+        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_PACK, p, p, nf, nv, 1, 1);
+        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
+        if (f != 0) return;
+        xm.faces[0].s.periodic[0] = 1;
+        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        int64_t got = ccn__xm_remove_knots(&xm, 1e-12);
+        const ccn__cad_surface *S = &xm.faces[0].s;
+        int same = S->periodic[0] && S->num_poles[0] == n0 && got == m && S->num_knots[0] == n0 + p + 1;
+        for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k];
+        CHECK(same, "closed trial %d: %lld knots removed, periodic %d, %d poles along u for %d", trial,
+              (long long)got, (int)S->periodic[0], (int)S->num_poles[0], n0);
+        face a = {0}, b = {0};
+        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
+        a.np[0] = n0, a.np[1] = nv, a.t[0] = t0, a.t[1] = tv, a.P = P0;
+        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = t0, b.t[1] = tv, b.P = (double *)S->poles;
+        double worst = 0;
+        for (int k = 0; same && k < 200; k++) {
+            double u = m * tl_rand01(), v = tv[nv] * tl_rand01(), x[3], y[3];
+            feval(&a, u, v, x);
+            feval(&b, u, v, y);
+            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
+        }
+        CHECK(worst <= 1e-12, "closed trial %d: the surface moved %g", trial, worst);
+        ccn__xm_free(&xm);
+    }
 }
 
 /* The exact pieces around holes equal the strict patches of a global refinement. */
@@ -536,5 +707,7 @@ int main(void) {
     RUN(test_torus_pack);
     RUN(test_refined);
     RUN(test_cages);
+    RUN(test_semi_sharp_knots);
+    RUN(test_knot_removal);
     return TEST_SUMMARY();
 }

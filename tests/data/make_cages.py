@@ -59,7 +59,7 @@ def fmt(x):
     return s
 
 
-def write(outdir, name, V, F, comment, knots=None):
+def write(outdir, name, V, F, comment, knots=None, creases=None):
     closed = check(name, V, F)
     path = os.path.join(outdir, name)
     with open(path, "w") as fh:
@@ -73,6 +73,8 @@ def write(outdir, name, V, F, comment, knots=None):
         if knots:
             for (a, b), d in knots:
                 fh.write("# knot %d %d %s\n" % (a + 1, b + 1, repr(float(d)).rstrip("0").rstrip(".")))
+        for (a, b), c in creases or []:
+            fh.write("# crease %d %d %s\n" % (a + 1, b + 1, repr(float(c)).rstrip("0").rstrip(".")))
     return closed
 
 
@@ -198,6 +200,20 @@ def torus(nu=8, nv=6, R=2.0, r=0.7):
     if signed_volume(V, F) < 0:
         F = [list(reversed(f)) for f in F]
     return V, F
+
+
+def torus_semi(nu=8, nv=6):
+    """The torus, every vertex moved by a deterministic wobble (no symmetry), with two closed
+    rings of semi-sharp edges that cross at one vertex: around the tube at u = 0 (sharpness 2)
+    and along it at v = 0 (sharpness 2.5)."""
+    V, F = torus(nu, nv)
+    for k, p in enumerate(V):
+        for c in range(3):
+            p[c] += 0.08 * math.sin(1.7 * k + 2.3 * c + 0.5)
+    idx = lambda i, j: (i % nu) * nv + (j % nv)
+    creases = [((idx(0, j), idx(0, j + 1)), 2.0) for j in range(nv)]
+    creases += [((idx(i, 0), idx(i + 1, 0)), 2.5) for i in range(nu)]
+    return V, F, creases
 
 
 def prism_pyramid():
@@ -420,6 +436,11 @@ CAGES = [
     ("jitter_flip.obj", jitter_flip, "flip35 with random non-planar jitter"),
 ]
 
+CREASED = [
+    ("torus_semi.obj", torus_semi,
+     "closed 8x6 torus, wobbled, two closed rings of semi-sharp edges (2 and 2.5) crossing"),
+]
+
 FIGS = [
     # not a paper figure: valence 8 with d_{s+2} != d_{s-2} and ratios 1:3 (the bi-5 cap on the
     # exact level-(K+1) surround, csrc/surround.c)
@@ -539,6 +560,9 @@ def main():
     for name, fn, comment in KNOTTED:
         V, F, knots = fn()
         write(outdir, name, V, F, comment, knots)
+    for name, fn, comment in CREASED:
+        V, F, creases = fn()
+        write(outdir, name, V, F, comment, creases=creases)
     for name, n, d in FIGS:
         V, F, knots = fig(n, d)
         write(outdir, name, V, F,

@@ -1,0 +1,311 @@
+/* Knot removal (io/knot_removal.h).
+ *
+ * Why: the export's refined pieces (the rings around semi-sharp creases and fallback holes,
+ * io/fill.c) are packed at the level where they became exact, with that level's knots. Where
+ * the limit is smoother than that (along a crease chain of constant sharpness it is the cage's
+ * own B-spline; across it only the knots at 2^-j of the crease remain), those knots are
+ * redundant and cost the file a pole row each. Removing them keeps the surface and its
+ * parametrisation and shrinks the nets by up to the refinement factor (2^levels).
+ *
+ * A5.8 with one removal of a simple knot u = U[r] of degree p: the poles first = r - p ..
+ * last = r - 1 are recomputed from both ends,
+ *   left:  Q_i = (P_i - (1 - a_i) Q_{i-1}) / a_i,   a_i = (u - U_i) / (U_{i+p+1} - U_i),
+ *   right: Q_j = (P_j - a_j Q_{j+1}) / (1 - a_j),
+ * and the knot is removable when the two meet: |P_m - (a_m Q_{m+1} + (1 - a_m) Q_{m-1})| <= d
+ * at the middle pole m (p odd) or |Q_left - Q_right| <= d (p even); the surface then moves by
+ * at most d. Every pole row of the direction must pass, each removal within tol; the removals
+ * of a direction are then checked together (verified): the removed knots inserted back must
+ * give the original poles within tol, or the direction is left as it was. */
+#include "io/knot_removal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KR_MAX_DEGREE 8 /* the export's faces are of degree 3 and 5 */
+
+static double dist3(const double *a, const double *b) {
+    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return sqrt(x * x + y * y + z * z);
+}
+
+/* One row's removal poles: Q (p + 2 points, Q[0] = P[first-1], Q[p+1] = P[last+1]) and the
+ * meeting distance. P: the row's poles (3 each, stride 3). */
+static double row_try(const double *U, int32_t p, int32_t r, const double *P, double Q[][3]) {
+    double u = U[r];
+    int32_t first = r - p, last = r - 1, off = first - 1;
+    memcpy(Q[0], P + 3 * (size_t)off, sizeof Q[0]);
+    memcpy(Q[last + 1 - off], P + 3 * (size_t)(last + 1), sizeof Q[0]);
+    int32_t i = first, j = last, ii = 1, jj = last - off;
+    while (j - i > 0) {
+        double ai = (u - U[i]) / (U[i + p + 1] - U[i]), aj = (u - U[j]) / (U[j + p + 1] - U[j]);
+        for (int c = 0; c < 3; c++) {
+            Q[ii][c] = (P[3 * (size_t)i + c] - (1 - ai) * Q[ii - 1][c]) / ai;
+            Q[jj][c] = (P[3 * (size_t)j + c] - aj * Q[jj + 1][c]) / (1 - aj);
+        }
+        i++, ii++, j--, jj--;
+    }
+    if (j - i < 0) return dist3(Q[ii - 1], Q[jj + 1]);
+    double ai = (u - U[i]) / (U[i + p + 1] - U[i]), m[3];
+    for (int c = 0; c < 3; c++) m[c] = ai * Q[ii + 1][c] + (1 - ai) * Q[ii - 1][c];
+    return dist3(P + 3 * (size_t)i, m);
+}
+
+/* Direction with rows x n poles W[row][k] (3 each) and flat knots U (n + p + 1, clamped: the
+ * interior knots are U[p+1 .. n-1]): removes each knot whose removal is within step_tol. Returns the number
+ * removed; *n and U, W updated. */
+static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double step_tol) {
+    int32_t removed = 0, N = *n;
+    double Q[KR_MAX_DEGREE + 2][3];
+    int32_t r = p + 1;
+    while (r <= N - 1) {
+        /* a simple interior knot at flat index r */
+        if (!(U[r] > U[r - 1] && U[r + 1] > U[r])) { r++; continue; }
+        double worst = 0;
+        for (int32_t row = 0; row < rows && worst <= step_tol; row++)
+            worst = fmax(worst, row_try(U, p, r, W + 3 * (size_t)row * (size_t)N, Q));
+        if (!(worst <= step_tol)) { r++; continue; }
+        int32_t first = r - p, last = r - 1, off = first - 1, fout = (2 * r - 1 - p) / 2;
+        double *Wn = W; /* rows re-packed in place at the new row length N - 1 */
+        for (int32_t row = 0; row < rows; row++) {
+            double *P = W + 3 * (size_t)row * (size_t)N;
+            row_try(U, p, r, P, Q);
+            for (int32_t i = first, j = last; j - i > 0; i++, j--) {
+                memcpy(P + 3 * (size_t)i, Q[i - off], sizeof Q[0]);
+                memcpy(P + 3 * (size_t)j, Q[j - off], sizeof Q[0]);
+            }
+            double *D = Wn + 3 * (size_t)row * (size_t)(N - 1);
+            memmove(D, P, sizeof(double) * 3 * (size_t)fout);
+            memmove(D + 3 * (size_t)fout, P + 3 * (size_t)(fout + 1), sizeof(double) * 3 * (size_t)(N - 1 - fout));
+        }
+        memmove(U + r, U + r + 1, sizeof(double) * (size_t)(N + p - r));
+        N--;
+        removed++;
+    }
+    *n = N;
+    return removed;
+}
+
+/* Boehm's insertion of u into one row: flat knots U (N + p + 1), poles P (N, 3 each; room for
+ * N + 1). */
+static void insert_knot(double *U, int32_t p, int32_t *N, double *P, double u) {
+    int32_t n = *N, k = p;
+    while (k + 1 < n && U[k + 1] <= u) k++;
+    for (int32_t i = n; i > k; i--) memcpy(P + 3 * (size_t)i, P + 3 * (size_t)(i - 1), sizeof(double) * 3);
+    for (int32_t i = k; i >= k - p + 1; i--) {
+        double a = (u - U[i]) / (U[i + p] - U[i]);
+        for (int c = 0; c < 3; c++) P[3 * (size_t)i + c] = a * P[3 * (size_t)i + c] + (1 - a) * P[3 * (size_t)(i - 1) + c];
+    }
+    memmove(U + k + 2, U + k + 1, sizeof(double) * (size_t)(n + p - k));
+    U[k + 1] = u;
+    *N = n + 1;
+}
+
+/* The removal checked as a whole: the removed knots inserted back into every row of (U1, W1)
+ * give the original poles W0 within tol (a bound on the surface's move: a B-spline lies in the
+ * convex hull of its poles, so it moves by at most its poles' largest move). */
+static int verified(const double *U0, const double *W0, int32_t n, const double *U1, const double *W1,
+                    int32_t n1, int32_t p, int32_t rows, double tol) {
+    double *U = malloc(sizeof(double) * (size_t)(n + p + 1)), *P = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!U || !P) { free(U); free(P); return -1; }
+    int ok = 1;
+    for (int32_t row = 0; row < rows && ok; row++) {
+        memcpy(U, U1, sizeof(double) * (size_t)(n1 + p + 1));
+        memcpy(P, W1 + 3 * (size_t)row * (size_t)n1, sizeof(double) * 3 * (size_t)n1);
+        int32_t N = n1;
+        /* the knots of U0 missing from U1 (both sorted), in increasing order */
+        for (int32_t i = 0, j = 0; i < n + p + 1; i++) {
+            if (j < n1 + p + 1 && U1[j] == U0[i]) { j++; continue; }
+            insert_knot(U, p, &N, P, U0[i]);
+        }
+        for (int32_t k = 0; k < n && ok; k++) ok = dist3(P + 3 * (size_t)k, W0 + 3 * ((size_t)row * n + k)) <= tol;
+    }
+    free(U);
+    free(P);
+    return ok;
+}
+
+/* A periodic direction in clamped form over the same domain [U[p], U[n]]: U[p] and U[n]
+ * inserted p times each (exact), the poles whose basis functions live in the domain kept:
+ * n poles per row, flat knots U'[p .. n + 2p] (n + p + 1). The face's two sides at the seam
+ * then meet as an edge of the face with itself (C2 across it, as before). U: room for
+ * n + 3p + 1; W: rows x (n + 2p), repacked to rows x n. -1: out of memory. */
+static int unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W) {
+    int32_t ext = n + 2 * p, m = n + p + 1;
+    double *Ur = malloc(sizeof(double) * (size_t)(m + 2 * p));
+    if (!Ur) return -1;
+    double u0 = U[p], u1 = U[n];
+    for (int32_t row = rows - 1; row >= 0; row--) /* rows spread to stride ext (backwards) */
+        memmove(W + 3 * (size_t)row * ext, W + 3 * (size_t)row * n, sizeof(double) * 3 * (size_t)n);
+    for (int32_t row = 0; row < rows; row++) {
+        double *Uw = row == rows - 1 ? U : Ur; /* the last row leaves its knots in U */
+        if (Uw != U) memcpy(Uw, U, sizeof(double) * (size_t)m);
+        int32_t N = n;
+        double *P = W + 3 * (size_t)row * ext;
+        for (int32_t k = 0; k < p; k++) insert_knot(Uw, p, &N, P, u0);
+        for (int32_t k = 0; k < p; k++) insert_knot(Uw, p, &N, P, u1);
+    }
+    for (int32_t row = 0; row < rows; row++)
+        memmove(W + 3 * (size_t)row * n, W + 3 * ((size_t)row * ext + p), sizeof(double) * 3 * (size_t)n);
+    memmove(U, U + p, sizeof(double) * (size_t)m);
+    free(Ur);
+    return 0;
+}
+
+/* Back to the periodic form after the removal (so that a closed face stays one periodic face,
+ * as the writers and readers know it): the clamped (U, W) of n poles over [u0, u1] with
+ * m = n - p spans is the unwrapping (unwrap_periodic) of the periodic spline with the same
+ * interior knots, extended with the period, and m distinct poles Q (the last p repeating the
+ * first p). unwrap is linear in Q, so Q is the least-squares solution of A Q = W's rows, A the
+ * unwrapping of the unit pole vectors, and is kept only if it reproduces W within tol. Returns
+ * 0 (U, W periodic), 1 (left clamped: too many spans for the dense solve, too few for a
+ * periodic form, or not reproduced), -1 out of memory. */
+#define KR_MAX_PERIODIC_SPANS 400
+static int rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol) {
+    int32_t m = n - p, ext = n + 2 * p;
+    if (m < p + 1 || m > KR_MAX_PERIODIC_SPANS) return 1;
+    double T = U[n + p] - U[0];
+    double *Up = malloc(sizeof(double) * (size_t)(n + 3 * p + 1));
+    double *Ub = malloc(sizeof(double) * (size_t)(n + 3 * p + 1));
+    double *B = malloc(sizeof(double) * 3 * (size_t)m * ext);     /* unit rows, unwrapped */
+    double *M = malloc(sizeof(double) * (size_t)m * m), *Q = malloc(sizeof(double) * 3 * (size_t)n * rows);
+    double *A = malloc(sizeof(double) * (size_t)n * m);
+    int st = 1;
+    if (!Up || !Ub || !B || !M || !Q || !A) { st = -1; goto out; }
+    /* periodic flat knots: the clamped interior with p knots of the neighbouring period on each side */
+    for (int32_t i = 0; i < p; i++) Up[i] = U[n - p + i] - T;           /* k_{m-p} .. k_{m-1} - T */
+    for (int32_t i = 0; i <= m; i++) Up[p + i] = U[p + i];               /* u0, k_1 .. k_{m-1}, u1 */
+    for (int32_t i = 1; i <= p; i++) Up[p + m + i] = U[p + i] + T;       /* k_1 .. k_p + T */
+    for (int32_t i = 1; i <= 2 * p; i++)
+        if (!(Up[i] > Up[i - 1]) || !(Up[p + m + i - p] > Up[p + m + i - p - 1])) goto out; /* simple knots only */
+    for (int32_t r = 0; r < m; r++) {
+        double *row = B + 3 * (size_t)r * n; /* packed rows: unwrap_periodic spreads them */
+        memset(row, 0, sizeof(double) * 3 * (size_t)n);
+        row[3 * r] = 1;
+        if (r < p) row[3 * (r + m)] = 1;
+    }
+    memcpy(Ub, Up, sizeof(double) * (size_t)(n + p + 1));
+    /* unwrap_periodic packs rows to stride n: A[i][r] = unit row r's pole i */
+    if (unwrap_periodic(Ub, p, n, m, B)) { st = -1; goto out; }
+    for (int32_t r = 0; r < m; r++)
+        for (int32_t i = 0; i < n; i++) A[(size_t)i * m + r] = B[3 * ((size_t)r * n + i)];
+    for (int32_t a = 0; a < m; a++) /* M = A^T A, Cholesky in place (lower) */
+        for (int32_t b = 0; b <= a; b++) {
+            double acc = 0;
+            for (int32_t i = 0; i < n; i++) acc += A[(size_t)i * m + a] * A[(size_t)i * m + b];
+            M[(size_t)a * m + b] = acc;
+        }
+    for (int32_t j = 0; j < m; j++) {
+        double d = M[(size_t)j * m + j];
+        for (int32_t k = 0; k < j; k++) d -= M[(size_t)j * m + k] * M[(size_t)j * m + k];
+        if (!(d > 1e-300)) goto out;
+        d = sqrt(d);
+        M[(size_t)j * m + j] = d;
+        for (int32_t i = j + 1; i < m; i++) {
+            double x = M[(size_t)i * m + j];
+            for (int32_t k = 0; k < j; k++) x -= M[(size_t)i * m + k] * M[(size_t)j * m + k];
+            M[(size_t)i * m + j] = x / d;
+        }
+    }
+    for (int32_t row = 0; row < rows; row++) {
+        const double *C = W + 3 * (size_t)row * n;
+        double *q = Q + 3 * (size_t)row * n;
+        for (int c = 0; c < 3; c++) {
+            double y[KR_MAX_PERIODIC_SPANS];
+            for (int32_t a = 0; a < m; a++) { /* A^T C, then forward and back substitution */
+                double acc = 0;
+                for (int32_t i = 0; i < n; i++) acc += A[(size_t)i * m + a] * C[3 * (size_t)i + c];
+                for (int32_t k = 0; k < a; k++) acc -= M[(size_t)a * m + k] * y[k];
+                y[a] = acc / M[(size_t)a * m + a];
+            }
+            for (int32_t a = m - 1; a >= 0; a--) {
+                double acc = y[a];
+                for (int32_t k = a + 1; k < m; k++) acc -= M[(size_t)k * m + a] * q[3 * (size_t)k + c];
+                q[3 * (size_t)a + c] = acc / M[(size_t)a * m + a];
+            }
+        }
+        for (int32_t i = m; i < n; i++) memcpy(q + 3 * (size_t)i, q + 3 * (size_t)(i - m), sizeof(double) * 3);
+        for (int32_t i = 0; i < n; i++) { /* reproduces the clamped poles? */
+            double x[3] = {0, 0, 0};
+            for (int32_t r = 0; r < m; r++)
+                for (int c = 0; c < 3; c++) x[c] += A[(size_t)i * m + r] * q[3 * (size_t)r + c];
+            if (!(dist3(x, C + 3 * (size_t)i) <= tol)) goto out;
+        }
+    }
+    memcpy(U, Up, sizeof(double) * (size_t)(n + p + 1));
+    memcpy(W, Q, sizeof(double) * 3 * (size_t)n * rows);
+    st = 0;
+out:
+    free(Up); free(Ub); free(B); free(M); free(Q); free(A);
+    return st;
+}
+
+static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
+    ccn__cad_surface *s = &xm->faces[f].s;
+    int32_t nu = s->num_poles[0], nv = s->num_poles[1];
+    int64_t removed = 0;
+    for (int dir = 0; dir < 2; dir++) {
+        int32_t p = s->degree[dir], n = s->num_poles[dir], rows = s->num_poles[1 - dir];
+        int per = s->periodic[dir];
+        if (p > KR_MAX_DEGREE || s->num_knots[dir] <= 2) continue;
+        if (!per && (s->mults[dir][0] != p + 1 || s->mults[dir][s->num_knots[dir] - 1] != p + 1)) continue;
+        int32_t m = n + p + 1, ext = n + 2 * p;
+        double *U = malloc(sizeof(double) * (2 * (size_t)m + 2 * (size_t)p));
+        double *W = malloc(sizeof(double) * 3 * ((size_t)ext + (size_t)n) * (size_t)rows);
+        if (!U || !W) { free(U); free(W); return -1; }
+        double *U0 = U + m + 2 * p, *W0 = W + 3 * (size_t)ext * (size_t)rows;
+        for (int32_t k = 0, i = 0; k < s->num_knots[dir]; k++)
+            for (int32_t c = 0; c < s->mults[dir][k]; c++) U[i++] = s->knots[dir][k];
+        /* W[row][k]: pole k along dir of row `row` */
+        const double *P = s->poles;
+        for (int32_t row = 0; row < rows; row++)
+            for (int32_t k = 0; k < n; k++)
+                memcpy(W + 3 * ((size_t)row * n + k),
+                       P + 3 * (dir == 0 ? (size_t)k * nv + row : (size_t)row * nv + k), sizeof(double) * 3);
+        if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
+        memcpy(U0, U, sizeof(double) * (size_t)m);
+        memcpy(W0, W, sizeof(double) * 3 * (size_t)n * (size_t)rows);
+        int32_t n1 = n, got = remove_dir(U, p, &n1, rows, W, tol);
+        int ok = got > 0 ? verified(U0, W0, n, U, W, n1, p, rows, tol) : 0;
+        if (ok < 0) { free(U); free(W); return -1; }
+        int wrapped = ok && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
+        if (wrapped < 0) { free(U); free(W); return -1; }
+        if (ok) {
+            s->num_poles[dir] = n1;
+            s->periodic[dir] = wrapped == 0;
+            if (ccn__xm_set_flat(xm, f, dir, U)) { free(U); free(W); return -1; }
+            double *np = (double *)s->poles; /* shrinks: written in place */
+            int32_t nu1 = dir == 0 ? n1 : nu, nv1 = dir == 0 ? nv : n1;
+            for (int32_t row = 0; row < rows; row++)
+                for (int32_t k = 0; k < n1; k++)
+                    memcpy(np + 3 * (dir == 0 ? (size_t)k * nv1 + row : (size_t)row * nv1 + k),
+                           W + 3 * ((size_t)row * n1 + k), sizeof(double) * 3);
+            nu = nu1, nv = nv1;
+            removed += got;
+        }
+        free(U);
+        free(W);
+    }
+    return removed;
+}
+
+/* A face's tolerance: rel_tol times the diagonal of its poles' bounding box. (Relative to the
+ * face, not to the model: a small face far from the origin keeps its knots where the removal
+ * would only be exact to the rounding of its coordinates, which its normals would show.) */
+static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0;
+    for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
+        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], s->poles[3 * i + c]), hi[c] = fmax(hi[c], s->poles[3 * i + c]);
+    for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+    return rel_tol * sqrt(d2);
+}
+
+int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol) {
+    int64_t total = 0;
+    for (int32_t f = 0; f < xm->num_faces; f++) {
+        int64_t got = face_remove(xm, f, face_tolerance(&xm->faces[f].s, rel_tol));
+        if (got < 0) { xm->oom = 1; return -1; }
+        total += got;
+    }
+    return total;
+}

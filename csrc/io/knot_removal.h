@@ -1,0 +1,18 @@
+/* Knot removal for the CAD export's B-spline faces (internal; io/knot_removal.c). */
+#ifndef CCN_IO_KNOT_REMOVAL_H
+#define CCN_IO_KNOT_REMOVAL_H
+
+#include "io/export_model.h"
+
+/* Removes, from every face of xm and in both directions that are not periodic, each simple
+ * interior knot the surface does not need: where it is C^3 across the knot's iso line (to the
+ * rounding of its poles), the same surface has a representation without that knot (The NURBS
+ * Book, 2nd ed., A5.8, applied to every pole row at once). A face moves by at most rel_tol
+ * times its own size (the diagonal of its poles' bounding box: small faces keep their
+ * relative precision, and with it their normals). Parameters, domains and cells are unchanged:
+ * the face map and the topology read only those. A closed (periodic) direction stays periodic
+ * where its knots allow. Returns the number of knots removed, -1 when out of memory (xm->oom
+ * set; the faces stay valid). */
+int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol);
+
+#endif
