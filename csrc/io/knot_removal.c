@@ -29,11 +29,12 @@ static double dist3(const double *a, const double *b) {
     return sqrt(x * x + y * y + z * z);
 }
 
-/* One row's removal poles: Q (p + 2 points, Q[0] = P[first-1], Q[p+1] = P[last+1]) and the
- * meeting distance. P: the row's poles (3 each, stride 3). */
-static double row_try(const double *U, int32_t p, int32_t r, const double *P, double Q[][3]) {
+/* One row's removal poles for one copy of the knot u = U[r] of multiplicity s (r its last
+ * index): Q (p - s + 3 points, Q[0] = P[first-1], Q[last+1-off] = P[last+1]) and the meeting
+ * distance. P: the row's poles (3 each). */
+static double row_try(const double *U, int32_t p, int32_t r, int32_t s, const double *P, double Q[][3]) {
     double u = U[r];
-    int32_t first = r - p, last = r - 1, off = first - 1;
+    int32_t first = r - p, last = r - s, off = first - 1;
     memcpy(Q[0], P + 3 * (size_t)off, sizeof Q[0]);
     memcpy(Q[last + 1 - off], P + 3 * (size_t)(last + 1), sizeof Q[0]);
     int32_t i = first, j = last, ii = 1, jj = last - off;
@@ -52,24 +53,27 @@ static double row_try(const double *U, int32_t p, int32_t r, const double *P, do
 }
 
 /* Direction with rows x n poles W[row][k] (3 each) and flat knots U (n + p + 1, clamped: the
- * interior knots are U[p+1 .. n-1]): removes each knot whose removal is within step_tol. Returns the number
- * removed; *n and U, W updated. */
+ * interior knots are U[p+1 .. n-1]): removes, one copy at a time, each interior knot copy whose
+ * removal is within step_tol (a knot of multiplicity s <= p: a join C^(p-s) becomes C^(p-s+1)).
+ * Returns the number of copies removed; *n and U, W updated. */
 static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double step_tol) {
     int32_t removed = 0, N = *n;
-    double Q[KR_MAX_DEGREE + 2][3];
+    double Q[KR_MAX_DEGREE + 3][3];
     int32_t r = p + 1;
-    while (r <= N - 1) {
-        /* a simple interior knot at flat index r */
-        if (!(U[r] > U[r - 1] && U[r + 1] > U[r])) { r++; continue; }
+    while (r < N) {
+        int32_t r1 = r; /* the run of copies U[r .. r1] */
+        while (r1 + 1 < N && U[r1 + 1] == U[r]) r1++;
+        int32_t s = r1 - r + 1;
+        if (U[r1 + 1] == U[r] || s > p) { r = r1 + 1; continue; } /* the end knot; a break */
         double worst = 0;
         for (int32_t row = 0; row < rows && worst <= step_tol; row++)
-            worst = fmax(worst, row_try(U, p, r, W + 3 * (size_t)row * (size_t)N, Q));
-        if (!(worst <= step_tol)) { r++; continue; }
-        int32_t first = r - p, last = r - 1, off = first - 1, fout = (2 * r - 1 - p) / 2;
+            worst = fmax(worst, row_try(U, p, r1, s, W + 3 * (size_t)row * (size_t)N, Q));
+        if (!(worst <= step_tol)) { r = r1 + 1; continue; }
+        int32_t first = r1 - p, last = r1 - s, off = first - 1, fout = (2 * r1 - s - p) / 2;
         double *Wn = W; /* rows re-packed in place at the new row length N - 1 */
         for (int32_t row = 0; row < rows; row++) {
             double *P = W + 3 * (size_t)row * (size_t)N;
-            row_try(U, p, r, P, Q);
+            row_try(U, p, r1, s, P, Q);
             for (int32_t i = first, j = last; j - i > 0; i++, j--) {
                 memcpy(P + 3 * (size_t)i, Q[i - off], sizeof Q[0]);
                 memcpy(P + 3 * (size_t)j, Q[j - off], sizeof Q[0]);
@@ -78,9 +82,9 @@ static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double
             memmove(D, P, sizeof(double) * 3 * (size_t)fout);
             memmove(D + 3 * (size_t)fout, P + 3 * (size_t)(fout + 1), sizeof(double) * 3 * (size_t)(N - 1 - fout));
         }
-        memmove(U + r, U + r + 1, sizeof(double) * (size_t)(N + p - r));
+        memmove(U + r1, U + r1 + 1, sizeof(double) * (size_t)(N + p - r1));
         N--;
-        removed++;
+        removed++; /* the same knot again (one copy fewer), or the next one at r */
     }
     *n = N;
     return removed;
@@ -287,6 +291,27 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
         free(W);
     }
     return removed;
+}
+
+int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol) {
+    int32_t n0 = *n, m = n0 + p + 1;
+    double *U0 = malloc(sizeof(double) * (size_t)m), *W0 = malloc(sizeof(double) * 3 * (size_t)n0 * rows);
+    if (!U0 || !W0) { free(U0); free(W0); return -1; }
+    memcpy(U0, U, sizeof(double) * (size_t)m);
+    memcpy(W0, W, sizeof(double) * 3 * (size_t)n0 * rows);
+    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol);
+    int ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
+    if (ok < 0) got = -1;
+    if (ok == 1) {
+        *n = n1;
+    } else { /* as it was */
+        memcpy(U, U0, sizeof(double) * (size_t)m);
+        memcpy(W, W0, sizeof(double) * 3 * (size_t)n0 * rows);
+        if (got > 0) got = 0;
+    }
+    free(U0);
+    free(W0);
+    return got;
 }
 
 /* A face's tolerance: rel_tol times the diagonal of its poles' bounding box. (Relative to the

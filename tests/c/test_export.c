@@ -371,6 +371,35 @@ static void test_semi_sharp_knots(void) {
     printf("# torus_semi: at most %d interior knots per face and direction\n", most);
 }
 
+/* Faces that share a whole side and join C1 or better are one face: the cube's 8 caps (24
+ * sectors, 4 bi-5 patches each: the centre and a ring's three) give at most 2 faces per sector,
+ * and the 72 bicubic patches around them (C2 to each other) at most 12 faces; test_cages
+ * checks the merged faces against the limit. */
+static void test_merged_faces(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 3;
+    ccn_plan *p = load("cube", &obj, &cage, &o);
+    CHECK(p != NULL, "cube: plan");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "cube: export: %s", err.message);
+    CHECK(info.num_bi5 <= 48 && info.num_bicubic <= 12, "cube: %d bi-5 faces (<= 48), %d bicubic (<= 12)",
+          (int)info.num_bi5, (int)info.num_bicubic);
+    printf("# cube: %d faces (%d bi-5, %d bicubic) from 96 bi-5 and 72 bicubic patches\n", (int)info.num_faces,
+           (int)info.num_bi5, (int)info.num_bicubic);
+    faces_free(&F);
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
 /* ---- knot removal (io/knot_removal.c), against a refinement made here ----------------------- */
 
 /* Boehm: u inserted into flat knots t (n + p + 1) of a row of n poles (3 each; room for n + 1). */
@@ -708,6 +737,7 @@ int main(void) {
     RUN(test_refined);
     RUN(test_cages);
     RUN(test_semi_sharp_knots);
+    RUN(test_merged_faces);
     RUN(test_knot_removal);
     return TEST_SUMMARY();
 }

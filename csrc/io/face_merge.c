@@ -1,0 +1,309 @@
+/* Merging the CAD export's faces (io/face_merge.h).
+ *
+ * Why: the export builds its faces piece by piece (the bi-5 cap's rings, one L of three
+ * patches per sector and ring, the bands of a refined hole, the packer's rectangles), and each
+ * face costs the file its boundary: four edge curves, their vertices and the loop. Where two
+ * faces of one kind and degree share a whole side and their union is one C^1 (or smoother)
+ * spline in a common parametrisation, one face is the same surface with fewer entities.
+ *
+ * A pair (face A, side s; face B, side t) is merged when, after turning both domains by
+ * quarter turns so that the shared side is A's u = max and B's u = min:
+ *   - both are clamped, not periodic, of equal degrees, with the same number of cell rows;
+ *   - their v knot vectors agree up to an affine map (B's v is re-parametrised onto A's);
+ *   - the shared pole column agrees within tol;
+ *   - B's u is scaled so that the two cross-boundary derivatives agree (ratio of their lengths
+ *     on the row where A's is largest), the union written with the join knot of multiplicity p
+ *     (C0: exact), and the join knot's copies the union does not need removed (the checked
+ *     removal of io/knot_removal.c): the merge is kept only if the join is left with at most
+ *     p - 1 copies (C^1 or smoother). Anything else leaves both faces as they were.
+ * Rounds of merges (each face at most once per round, the topology rebuilt between rounds)
+ * run until none is possible, so nested pieces (a cap's rings around its centre) grow into one
+ * face per sector. The merged face has patch -1 and the cells of both, B's re-parametrised. */
+#include "io/face_merge.h"
+
+#include "base/error.h"
+#include "io/export_topo.h"
+#include "io/knot_removal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A face's data in flat form, owned. */
+typedef struct {
+    int32_t deg[2], n[2];
+    double *t[2]; /* flat knots: n + deg + 1 */
+    double *P;    /* pole (i, j) at 3 (i n[1] + j), i along u */
+    int32_t cu, cv;
+    ccn__xcell *cells; /* (i, j) at i + cu j */
+} tface;
+
+static void tface_free(tface *f) {
+    free(f->t[0]); free(f->t[1]); free(f->P); free(f->cells);
+    memset(f, 0, sizeof *f);
+}
+
+static int tface_of(const ccn__xmodel *xm, int32_t fi, tface *f) {
+    const ccn__xface *X = &xm->faces[fi];
+    const ccn__cad_surface *s = &X->s;
+    memset(f, 0, sizeof *f);
+    size_t np = (size_t)s->num_poles[0] * s->num_poles[1];
+    f->P = malloc(sizeof(double) * 3 * np);
+    f->cells = malloc(sizeof(ccn__xcell) * (size_t)X->cells_u * X->cells_v);
+    for (int d = 0; d < 2; d++) {
+        f->deg[d] = s->degree[d];
+        f->n[d] = s->num_poles[d];
+        f->t[d] = malloc(sizeof(double) * (size_t)(s->num_poles[d] + s->degree[d] + 1));
+    }
+    if (!f->P || !f->cells || !f->t[0] || !f->t[1]) { tface_free(f); return -1; }
+    memcpy(f->P, s->poles, sizeof(double) * 3 * np);
+    for (int d = 0; d < 2; d++)
+        for (int32_t k = 0, i = 0; k < s->num_knots[d]; k++)
+            for (int32_t c = 0; c < s->mults[d][k]; c++) f->t[d][i++] = s->knots[d][k];
+    f->cu = X->cells_u;
+    f->cv = X->cells_v;
+    memcpy(f->cells, xm->cells + X->cell0, sizeof(ccn__xcell) * (size_t)f->cu * f->cv);
+    return 0;
+}
+
+/* A quarter turn of the domain: (u, v) -> (v, -u), side k becomes side k - 1 (orientation, and
+ * so the normal, kept). */
+static int tface_turn(tface *f) {
+    int32_t nu = f->n[0], nv = f->n[1], mu = nu + f->deg[0] + 1;
+    double *P = malloc(sizeof(double) * 3 * (size_t)nu * nv), *tv = malloc(sizeof(double) * (size_t)mu);
+    ccn__xcell *C = malloc(sizeof(ccn__xcell) * (size_t)f->cu * f->cv);
+    if (!P || !tv || !C) { free(P); free(tv); free(C); return -1; }
+    for (int32_t i2 = 0; i2 < nv; i2++) /* new (i2, j2) = old (nu - 1 - j2, i2) */
+        for (int32_t j2 = 0; j2 < nu; j2++)
+            memcpy(P + 3 * ((size_t)i2 * nu + j2), f->P + 3 * ((size_t)(nu - 1 - j2) * nv + i2), sizeof(double) * 3);
+    for (int32_t i = 0; i < mu; i++) tv[i] = -f->t[0][mu - 1 - i];
+    for (int32_t ci = 0; ci < f->cu; ci++)
+        for (int32_t cj = 0; cj < f->cv; cj++) {
+            const ccn__xcell *a = &f->cells[ci + f->cu * cj];
+            ccn__xcell *b = &C[cj + f->cv * (f->cu - 1 - ci)];
+            b->uv[0] = a->uv[2], b->uv[1] = a->uv[3], b->uv[2] = -a->uv[1], b->uv[3] = -a->uv[0];
+            ccn__xplace_rotate(&a->pl, 1, &b->pl);
+        }
+    free(f->P); free(f->cells); free(f->t[0]);
+    f->P = P, f->cells = C;
+    f->t[0] = f->t[1], f->t[1] = tv;
+    int32_t d = f->deg[0]; f->deg[0] = f->deg[1], f->deg[1] = d;
+    f->n[0] = nv, f->n[1] = nu;
+    int32_t c = f->cu; f->cu = f->cv, f->cv = c;
+    return 0;
+}
+
+static int clamped(const double *t, int32_t n, int32_t p) {
+    for (int32_t i = 1; i <= p; i++)
+        if (t[i] != t[0] || t[n + p - i] != t[n + p]) return 0;
+    return t[p + 1] > t[p] && t[n] > t[n - 1];
+}
+
+static double dist3(const double *a, const double *b) {
+    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return sqrt(x * x + y * y + z * z);
+}
+
+
+/* B's v parameter x on A's: A's knot where x is B's corresponding knot (exactly: the cells'
+ * ends must be the face's own values, or a sample on the border would fall outside the domain),
+ * else the affine map. */
+static double map_v(const double *ta, const double *tb, int32_t mv, double sv, double x) {
+    for (int32_t i = 0; i < mv; i++)
+        if (tb[i] == x) return ta[i];
+    return ta[0] + (x - tb[0]) * sv;
+}
+
+/* The union of A (its u = max side) and B (its u = min side), or 0 when it is not C^1; M gets
+ * the merged face. -1: out of memory. */
+static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
+    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
+    memset(M, 0, sizeof *M);
+    if (B->deg[0] != p || B->deg[1] != q || B->n[1] != nv || B->cv != A->cv) return 0;
+    if (!clamped(A->t[0], nA, p) || !clamped(B->t[0], nB, p) || !clamped(A->t[1], nv, q) || !clamped(B->t[1], nv, q))
+        return 0;
+    /* v: B's knots an affine image of A's */
+    const double *ta = A->t[1], *tb = B->t[1];
+    int32_t mv = nv + q + 1;
+    double a0 = ta[0], a1 = ta[mv - 1], b0 = tb[0], b1 = tb[mv - 1], sv = (a1 - a0) / (b1 - b0);
+    for (int32_t i = 0; i < mv; i++)
+        if (fabs(a0 + (tb[i] - b0) * sv - ta[i]) > 1e-12 * (a1 - a0)) return 0;
+    /* the shared column */
+    for (int32_t j = 0; j < nv; j++)
+        if (!(dist3(A->P + 3 * ((size_t)(nA - 1) * nv + j), B->P + 3 * (size_t)j) <= tol)) return 0;
+    /* B's u scale: the cross-boundary derivatives' ratio on A's largest */
+    double best = -1, c = 1;
+    double ha = A->t[0][nA + p] - A->t[0][nA - 1], hb = B->t[0][p + 1] - B->t[0][0];
+    for (int32_t j = 0; j < nv; j++) {
+        double da[3], db[3];
+        for (int k = 0; k < 3; k++) {
+            da[k] = (A->P[3 * ((size_t)(nA - 1) * nv + j) + k] - A->P[3 * ((size_t)(nA - 2) * nv + j) + k]) / ha;
+            db[k] = (B->P[3 * ((size_t)nv + j) + k] - B->P[3 * (size_t)j + k]) / hb;
+        }
+        double la = sqrt(da[0] * da[0] + da[1] * da[1] + da[2] * da[2]);
+        double lb = sqrt(db[0] * db[0] + db[1] * db[1] + db[2] * db[2]);
+        if (la > best && lb > 0) best = la, c = lb / la;
+    }
+    if (!(best > 0) || !(c > 0) || !isfinite(c)) return 0;
+    /* the union: u knots A's (without its end copies), the join p times, B's scaled */
+    int32_t n = nA + nB - 1, m = n + p + 1;
+    double *U = malloc(sizeof(double) * (size_t)m), *W = malloc(sizeof(double) * 3 * (size_t)n * nv);
+    if (!U || !W) { free(U); free(W); return -1; }
+    double uj = A->t[0][nA + p], ub = B->t[0][0];
+    for (int32_t i = 0; i < nA; i++) U[i] = A->t[0][i];
+    for (int32_t i = 0; i < p; i++) U[nA + i] = uj;
+    for (int32_t i = p + 1; i <= nB + p; i++) U[nA + p + (i - p - 1)] = uj + c * (B->t[0][i] - ub);
+    /* rows along u: W[row j][k] */
+    for (int32_t j = 0; j < nv; j++)
+        for (int32_t k = 0; k < n; k++) {
+            const double *src = k < nA ? A->P + 3 * ((size_t)k * nv + j) : B->P + 3 * ((size_t)(k - nA + 1) * nv + j);
+            memcpy(W + 3 * ((size_t)j * n + k), src, sizeof(double) * 3);
+        }
+    int32_t n1 = n, got = ccn__kr_reduce_rows(U, p, &n1, nv, W, tol);
+    if (got < 0) { free(U); free(W); return -1; }
+    int32_t mult = 0;
+    for (int32_t i = 0; i < n1 + p + 1; i++) mult += U[i] == uj;
+    if (got == 0 || mult > p - 1) { free(U); free(W); return 0; }
+    M->deg[0] = p, M->deg[1] = q;
+    M->n[0] = n1, M->n[1] = nv;
+    M->t[0] = U;
+    M->t[1] = malloc(sizeof(double) * (size_t)mv);
+    M->P = malloc(sizeof(double) * 3 * (size_t)n1 * nv);
+    M->cu = A->cu + B->cu, M->cv = A->cv;
+    M->cells = malloc(sizeof(ccn__xcell) * (size_t)M->cu * M->cv);
+    if (!M->t[1] || !M->P || !M->cells) { free(W); tface_free(M); return -1; }
+    memcpy(M->t[1], ta, sizeof(double) * (size_t)mv);
+    for (int32_t i = 0; i < n1; i++)
+        for (int32_t j = 0; j < nv; j++) memcpy(M->P + 3 * ((size_t)i * nv + j), W + 3 * ((size_t)j * n1 + i), sizeof(double) * 3);
+    free(W);
+    for (int32_t cj = 0; cj < M->cv; cj++) {
+        for (int32_t ci = 0; ci < A->cu; ci++) M->cells[ci + M->cu * cj] = A->cells[ci + A->cu * cj];
+        for (int32_t ci = 0; ci < B->cu; ci++) {
+            ccn__xcell x = B->cells[ci + B->cu * cj];
+            x.uv[0] = uj + c * (x.uv[0] - ub), x.uv[1] = uj + c * (x.uv[1] - ub);
+            x.uv[2] = map_v(ta, tb, mv, sv, x.uv[2]), x.uv[3] = map_v(ta, tb, mv, sv, x.uv[3]);
+            M->cells[A->cu + ci + M->cu * cj] = x;
+        }
+    }
+    return 1;
+}
+
+/* Face fi of xm becomes M (its arrays taken over; cells appended to xm->cells). */
+static int replace_face(ccn__xmodel *xm, int32_t fi, tface *M) {
+    ccn__xface *X = &xm->faces[fi];
+    int32_t nc = M->cu * M->cv;
+    if (xm->num_cells + nc > xm->cap_cells) {
+        int32_t cap = 2 * (xm->num_cells + nc) + 256;
+        ccn__xcell *p = realloc(xm->cells, sizeof *p * (size_t)cap);
+        if (!p) return -1;
+        xm->cells = p;
+        xm->cap_cells = cap;
+    }
+    memcpy(xm->cells + xm->num_cells, M->cells, sizeof(ccn__xcell) * (size_t)nc);
+    X->cell0 = xm->num_cells;
+    xm->num_cells += nc;
+    X->cells_u = M->cu, X->cells_v = M->cv;
+    X->patch = -1;
+    ccn__cad_surface *s = &X->s;
+    free((void *)s->poles);
+    s->poles = M->P;
+    M->P = NULL;
+    for (int d = 0; d < 2; d++) {
+        s->degree[d] = M->deg[d];
+        s->num_poles[d] = M->n[d];
+        s->periodic[d] = 0;
+        if (ccn__xm_set_flat(xm, fi, d, M->t[d])) return -1;
+    }
+    return 0;
+}
+
+static void drop_face(ccn__xmodel *xm, int32_t fi) {
+    ccn__cad_surface *s = &xm->faces[fi].s;
+    free((void *)s->poles);
+    for (int d = 0; d < 2; d++) { free((void *)s->knots[d]); free((void *)s->mults[d]); }
+    memset(s, 0, sizeof *s);
+    xm->faces[fi].kind = -1;
+}
+
+static int mergeable_kind(int32_t kind) {
+    return kind == CCN_EXPORT_FACE_PACK || kind == CCN_EXPORT_FACE_BICUBIC || kind == CCN_EXPORT_FACE_BI5 ||
+           kind == CCN_EXPORT_FACE_REFINED;
+}
+
+static double face_size(const ccn__cad_surface *s) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0;
+    for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
+        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], s->poles[3 * i + c]), hi[c] = fmax(hi[c], s->poles[3 * i + c]);
+    for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+    return sqrt(d2);
+}
+
+int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, ccn_error *err) {
+    int64_t merged = 0;
+    for (;;) {
+        int32_t *bs = NULL, *adj = NULL;
+        double *br = NULL;
+        uint8_t *crease = NULL;
+        ccn_status st = ccn__xtopo_build(xm, cage, &bs, &br, &adj, &crease, err);
+        if (st) return -1;
+        int32_t nf = xm->num_faces, nseg = 4 * nf + bs[4 * nf];
+        int32_t *segface = malloc(sizeof(int32_t) * (size_t)nseg);
+        uint8_t *segside = malloc((size_t)nseg), *used = calloc((size_t)nf, 1);
+        if (!segface || !segside || !used) {
+            free(segface); free(segside); free(used); free(bs); free(br); free(adj); free(crease);
+            ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
+            return -1;
+        }
+        for (int32_t f = 0; f < nf; f++)
+            for (int s = 0; s < 4; s++)
+                for (int32_t k = 0; k <= bs[4 * f + s + 1] - bs[4 * f + s]; k++) {
+                    int32_t j = 4 * f + s + bs[4 * f + s] + k;
+                    segface[j] = f, segside[j] = (uint8_t)s;
+                }
+        int64_t round = 0;
+        int oom = 0;
+        for (int32_t f = 0; f < nf && !oom; f++) {
+            if (used[f] || !mergeable_kind(xm->faces[f].kind)) continue;
+            for (int s = 0; s < 4 && !used[f] && !oom; s++) {
+                if (bs[4 * f + s + 1] != bs[4 * f + s]) continue; /* split side */
+                int32_t j = 4 * f + s + bs[4 * f + s], o = adj[j];
+                if (o < 0 || crease[j]) continue;
+                int32_t g = segface[o], t = segside[o];
+                if (g == f || used[g] || xm->faces[g].kind != xm->faces[f].kind) continue;
+                if (bs[4 * g + t + 1] != bs[4 * g + t]) continue;
+                const ccn__cad_surface *sf = &xm->faces[f].s, *sg = &xm->faces[g].s;
+                if (sf->periodic[0] || sf->periodic[1] || sg->periodic[0] || sg->periodic[1]) continue;
+                tface A, B, M;
+                if (tface_of(xm, f, &A)) { oom = 1; break; }
+                if (tface_of(xm, g, &B)) { tface_free(&A); oom = 1; break; }
+                int r = 0;
+                for (int k = 0; k < (s + 3) % 4 && !r; k++) r = tface_turn(&A); /* side s -> 1 */
+                for (int k = 0; k < (t + 1) % 4 && !r; k++) r = tface_turn(&B); /* side t -> 3 */
+                double tol = rel_tol * fmax(face_size(sf), face_size(sg));
+                int ok = r ? -1 : merge_pair(&A, &B, tol, &M);
+                tface_free(&A);
+                tface_free(&B);
+                if (ok < 0) { oom = 1; break; }
+                if (!ok) continue;
+                if (replace_face(xm, f, &M)) { tface_free(&M); oom = 1; break; }
+                tface_free(&M);
+                drop_face(xm, g);
+                used[f] = used[g] = 1;
+                round++;
+            }
+        }
+        free(segface); free(segside); free(used); free(bs); free(br); free(adj); free(crease);
+        if (oom) {
+            ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
+            return -1;
+        }
+        /* the dropped faces out (their cells stay unused in xm->cells) */
+        int32_t w = 0;
+        for (int32_t f = 0; f < xm->num_faces; f++)
+            if (xm->faces[f].kind >= 0) xm->faces[w++] = xm->faces[f];
+        xm->num_faces = w;
+        merged += round;
+        if (!round) break;
+    }
+    return merged;
+}

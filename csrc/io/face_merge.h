@@ -1,0 +1,14 @@
+/* Merging the CAD export's faces across whole shared sides (internal; io/face_merge.c). */
+#ifndef CCN_IO_FACE_MERGE_H
+#define CCN_IO_FACE_MERGE_H
+
+#include "io/export_model.h"
+
+/* Merges, in rounds until none is left, pairs of faces of one kind (packs, bicubic, bi-5,
+ * refined; never fills) that share a whole side (no crease) and whose union is one spline at
+ * least C^1 across the join, checked within rel_tol times the larger face's size. The merged
+ * face replaces the first, the second is removed (xm->num_faces shrinks). Returns the number of
+ * merges, -1 on failure (err set; xm stays valid). cage: the plan's level 0. */
+int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, ccn_error *err);
+
+#endif
