@@ -10,7 +10,8 @@
  * quarter turns so that the shared side is A's u = max and B's u = min:
  *   - both are clamped, not periodic, of equal degrees, with the same number of cell rows;
  *   - their v knot vectors agree up to an affine map (B's v is re-parametrised onto A's);
- *   - the shared pole column agrees within tol;
+ *   - the shared pole column agrees within tol (rel_tol of the faces' size, plus the rounding
+ *     of their coordinates);
  *   - B's u is scaled so that the two cross-boundary derivatives agree (ratio of their lengths
  *     on the row where A's is largest), the union written with the join knot of multiplicity p
  *     (C0: exact), and the join knot's copies the union does not need removed (the checked
@@ -25,6 +26,7 @@
 #include "io/export_topo.h"
 #include "io/knot_removal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -230,12 +232,19 @@ static int mergeable_kind(int32_t kind) {
            kind == CCN_EXPORT_FACE_REFINED;
 }
 
-static double face_size(const ccn__cad_surface *s) {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0;
+/* A pair's tolerance: rel_tol times the face's size (its poles' bounding-box diagonal) plus the
+ * rounding of its coordinates (16 units in the last place of the largest): two faces computed
+ * apart (a cap's sectors, a hole's levels) share their boundary only to that rounding, which on
+ * a small face far from the origin is more than rel_tol of its size. */
+static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0, big = 0;
     for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
-        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], s->poles[3 * i + c]), hi[c] = fmax(hi[c], s->poles[3 * i + c]);
+        for (int c = 0; c < 3; c++) {
+            double x = s->poles[3 * i + c];
+            lo[c] = fmin(lo[c], x), hi[c] = fmax(hi[c], x), big = fmax(big, fabs(x));
+        }
     for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
-    return sqrt(d2);
+    return rel_tol * sqrt(d2) + 16 * DBL_EPSILON * big;
 }
 
 int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, ccn_error *err) {
@@ -279,7 +288,7 @@ int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_to
                 int r = 0;
                 for (int k = 0; k < (s + 3) % 4 && !r; k++) r = tface_turn(&A); /* side s -> 1 */
                 for (int k = 0; k < (t + 1) % 4 && !r; k++) r = tface_turn(&B); /* side t -> 3 */
-                double tol = rel_tol * fmax(face_size(sf), face_size(sg));
+                double tol = fmax(face_tolerance(sf, rel_tol), face_tolerance(sg, rel_tol));
                 int ok = r ? -1 : merge_pair(&A, &B, tol, &M);
                 tface_free(&A);
                 tface_free(&B);
