@@ -24,7 +24,8 @@ _ADVICE = {
                      "can meet at a vertex.",
     "face_size_limit": "Split this face (Knife, or Poke Faces).",
     "no_faces": "Add faces: only faces are subdivided.",
-    "linked_data": "Append the object instead of linking it (File > Append), or make it local "
+    "linked_data": "Make a library override (Object > Library Override > Make), append the "
+                   "object instead of linking it (File > Append), or make it local "
                    "(Object > Relations > Make Local).",
     "levels_refused": "Each level needs four times the memory of the one below: lower the "
                       "levels, or close programs that hold memory.",

@@ -167,3 +167,47 @@ class TestScenes(AddonTestCase):
             d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
             self.assertLessEqual(d, POS_TOL, "appended collection, viewport, " + what)
         self._setup_and_check(build, check, "scenes_appended")
+
+    def test_linked_collection_override(self):
+        """A collection holding a cage linked from another file and instanced (File > Link,
+        Instance Collections), then made a library override (Object > Library Override > Make,
+        how a linked asset is made editable): its cage shows its limit surface, in renders and
+        in the viewport, and its settings can be changed."""
+        def local(name):
+            return next(o for o in bpy.data.objects if o.name == name and o.library is None)
+
+        def build():
+            coll = bpy.data.collections.new("Asset")
+            bpy.context.scene.collection.children.link(coll)
+            names = [o.name for o in twins("Ov", coll)]
+            add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS)
+            lib = os.path.join(TMP, "scenes_override_lib.blend")
+            bpy.ops.wm.save_as_mainfile(filepath=lib)
+            reset_scene()  # a new file
+            with bpy.data.libraries.load(lib, link=True) as (src, dst):
+                dst.collections = ["Asset"]
+            inst = bpy.data.objects.new("Asset instance", None)
+            inst.instance_type = 'COLLECTION'
+            inst.instance_collection = dst.collections[0]
+            bpy.context.scene.collection.objects.link(inst)
+            bpy.context.view_layer.update()  # the new object's base, so that it can be selected
+            for o in bpy.context.view_layer.objects:
+                o.select_set(o == inst)
+            bpy.context.view_layer.objects.active = inst
+            self.assertEqual(bpy.ops.object.make_override_library(), {'FINISHED'})
+            return names
+
+        def check(names, what):
+            cc, ss = (local(n) for n in names)
+            self.assertIsNotNone(cc.override_library, "the cage is not an override, " + what)
+            scene = bpy.context.scene
+            seen = render_probe(scene, scene.view_layers[0].name, names)
+            self.assertTwinsEqual(seen, names, "overridden linked collection, " + what)
+            dg = update()
+            d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
+            self.assertLessEqual(d, POS_TOL, "overridden linked collection, viewport, " + what)
+        self._setup_and_check(build, check, "scenes_override")
+        cc = local("OvCCNURBS")
+        cc.ccnurbs.levels = LEVELS + 1  # an override's settings are its own
+        n = len(positions_in(update(), cc))
+        self.assertEqual(n, 6 * 4 ** (LEVELS + 1) + 2, "levels %d on the override: %d vertices" % (LEVELS + 1, n))
