@@ -258,6 +258,9 @@ static void face_map(const ccn_export_options *o, const ccn__xmodel *xm) {
  * its own size (io/knot_removal.c): far below the 1e-12 of the model's size the export keeps to
  * the limit. */
 #define KNOT_TOLERANCE 1e-13
+/* Faces are merged where their union is C1 to this much of their size (io/face_merge.c: far
+ * from both the unions that are C1, which miss by 3e-12 at most, and those that are not). */
+#define MERGE_TOLERANCE 1e-10
 
 static ccn_status build_faces(ccn__xmodel *xm, const ccn__plan_view *v, const rec_list *rl,
                               const ccn_export_options *o, ccn_export_info *inf, ccn_error *err) {
@@ -402,7 +405,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (rl.oom) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (patches)"); goto done; }
     progress(&o, 0.15);
     if ((st = build_faces(&xm, &v, &rl, &o, &inf, err))) goto done;
-    if (!(o.flags & CCN_EXPORT_UNPACKED) && ccn__xm_merge_faces(&xm, v.lev[0], KNOT_TOLERANCE, err) < 0) {
+    if (!(o.flags & CCN_EXPORT_UNPACKED) && ccn__xm_merge_faces(&xm, v.lev[0], MERGE_TOLERANCE, err) < 0) {
         st = err ? err->status : CCN_ERR_MEMORY;
         goto done;
     }

@@ -54,9 +54,12 @@ static double row_try(const double *U, int32_t p, int32_t r, int32_t s, const do
 
 /* Direction with rows x n poles W[row][k] (3 each) and flat knots U (n + p + 1, clamped: the
  * interior knots are U[p+1 .. n-1]): removes, one copy at a time, each interior knot copy whose
- * removal is within step_tol (a knot of multiplicity s <= p: a join C^(p-s) becomes C^(p-s+1)).
+ * removal is within step_tol (a knot of multiplicity s <= p: a join C^(p-s) becomes C^(p-s+1));
+ * only the knot of value `only` unless it is NaN. (Skipped: the end knots, and interior breaks of
+ * multiplicity p + 1.)
  * Returns the number of copies removed; *n and U, W updated. */
-static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double step_tol) {
+static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double step_tol,
+                          double only) {
     int32_t removed = 0, N = *n;
     double Q[KR_MAX_DEGREE + 3][3];
     int32_t r = p + 1;
@@ -64,7 +67,7 @@ static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double
         int32_t r1 = r; /* the run of copies U[r .. r1] */
         while (r1 + 1 < N && U[r1 + 1] == U[r]) r1++;
         int32_t s = r1 - r + 1;
-        if (U[r1 + 1] == U[r] || s > p) { r = r1 + 1; continue; } /* the end knot; a break */
+        if (U[r1 + 1] == U[r] || s > p || (only == only && U[r] != only)) { r = r1 + 1; continue; }
         double worst = 0;
         for (int32_t row = 0; row < rows && worst <= step_tol; row++)
             worst = fmax(worst, row_try(U, p, r1, s, W + 3 * (size_t)row * (size_t)N, Q));
@@ -269,7 +272,7 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
         if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
         memcpy(U0, U, sizeof(double) * (size_t)m);
         memcpy(W0, W, sizeof(double) * 3 * (size_t)n * (size_t)rows);
-        int32_t n1 = n, got = remove_dir(U, p, &n1, rows, W, tol);
+        int32_t n1 = n, got = remove_dir(U, p, &n1, rows, W, tol, NAN);
         int ok = got > 0 ? verified(U0, W0, n, U, W, n1, p, rows, tol) : 0;
         if (ok < 0) { free(U); free(W); return -1; }
         int wrapped = ok && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
@@ -293,13 +296,14 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
     return removed;
 }
 
-int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol) {
+int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol,
+                            double only) {
     int32_t n0 = *n, m = n0 + p + 1;
     double *U0 = malloc(sizeof(double) * (size_t)m), *W0 = malloc(sizeof(double) * 3 * (size_t)n0 * rows);
     if (!U0 || !W0) { free(U0); free(W0); return -1; }
     memcpy(U0, U, sizeof(double) * (size_t)m);
     memcpy(W0, W, sizeof(double) * 3 * (size_t)n0 * rows);
-    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol);
+    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol, only);
     int ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
     if (ok < 0) got = -1;
     if (ok == 1) {

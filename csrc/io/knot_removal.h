@@ -16,9 +16,10 @@
 int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol);
 
 /* Rows x n poles W (W[row][k], 3 each) along clamped flat knots U (n + p + 1): every interior
- * knot copy the rows do not need removed, checked as a whole within tol (model units). Returns
- * the copies removed and updates U, W, *n; 0 when none could be (U, W unchanged); -1 when out
- * of memory. */
-int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol);
+ * knot copy the rows do not need (of the value `only`, every value if it is NaN) removed, checked
+ * as a whole within tol (model units). Returns the copies removed and updates U, W, *n; 0 when
+ * none could be (U, W unchanged); -1 when out of memory. */
+int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol,
+                            double only);
 
 #endif
