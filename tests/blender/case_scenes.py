@@ -31,6 +31,19 @@ def twins(name, collection):
     return obs
 
 
+def asset_library(prefix, stem):
+    """A library file holding the collection "Asset" with twins (CCNURBS on the first), saved as
+    TMP/stem.blend; then a new file. Returns the twins' names and the library's path."""
+    coll = bpy.data.collections.new("Asset")
+    bpy.context.scene.collection.children.link(coll)
+    names = [o.name for o in twins(prefix, coll)]
+    add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS)
+    lib = os.path.join(TMP, stem + ".blend")
+    bpy.ops.wm.save_as_mainfile(filepath=lib)
+    reset_scene()  # a new file
+    return names, lib
+
+
 def positions_in(dg, ob):
     me = ob.evaluated_get(dg).data
     P = np.empty(3 * len(me.vertices))
@@ -146,13 +159,7 @@ class TestScenes(AddonTestCase):
         """A collection holding a cage appended from another file (File > Append > Collection)
         and linked into the scene: its cage shows its limit surface."""
         def build():
-            coll = bpy.data.collections.new("Asset")
-            bpy.context.scene.collection.children.link(coll)
-            names = [o.name for o in twins("Ap", coll)]
-            add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS)
-            lib = os.path.join(TMP, "scenes_asset_lib.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=lib)
-            reset_scene()  # a new file
+            names, lib = asset_library("Ap", "scenes_asset_lib")
             with bpy.data.libraries.load(lib, link=False) as (src, dst):
                 dst.collections = ["Asset"]
             bpy.context.scene.collection.children.link(dst.collections[0])
@@ -177,13 +184,7 @@ class TestScenes(AddonTestCase):
             return next(o for o in bpy.data.objects if o.name == name and o.library is None)
 
         def build():
-            coll = bpy.data.collections.new("Asset")
-            bpy.context.scene.collection.children.link(coll)
-            names = [o.name for o in twins("Ov", coll)]
-            add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS)
-            lib = os.path.join(TMP, "scenes_override_lib.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=lib)
-            reset_scene()  # a new file
+            names, lib = asset_library("Ov", "scenes_override_lib")
             with bpy.data.libraries.load(lib, link=True) as (src, dst):
                 dst.collections = ["Asset"]
             inst = bpy.data.objects.new("Asset instance", None)

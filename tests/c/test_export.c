@@ -329,34 +329,44 @@ static void test_cages(void) {
     check_cage("torus_semi", 1, 0);
 }
 
-/* Largest number of distinct interior knots of an exported face in one direction. */
-static int max_interior_knots(const char *name) {
+/* The default export of tests/data/<name>.obj at level 3 into F and info; CCN_OK or the
+ * failure (F then empty). */
+static ccn_status export_of(const char *name, faces *F, ccn_export_info *info) {
     ccn_obj *obj;
     ccn_cage cage;
     ccn_options o = {0};
     o.levels = 3;
     ccn_plan *p = load(name, &obj, &cage, &o);
-    if (!p) return -1;
+    memset(F, 0, sizeof *F);
+    if (!p) return CCN_ERR_ARGUMENT;
     ccn_export_options eo;
     memset(&eo, 0, sizeof eo);
-    faces F;
     sink s = {NULL, 0, 0, -1};
-    ccn_export_info info;
     ccn_error err;
-    int most = -1;
-    if (run(p, &eo, &F, &s, &info, &err) == CCN_OK) {
-        most = 0;
-        for (int i = 0; i < F.n; i++)
-            for (int d = 0; d < 2; d++) {
-                int distinct = 0;
-                for (int k = 1; k < F.f[i].nt[d]; k++) distinct += F.f[i].t[d][k] != F.f[i].t[d][k - 1];
-                if (distinct - 1 > most) most = distinct - 1;
-            }
-        faces_free(&F);
+    ccn_status st = run(p, &eo, F, &s, info, &err);
+    if (st != CCN_OK) {
+        faces_free(F);
+        memset(F, 0, sizeof *F);
     }
     free(s.d);
     ccn_plan_destroy(p);
     ccn_obj_destroy(obj);
+    return st;
+}
+
+/* Largest number of distinct interior knots of an exported face in one direction. */
+static int max_interior_knots(const char *name) {
+    faces F;
+    ccn_export_info info;
+    if (export_of(name, &F, &info) != CCN_OK) return -1;
+    int most = 0;
+    for (int i = 0; i < F.n; i++)
+        for (int d = 0; d < 2; d++) {
+            int distinct = 0;
+            for (int k = 1; k < F.f[i].nt[d]; k++) distinct += F.f[i].t[d][k] != F.f[i].t[d][k - 1];
+            if (distinct - 1 > most) most = distinct - 1;
+        }
+    faces_free(&F);
     return most;
 }
 
@@ -376,28 +386,14 @@ static void test_semi_sharp_knots(void) {
  * and the 72 bicubic patches around them (C2 to each other) at most 12 faces; test_cages
  * checks the merged faces against the limit. */
 static void test_merged_faces(void) {
-    ccn_obj *obj;
-    ccn_cage cage;
-    ccn_options o = {0};
-    o.levels = 3;
-    ccn_plan *p = load("cube", &obj, &cage, &o);
-    CHECK(p != NULL, "cube: plan");
-    if (!p) return;
-    ccn_export_options eo;
-    memset(&eo, 0, sizeof eo);
     faces F;
-    sink s = {NULL, 0, 0, -1};
     ccn_export_info info;
-    ccn_error err;
-    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "cube: export: %s", err.message);
+    CHECK(export_of("cube", &F, &info) == CCN_OK, "cube: export");
     CHECK(info.num_bi5 <= 48 && info.num_bicubic <= 12, "cube: %d bi-5 faces (<= 48), %d bicubic (<= 12)",
           (int)info.num_bi5, (int)info.num_bicubic);
     printf("# cube: %d faces (%d bi-5, %d bicubic) from 96 bi-5 and 72 bicubic patches\n", (int)info.num_faces,
            (int)info.num_bi5, (int)info.num_bicubic);
     faces_free(&F);
-    free(s.d);
-    ccn_plan_destroy(p);
-    ccn_obj_destroy(obj);
 }
 
 /* ---- knot removal (io/knot_removal.c), against a refinement made here ----------------------- */
