@@ -14,11 +14,14 @@
  *   - B's u is scaled so that the two cross-boundary derivatives agree (ratio of their lengths
  *     on the row where A's is largest), the union written with the join knot of multiplicity p
  *     (C0: exact), and the join knot's copies the union does not need removed (the checked
- *     removal of io/knot_removal.c, the join's knot only): the merge is kept only if the join is left with at most
- *     p - 1 copies (C^1 or smoother). Anything else leaves both faces as they were.
+ *     removal of io/knot_removal.c, the join's knot only): the merge is kept only if the join
+ *     is left with at most p - 1 copies (C^1 or smoother). Anything else leaves both faces as
+ *     they were.
  * Rounds of merges (each face at most once per round, the topology rebuilt between rounds)
  * run until none is possible, so nested pieces (a cap's rings around its centre) grow into one
- * face per sector. The merged face has patch -1 and the cells of both, B's re-parametrised. */
+ * or two faces per sector; across spokes a cap's rings join G1 only (the C2-rule's centre
+ * relation), so sectors stay apart. The merged face has patch -1 and the cells of both, B's
+ * re-parametrised. */
 #include "io/face_merge.h"
 
 #include "base/error.h"
