@@ -18,6 +18,11 @@ static inline void ccn__cross3(const double a[3], const double b[3], double c[3]
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+static inline double ccn__dist3(const double a[3], const double b[3]) {
+    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return sqrt(x * x + y * y + z * z);
+}
+
 /* Unit normal du x dv; (0,0,1) for degenerate geometry (documented fallback). */
 static inline void ccn__unit_normal(const double du[3], const double dv[3], double n[3]) {
     ccn__cross3(du, dv, n);

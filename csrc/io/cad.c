@@ -3,6 +3,7 @@
 #include "io/cad.h"
 
 #include "base/error.h"
+#include "base/vec3.h"
 #include "rules/bspline.h"
 
 #include <math.h>
@@ -264,11 +265,6 @@ static void seg_point(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j
     side_point_at(&m->faces[t->seg_face[j]], s, s < 2 ? lo + w * (hi - lo) : hi - w * (hi - lo), out);
 }
 
-static double dist3(const double a[3], const double b[3]) {
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                (a[2] - b[2]) * (a[2] - b[2]));
-}
-
 static int32_t uf_find(int32_t *parent, int32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
@@ -322,7 +318,7 @@ static ccn_status check_faces(const ccn__cad_model *m, ccn__cad_topo *t, ccn_err
                 for (int32_t j = 0; j < other; j++) {
                     size_t a = dir == 0 ? (size_t)i * nv + j : (size_t)j * nv + i;
                     size_t b = dir == 0 ? (size_t)(i + n - p) * nv + j : (size_t)j * nv + i + n - p;
-                    if (dist3(f->poles + 3 * a, f->poles + 3 * b) > t->tolerance)
+                    if (ccn__dist3(f->poles + 3 * a, f->poles + 3 * b) > t->tolerance)
                         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_FACE, fi,
                                              "face %d: %s is marked periodic but pole row %d "
                                              "differs from row %d", (int)fi, dir ? "v" : "u",
@@ -401,7 +397,7 @@ static ccn_status check_adjacency(const ccn__cad_model *m, const ccn__cad_topo *
             double pa[3], pb[3];
             seg_point(m, t, a, w[k], pa);
             seg_point(m, t, b, 1 - w[k], pb);
-            double d = dist3(pa, pb);
+            double d = ccn__dist3(pa, pb);
             if (!(d <= t->tolerance))
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_FACE, fa,
                                      "face %d side %d and face %d side %d are not the same "

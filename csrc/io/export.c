@@ -405,13 +405,13 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (rl.oom) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (patches)"); goto done; }
     progress(&o, 0.15);
     if ((st = build_faces(&xm, &v, &rl, &o, &inf, err))) goto done;
-    if (!(o.flags & CCN_EXPORT_UNPACKED) && ccn__xm_merge_faces(&xm, v.lev[0], MERGE_TOLERANCE, err) < 0) {
-        st = err ? err->status : CCN_ERR_MEMORY;
-        goto done;
-    }
-    if (!(o.flags & CCN_EXPORT_UNPACKED) && ccn__xm_remove_knots(&xm, KNOT_TOLERANCE) < 0) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (knot removal)");
-        goto done;
+    if (!(o.flags & CCN_EXPORT_UNPACKED)) { /* fewer faces and knots, the same surface */
+        int64_t merged;
+        if ((st = ccn__xm_merge_faces(&xm, v.lev[0], MERGE_TOLERANCE, &merged, err))) goto done;
+        if (ccn__xm_remove_knots(&xm, KNOT_TOLERANCE) < 0) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (knot removal)");
+            goto done;
+        }
     }
     if (xm.num_faces == 0) {
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_NONE, -1, "the cage has no surface to export");

@@ -2,6 +2,7 @@
  * their cells, and the places of mesh faces on the cage. */
 #include "io/export_model.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -56,12 +57,14 @@ void ccn__xplace_of(const ccn_mesh *const *lev, int32_t level, int32_t f, ccn__x
 
 /* ---- faces ------------------------------------------------------------------------- */
 
+void ccn__xm_free_surface(ccn__cad_surface *s) {
+    free((void *)s->poles);
+    for (int d = 0; d < 2; d++) { free((void *)s->knots[d]); free((void *)s->mults[d]); }
+    memset(s, 0, sizeof *s);
+}
+
 void ccn__xm_free(ccn__xmodel *xm) {
-    for (int32_t f = 0; f < xm->num_faces; f++) {
-        ccn__cad_surface *s = &xm->faces[f].s;
-        free((void *)s->poles);
-        for (int d = 0; d < 2; d++) { free((void *)s->knots[d]); free((void *)s->mults[d]); }
-    }
+    for (int32_t f = 0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
     free(xm->faces);
     free(xm->cells);
     memset(xm, 0, sizeof *xm);
@@ -121,6 +124,23 @@ int ccn__xm_set_flat(ccn__xmodel *xm, int32_t f, int dir, const double *t) {
     s->mults[dir] = mu;
     s->num_knots[dir] = nk;
     return 0;
+}
+
+void ccn__cad_flat_knots(const ccn__cad_surface *s, int dir, double *t) {
+    for (int32_t k = 0, i = 0; k < s->num_knots[dir]; k++)
+        for (int32_t c = 0; c < s->mults[dir][k]; c++) t[i++] = s->knots[dir][k];
+}
+
+double ccn__cad_surface_size(const ccn__cad_surface *s, double *reach) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0, big = 0;
+    for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
+        for (int c = 0; c < 3; c++) {
+            double x = s->poles[3 * i + c];
+            lo[c] = fmin(lo[c], x), hi[c] = fmax(hi[c], x), big = fmax(big, fabs(x));
+        }
+    for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+    if (reach) *reach = big;
+    return sqrt(d2);
 }
 
 int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const double *pts,

@@ -63,6 +63,13 @@ int32_t ccn__xm_add_face(ccn__xmodel *xm, int32_t kind, int32_t du, int32_t dv, 
                          int32_t nv, int32_t cells_u, int32_t cells_v);
 /* Sets direction dir of face f from flat knots t (num_poles + degree + 1 values). */
 int ccn__xm_set_flat(ccn__xmodel *xm, int32_t f, int dir, const double *t);
+/* Direction dir's flat knots of s (num_poles + degree + 1 values) into t. */
+void ccn__cad_flat_knots(const ccn__cad_surface *s, int dir, double *t);
+/* The diagonal of the bounding box of s's poles; *reach (may be NULL): their largest
+ * coordinate's magnitude. */
+double ccn__cad_surface_size(const ccn__cad_surface *s, double *reach);
+/* Frees s's owned poles, knots and multiplicities (a face of the model) and zeroes s. */
+void ccn__xm_free_surface(ccn__cad_surface *s);
 /* A Bezier face of degree deg (pts: (deg+1)^2 x 3, first index along u) at place pl. */
 int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const double *pts,
                            const ccn__xplace *pl);

@@ -25,6 +25,7 @@
 #include "io/face_merge.h"
 
 #include "base/error.h"
+#include "base/vec3.h"
 #include "io/export_topo.h"
 #include "io/knot_removal.h"
 
@@ -61,9 +62,7 @@ static int tface_of(const ccn__xmodel *xm, int32_t fi, tface *f) {
     }
     if (!f->P || !f->cells || !f->t[0] || !f->t[1]) { tface_free(f); return -1; }
     memcpy(f->P, s->poles, sizeof(double) * 3 * np);
-    for (int d = 0; d < 2; d++)
-        for (int32_t k = 0, i = 0; k < s->num_knots[d]; k++)
-            for (int32_t c = 0; c < s->mults[d][k]; c++) f->t[d][i++] = s->knots[d][k];
+    for (int d = 0; d < 2; d++) ccn__cad_flat_knots(s, d, f->t[d]);
     f->cu = X->cells_u;
     f->cv = X->cells_v;
     memcpy(f->cells, xm->cells + X->cell0, sizeof(ccn__xcell) * (size_t)f->cu * f->cv);
@@ -103,12 +102,6 @@ static int clamped(const double *t, int32_t n, int32_t p) {
     return t[p + 1] > t[p] && t[n] > t[n - 1];
 }
 
-static double dist3(const double *a, const double *b) {
-    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-    return sqrt(x * x + y * y + z * z);
-}
-
-
 /* B's v parameter x on A's: A's knot where x is B's corresponding knot (exactly: the cells'
  * ends must be the face's own values, or a sample on the border would fall outside the domain),
  * else the affine map. */
@@ -134,7 +127,7 @@ static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
         if (fabs(a0 + (tb[i] - b0) * sv - ta[i]) > 1e-12 * (a1 - a0)) return 0;
     /* the shared column */
     for (int32_t j = 0; j < nv; j++)
-        if (!(dist3(A->P + 3 * ((size_t)(nA - 1) * nv + j), B->P + 3 * (size_t)j) <= tol)) return 0;
+        if (!(ccn__dist3(A->P + 3 * ((size_t)(nA - 1) * nv + j), B->P + 3 * (size_t)j) <= tol)) return 0;
     /* B's u scale: the cross-boundary derivatives' ratio on A's largest */
     double best = -1, c = 1;
     double ha = A->t[0][nA + p] - A->t[0][nA - 1], hb = B->t[0][p + 1] - B->t[0][0];
@@ -222,10 +215,7 @@ static int replace_face(ccn__xmodel *xm, int32_t fi, tface *M) {
 }
 
 static void drop_face(ccn__xmodel *xm, int32_t fi) {
-    ccn__cad_surface *s = &xm->faces[fi].s;
-    free((void *)s->poles);
-    for (int d = 0; d < 2; d++) { free((void *)s->knots[d]); free((void *)s->mults[d]); }
-    memset(s, 0, sizeof *s);
+    ccn__xm_free_surface(&xm->faces[fi].s);
     xm->faces[fi].kind = -1;
 }
 
@@ -242,31 +232,25 @@ static int mergeable_kind(int32_t kind) {
  * 3e-12; so rel_tol = 1e-10 decides far from both (the same faces on every platform's build),
  * while the surface moves only by the union's actual defect. */
 static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0, big = 0;
-    for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
-        for (int c = 0; c < 3; c++) {
-            double x = s->poles[3 * i + c];
-            lo[c] = fmin(lo[c], x), hi[c] = fmax(hi[c], x), big = fmax(big, fabs(x));
-        }
-    for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
-    return rel_tol * sqrt(d2) + 16 * DBL_EPSILON * big;
+    double big, size = ccn__cad_surface_size(s, &big);
+    return rel_tol * size + 16 * DBL_EPSILON * big;
 }
 
-int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, ccn_error *err) {
-    int64_t merged = 0;
+ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int64_t *merged,
+                                ccn_error *err) {
+    *merged = 0;
     for (;;) {
         int32_t *bs = NULL, *adj = NULL;
         double *br = NULL;
         uint8_t *crease = NULL;
         ccn_status st = ccn__xtopo_build(xm, cage, &bs, &br, &adj, &crease, err);
-        if (st) return -1;
+        if (st) return st;
         int32_t nf = xm->num_faces, nseg = 4 * nf + bs[4 * nf];
         int32_t *segface = malloc(sizeof(int32_t) * (size_t)nseg);
         uint8_t *segside = malloc((size_t)nseg), *used = calloc((size_t)nf, 1);
         if (!segface || !segside || !used) {
             free(segface); free(segside); free(used); free(bs); free(br); free(adj); free(crease);
-            ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
-            return -1;
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
         }
         for (int32_t f = 0; f < nf; f++)
             for (int s = 0; s < 4; s++)
@@ -308,16 +292,15 @@ int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_to
         }
         free(segface); free(segside); free(used); free(bs); free(br); free(adj); free(crease);
         if (oom) {
-            ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
-            return -1;
+            return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (face merging)");
         }
         /* the dropped faces out (their cells stay unused in xm->cells) */
         int32_t w = 0;
         for (int32_t f = 0; f < xm->num_faces; f++)
             if (xm->faces[f].kind >= 0) xm->faces[w++] = xm->faces[f];
         xm->num_faces = w;
-        merged += round;
+        *merged += round;
         if (!round) break;
     }
-    return merged;
+    return CCN_OK;
 }

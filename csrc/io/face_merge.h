@@ -7,9 +7,9 @@
 /* Merges, in rounds until none is left, pairs of faces of one kind (packs, bicubic, bi-5,
  * refined; never fills) that share a whole side (no crease) and whose union is one spline at
  * least C^1 across the join, checked within rel_tol times the larger face's size plus the
- * rounding of its coordinates. The merged
- * face replaces the first, the second is removed (xm->num_faces shrinks). Returns the number of
- * merges, -1 on failure (err set; xm stays valid). cage: the plan's level 0. */
-int64_t ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, ccn_error *err);
+ * rounding of its coordinates. The merged face replaces the first, the second is removed
+ * (xm->num_faces shrinks). *merged: the number of merges. Returns CCN_OK or the failure (err set; xm stays valid). cage: the plan's level 0. */
+ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int64_t *merged,
+                               ccn_error *err);
 
 #endif

@@ -266,11 +266,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
             free(cov);
             if (st == CCN_ERR_INTERNAL && level + j + 1 < CCN_FILL_MAX_LEVEL) {
                 /* irregular vertices still too close for the fill's blocks: one level more */
-                for (int32_t f = nf0; f < xm->num_faces; f++) {
-                    ccn__cad_surface *sf = &xm->faces[f].s;
-                    free((void *)sf->poles);
-                    for (int d = 0; d < 2; d++) { free((void *)sf->knots[d]); free((void *)sf->mults[d]); }
-                }
+                for (int32_t f = nf0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
                 xm->num_faces = nf0;
                 xm->num_cells = nc0;
                 o->num_fills = nfill0;

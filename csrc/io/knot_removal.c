@@ -18,16 +18,13 @@
  * give the original poles within tol, or the direction is left as it was. */
 #include "io/knot_removal.h"
 
+#include "base/vec3.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define KR_MAX_DEGREE 8 /* the export's faces are of degree 3 and 5 */
-
-static double dist3(const double *a, const double *b) {
-    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-    return sqrt(x * x + y * y + z * z);
-}
 
 /* One row's removal poles for one copy of the knot u = U[r] of multiplicity s (r its last
  * index): Q (p - s + 3 points, Q[0] = P[first-1], Q[last+1-off] = P[last+1]) and the meeting
@@ -46,10 +43,10 @@ static double row_try(const double *U, int32_t p, int32_t r, int32_t s, const do
         }
         i++, ii++, j--, jj--;
     }
-    if (j - i < 0) return dist3(Q[ii - 1], Q[jj + 1]);
+    if (j - i < 0) return ccn__dist3(Q[ii - 1], Q[jj + 1]);
     double ai = (u - U[i]) / (U[i + p + 1] - U[i]), m[3];
     for (int c = 0; c < 3; c++) m[c] = ai * Q[ii + 1][c] + (1 - ai) * Q[ii - 1][c];
-    return dist3(P + 3 * (size_t)i, m);
+    return ccn__dist3(P + 3 * (size_t)i, m);
 }
 
 /* Direction with rows x n poles W[row][k] (3 each) and flat knots U (n + p + 1, clamped: the
@@ -93,19 +90,19 @@ static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double
     return removed;
 }
 
-/* Boehm's insertion of u into one row: flat knots U (N + p + 1), poles P (N, 3 each; room for
- * N + 1). */
-static void insert_knot(double *U, int32_t p, int32_t *N, double *P, double u) {
-    int32_t n = *N, k = p;
-    while (k + 1 < n && U[k + 1] <= u) k++;
-    for (int32_t i = n; i > k; i--) memcpy(P + 3 * (size_t)i, P + 3 * (size_t)(i - 1), sizeof(double) * 3);
-    for (int32_t i = k; i >= k - p + 1; i--) {
-        double a = (u - U[i]) / (U[i + p] - U[i]);
-        for (int c = 0; c < 3; c++) P[3 * (size_t)i + c] = a * P[3 * (size_t)i + c] + (1 - a) * P[3 * (size_t)(i - 1) + c];
+void ccn__insert_knot(double *P, int32_t *n, int32_t w, double *t, int32_t p, double x) {
+    int32_t k = p, N = *n;
+    while (k + 1 < N && t[k + 1] <= x) k++;
+    memmove(P + (size_t)(k + 1) * w, P + (size_t)k * w, sizeof(double) * (size_t)(N - k) * w);
+    for (int32_t i = k; i > k - p; i--) { /* new pole i from old i-1, i (not yet overwritten) */
+        double al = (x - t[i]) / (t[i + p] - t[i]);
+        double *q = P + (size_t)i * w;
+        const double *a = P + (size_t)(i - 1) * w, *b = q;
+        for (int32_t c = 0; c < w; c++) q[c] = (1 - al) * a[c] + al * b[c];
     }
-    memmove(U + k + 2, U + k + 1, sizeof(double) * (size_t)(n + p - k));
-    U[k + 1] = u;
-    *N = n + 1;
+    memmove(t + k + 2, t + k + 1, sizeof(double) * (size_t)(N + p - k));
+    t[k + 1] = x;
+    *n = N + 1;
 }
 
 /* The removal checked as a whole: the removed knots inserted back into every row of (U1, W1)
@@ -123,13 +120,35 @@ static int verified(const double *U0, const double *W0, int32_t n, const double 
         /* the knots of U0 missing from U1 (both sorted), in increasing order */
         for (int32_t i = 0, j = 0; i < n + p + 1; i++) {
             if (j < n1 + p + 1 && U1[j] == U0[i]) { j++; continue; }
-            insert_knot(U, p, &N, P, U0[i]);
+            ccn__insert_knot(P, &N, 3, U, p, U0[i]);
         }
-        for (int32_t k = 0; k < n && ok; k++) ok = dist3(P + 3 * (size_t)k, W0 + 3 * ((size_t)row * n + k)) <= tol;
+        for (int32_t k = 0; k < n && ok; k++) ok = ccn__dist3(P + 3 * (size_t)k, W0 + 3 * ((size_t)row * n + k)) <= tol;
     }
     free(U);
     free(P);
     return ok;
+}
+
+int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol,
+                            double only) {
+    int32_t n0 = *n, m = n0 + p + 1;
+    double *U0 = malloc(sizeof(double) * (size_t)m), *W0 = malloc(sizeof(double) * 3 * (size_t)n0 * rows);
+    if (!U0 || !W0) { free(U0); free(W0); return -1; }
+    memcpy(U0, U, sizeof(double) * (size_t)m);
+    memcpy(W0, W, sizeof(double) * 3 * (size_t)n0 * rows);
+    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol, only);
+    int ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
+    if (ok < 0) got = -1;
+    if (ok == 1) {
+        *n = n1;
+    } else { /* as it was */
+        memcpy(U, U0, sizeof(double) * (size_t)m);
+        memcpy(W, W0, sizeof(double) * 3 * (size_t)n0 * rows);
+        if (got > 0) got = 0;
+    }
+    free(U0);
+    free(W0);
+    return got;
 }
 
 /* A periodic direction in clamped form over the same domain [U[p], U[n]]: U[p] and U[n]
@@ -149,8 +168,8 @@ static int unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double
         if (Uw != U) memcpy(Uw, U, sizeof(double) * (size_t)m);
         int32_t N = n;
         double *P = W + 3 * (size_t)row * ext;
-        for (int32_t k = 0; k < p; k++) insert_knot(Uw, p, &N, P, u0);
-        for (int32_t k = 0; k < p; k++) insert_knot(Uw, p, &N, P, u1);
+        for (int32_t k = 0; k < p; k++) ccn__insert_knot(P, &N, 3, Uw, p, u0);
+        for (int32_t k = 0; k < p; k++) ccn__insert_knot(P, &N, 3, Uw, p, u1);
     }
     for (int32_t row = 0; row < rows; row++)
         memmove(W + 3 * (size_t)row * n, W + 3 * ((size_t)row * ext + p), sizeof(double) * 3 * (size_t)n);
@@ -236,7 +255,7 @@ static int rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double
             double x[3] = {0, 0, 0};
             for (int32_t r = 0; r < m; r++)
                 for (int c = 0; c < 3; c++) x[c] += A[(size_t)i * m + r] * q[3 * (size_t)r + c];
-            if (!(dist3(x, C + 3 * (size_t)i) <= tol)) goto out;
+            if (!(ccn__dist3(x, C + 3 * (size_t)i) <= tol)) goto out;
         }
     }
     memcpy(U, Up, sizeof(double) * (size_t)(n + p + 1));
@@ -256,13 +275,11 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
         int per = s->periodic[dir];
         if (p > KR_MAX_DEGREE || s->num_knots[dir] <= 2) continue;
         if (!per && (s->mults[dir][0] != p + 1 || s->mults[dir][s->num_knots[dir] - 1] != p + 1)) continue;
-        int32_t m = n + p + 1, ext = n + 2 * p;
-        double *U = malloc(sizeof(double) * (2 * (size_t)m + 2 * (size_t)p));
-        double *W = malloc(sizeof(double) * 3 * ((size_t)ext + (size_t)n) * (size_t)rows);
+        int32_t m = n + p + 1, ext = n + 2 * p; /* room for unwrap_periodic */
+        double *U = malloc(sizeof(double) * ((size_t)m + 2 * (size_t)p));
+        double *W = malloc(sizeof(double) * 3 * (size_t)ext * (size_t)rows);
         if (!U || !W) { free(U); free(W); return -1; }
-        double *U0 = U + m + 2 * p, *W0 = W + 3 * (size_t)ext * (size_t)rows;
-        for (int32_t k = 0, i = 0; k < s->num_knots[dir]; k++)
-            for (int32_t c = 0; c < s->mults[dir][k]; c++) U[i++] = s->knots[dir][k];
+        ccn__cad_flat_knots(s, dir, U);
         /* W[row][k]: pole k along dir of row `row` */
         const double *P = s->poles;
         for (int32_t row = 0; row < rows; row++)
@@ -270,14 +287,10 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
                 memcpy(W + 3 * ((size_t)row * n + k),
                        P + 3 * (dir == 0 ? (size_t)k * nv + row : (size_t)row * nv + k), sizeof(double) * 3);
         if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
-        memcpy(U0, U, sizeof(double) * (size_t)m);
-        memcpy(W0, W, sizeof(double) * 3 * (size_t)n * (size_t)rows);
-        int32_t n1 = n, got = remove_dir(U, p, &n1, rows, W, tol, NAN);
-        int ok = got > 0 ? verified(U0, W0, n, U, W, n1, p, rows, tol) : 0;
-        if (ok < 0) { free(U); free(W); return -1; }
-        int wrapped = ok && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
-        if (wrapped < 0) { free(U); free(W); return -1; }
-        if (ok) {
+        int32_t n1 = n, got = ccn__kr_reduce_rows(U, p, &n1, rows, W, tol, NAN);
+        int wrapped = got > 0 && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
+        if (got < 0 || wrapped < 0) { free(U); free(W); return -1; }
+        if (got > 0) {
             s->num_poles[dir] = n1;
             s->periodic[dir] = wrapped == 0;
             if (ccn__xm_set_flat(xm, f, dir, U)) { free(U); free(W); return -1; }
@@ -296,43 +309,11 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
     return removed;
 }
 
-int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol,
-                            double only) {
-    int32_t n0 = *n, m = n0 + p + 1;
-    double *U0 = malloc(sizeof(double) * (size_t)m), *W0 = malloc(sizeof(double) * 3 * (size_t)n0 * rows);
-    if (!U0 || !W0) { free(U0); free(W0); return -1; }
-    memcpy(U0, U, sizeof(double) * (size_t)m);
-    memcpy(W0, W, sizeof(double) * 3 * (size_t)n0 * rows);
-    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol, only);
-    int ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
-    if (ok < 0) got = -1;
-    if (ok == 1) {
-        *n = n1;
-    } else { /* as it was */
-        memcpy(U, U0, sizeof(double) * (size_t)m);
-        memcpy(W, W0, sizeof(double) * 3 * (size_t)n0 * rows);
-        if (got > 0) got = 0;
-    }
-    free(U0);
-    free(W0);
-    return got;
-}
-
-/* A face's tolerance: rel_tol times the diagonal of its poles' bounding box. (Relative to the
- * face, not to the model: a small face far from the origin keeps its knots where the removal
- * would only be exact to the rounding of its coordinates, which its normals would show.) */
-static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0;
-    for (int64_t i = 0; i < (int64_t)s->num_poles[0] * s->num_poles[1]; i++)
-        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], s->poles[3 * i + c]), hi[c] = fmax(hi[c], s->poles[3 * i + c]);
-    for (int c = 0; c < 3; c++) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
-    return rel_tol * sqrt(d2);
-}
 
 int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol) {
     int64_t total = 0;
     for (int32_t f = 0; f < xm->num_faces; f++) {
-        int64_t got = face_remove(xm, f, face_tolerance(&xm->faces[f].s, rel_tol));
+        int64_t got = face_remove(xm, f, rel_tol * ccn__cad_surface_size(&xm->faces[f].s, NULL));
         if (got < 0) { xm->oom = 1; return -1; }
         total += got;
     }

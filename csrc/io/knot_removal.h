@@ -15,6 +15,10 @@
  * set; the faces stay valid). */
 int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol);
 
+/* Boehm's insertion of x into a B-spline curve of degree p with n poles of w doubles each
+ * (P: n x w, flat knots t: n + p + 1 values; both with room for one more). */
+void ccn__insert_knot(double *P, int32_t *n, int32_t w, double *t, int32_t p, double x);
+
 /* Rows x n poles W (W[row][k], 3 each) along clamped flat knots U (n + p + 1): every interior
  * knot copy the rows do not need (of the value `only`, every value if it is NaN) removed, checked
  * as a whole within tol (model units). Returns the copies removed and updates U, W, *n; 0 when

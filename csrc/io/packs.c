@@ -18,6 +18,8 @@
  */
 #include "io/packs.h"
 
+#include "io/knot_removal.h"
+
 #include "base/error.h"
 #include "surface/limit.h"
 #include "surface/patches.h"
@@ -167,37 +169,20 @@ static void flat_knots(const double *D, int32_t n, int periodic, double *t) {
 #undef DK
 }
 
-/* Boehm insertion of x into a curve of n poles of w doubles each (P: n x w, flat knots t:
- * n + p + 1 values; both with room for one more). */
-static void insert_knot(double *P, int32_t *n, int32_t w, double *t, int32_t p, double x) {
-    int32_t k = p, N = *n;
-    while (k + 1 < N && t[k + 1] <= x) k++;
-    memmove(P + (size_t)(k + 1) * w, P + (size_t)k * w, sizeof(double) * (size_t)(N - k) * w);
-    for (int32_t i = k; i > k - p; i--) { /* new pole i from old i-1, i (not yet overwritten) */
-        double al = (x - t[i]) / (t[i + p] - t[i]);
-        double *q = P + (size_t)i * w;
-        const double *a = P + (size_t)(i - 1) * w, *b = q;
-        for (int32_t c = 0; c < w; c++) q[c] = (1 - al) * a[c] + al * b[c];
-    }
-    memmove(t + k + 2, t + k + 1, sizeof(double) * (size_t)(N + p - k));
-    t[k + 1] = x;
-    *n = N + 1;
-}
-
 /* Clamps both ends of a cubic curve of n poles (P: capacity n + 2 rows, t: n + 6 values):
  * afterwards n is unchanged, t = (t_0 x 4, interior knots, t_n x 4). */
 static void clamp_curve(double *P, int32_t n, int32_t w, double *t) {
     int32_t N = n;
     double lo = t[3], hi = t[n];
-    insert_knot(P, &N, w, t, 3, lo);
-    insert_knot(P, &N, w, t, 3, lo);
+    ccn__insert_knot(P, &N, w, t, 3, lo);
+    ccn__insert_knot(P, &N, w, t, 3, lo);
     /* triple lo at flat 3..5: pole 2 is the start; drop poles 0, 1 and knots t_-3, t_-2 */
     memmove(P, P + 2 * (size_t)w, sizeof(double) * (size_t)(N - 2) * w);
     memmove(t, t + 2, sizeof(double) * (size_t)(N + 4 - 2));
     N -= 2;
     t[0] = lo;
-    insert_knot(P, &N, w, t, 3, hi);
-    insert_knot(P, &N, w, t, 3, hi);
+    ccn__insert_knot(P, &N, w, t, 3, hi);
+    ccn__insert_knot(P, &N, w, t, 3, hi);
     /* triple hi at flat N-2..N: pole N-3 is the end; keep poles 0..N-3, knots 0..N, + hi */
     N -= 2;
     t[N + 3] = hi;
