@@ -26,7 +26,8 @@ _ADVICE = {
     "no_faces": "Add faces: only faces are subdivided.",
     "linked_data": "Make a library override (Object > Library Override > Make), append the "
                    "object instead of linking it (File > Append), or make it local "
-                   "(Object > Relations > Make Local).",
+                   "(Object > Relations > Make Local). Or, in the library file, turn on Store "
+                   "Render Mesh in File and save it: the files that link it show that surface.",
     "levels_refused": "Each level needs four times the memory of the one below: lower the "
                       "levels, or close programs that hold memory.",
     "out_of_memory": "Lower the levels: the limit mesh did not fit in memory.",

@@ -51,7 +51,7 @@ class Status:
         self.num_verts = self.num_faces = 0
         self.sizes = {}
         self.seconds = 0.0
-        self.showing = "limit"   # limit | last valid limit | cage
+        self.showing = "limit"   # limit | last valid limit | cage | stored (a linked cage)
         self.loose = (0, 0)      # (vertices, edges) in no face, counted by the add-on
         self.element = None      # (ccn_element_kind, index) an error names (errors.py)
         self.reason = None       # the error's reason (native.REASONS; errors.advice keys on it)
@@ -279,14 +279,25 @@ def missing_tap(obj, kind):
 
 
 def linked_cage(obj, kind):
-    """A cage linked from a library file: its proxies are that file's, read-only here, so the
-    add-on cannot write its limit and the object shows its cage (or, in renders, the render
-    mesh the library stored). Said in the panel instead of silently."""
-    lib = obj.library.filepath if obj.library is not None else ""
-    st = Status(kind, error="linked from %s: the add-on cannot write the limit surface into "
-                "linked data, so the cage is shown" % (bpy.path.basename(lib) or "a library"))
-    st.reason = "linked_data"
-    st.showing = "cage"
+    """A cage linked from a library file: its proxies are that file's, read-only here (writing
+    into linked meshes through the API crashes some of Blender's mesh functions), so the add-on
+    cannot write its limit. It shows the render mesh the library stored (Store Render Mesh in
+    File: in the viewport too, the viewport proxy being saved empty), else its cage; said in
+    the panel either way."""
+    lib = bpy.path.basename(obj.library.filepath) if obj.library is not None else ""
+    p = modifier.proxy(obj, 'RENDER')
+    me = p.data if p is not None else None
+    if me is not None and (len(me.polygons) or me.get(proxies.KEY_PROP) == proxies.CAGE_KEY):
+        st = Status(kind, obj.ccnurbs.render_levels)
+        st.num_verts, st.num_faces = len(me.vertices), len(me.polygons)
+        st.showing = "stored"
+        st.reason = "linked_stored"
+    else:
+        st = Status(kind, error="linked from %s, which stores no render mesh: the add-on cannot "
+                    "write the limit surface into linked data, so the cage is shown"
+                    % (lib or "a library"))
+        st.reason = "linked_data"
+        st.showing = "cage"
     state.of(obj).status[kind] = st
     return st
 

@@ -65,6 +65,11 @@ def _draw_status(layout, obj):
         if errors.selectable(st):
             box.operator("object.ccnurbs_select_error", text="Select", icon='RESTRICT_SELECT_OFF')
         return
+    if st.showing == "stored":
+        lib = bpy.path.basename(obj.library.filepath) if obj.library is not None else ""
+        return ["Linked: the surface %s stored, %d vertices, %d faces" % (
+            lib or "its library", st.num_verts, st.num_faces),
+            "(Render Levels %d; a library override makes it live)" % st.levels]
     if st.key == proxies.CAGE_KEY:  # Levels 0
         box.label(text="Levels 0: the cage, %d vertices, %d faces" % (st.num_verts, st.num_faces),
                   icon='MESH_DATA')
@@ -138,6 +143,11 @@ def status_lines(obj):
         return []
     if st.error:
         return [error_heading(st), st.error]
+    if st.showing == "stored":
+        lib = bpy.path.basename(obj.library.filepath) if obj.library is not None else ""
+        return ["Linked: the surface %s stored, %d vertices, %d faces" % (
+            lib or "its library", st.num_verts, st.num_faces),
+            "(Render Levels %d; a library override makes it live)" % st.levels]
     if st.key == proxies.CAGE_KEY:
         return ["Levels 0: the cage, %d vertices, %d faces" % (st.num_verts, st.num_faces)]
     return ["Limit: %d vertices, %d faces" % (st.num_verts, st.num_faces)]

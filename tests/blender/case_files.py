@@ -240,19 +240,21 @@ class TestFileHygiene(AddonTestCase):
         self.assertClean(save("hyg_append_dst"), "append")
 
     def test_linked_cage_says_it_shows_the_cage(self):
-        """A cage linked (not appended) from a library file cannot get its limit written (its
-        proxies are the library's, read-only): it shows its cage and the panel says so, with
-        what to do, instead of nothing."""
+        """A cage linked (not appended) from a library file that stores no render mesh cannot
+        get its limit written (its proxies are the library's, read-only): it shows its cage and
+        the panel says so, with what to do, instead of nothing."""
         ob = add_modifier(grid(3, "Linked"))
         self.assertGreater(len(evaluated_positions(ob)), len(ob.data.vertices))
         lo = from_library("hyg_link", "Linked", link=True)
         self.assertIsNotNone(lo.library)
         st = ccn.sync.status(lo)
         self.assertIsNotNone(st, "a linked cage gets no status")
-        self.assertIn("linked from hyg_link_lib.blend: the add-on cannot write", st.error or "")
+        self.assertIn("linked from hyg_link_lib.blend, which stores no render mesh: the add-on "
+                      "cannot write", st.error or "")
         self.assertEqual(st.showing, "cage")
         self.assertEqual(len(evaluated_positions(lo)), len(lo.data.vertices))
-        for way in ("Library Override > Make", "File > Append", "Make Local"):
+        for way in ("Library Override > Make", "File > Append", "Make Local",
+                    "Store Render Mesh in File"):
             self.assertIn(way, ccn.errors.advice(st))
         bpy.context.view_layer.objects.active = lo
         self.assertIn("the add-on cannot write the limit surface",

@@ -31,13 +31,14 @@ def twins(name, collection):
     return obs
 
 
-def asset_library(prefix, stem):
-    """A library file holding the collection "Asset" with twins (CCNURBS on the first), saved as
-    TMP/stem.blend; then a new file. Returns the twins' names and the library's path."""
+def asset_library(prefix, stem, **settings):
+    """A library file holding the collection "Asset" with twins (CCNURBS on the first, with
+    `settings`), saved as TMP/stem.blend; then a new file. Returns the twins' names and the
+    library's path."""
     coll = bpy.data.collections.new("Asset")
     bpy.context.scene.collection.children.link(coll)
     names = [o.name for o in twins(prefix, coll)]
-    add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS)
+    add_modifier(bpy.data.objects[names[0]], levels=LEVELS, render_levels=LEVELS, **settings)
     lib = os.path.join(TMP, stem + ".blend")
     bpy.ops.wm.save_as_mainfile(filepath=lib)
     reset_scene()  # a new file
@@ -75,7 +76,10 @@ def render_probe(scene, layer, names):
                 self.end_result(r)
                 return
             for inst in depsgraph.object_instances:  # to its end (a walk left early leaks)
-                if not inst.is_instance and inst.object.original.name in names:
+                # the objects themselves, or drawn by a collection instance; not the tap (an
+                # instance scaled to zero)
+                if inst.object.original.name in names and (
+                        not inst.is_instance or abs(inst.matrix_world.determinant()) > 0):
                     seen[inst.object.original.name] = cagelib.mesh_positions(inst.object.data)
             r = self.begin_result(0, 0, 4, 4)
             self.end_result(r)
@@ -174,6 +178,37 @@ class TestScenes(AddonTestCase):
             d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
             self.assertLessEqual(d, POS_TOL, "appended collection, viewport, " + what)
         self._setup_and_check(build, check, "scenes_appended")
+
+    def test_linked_collection(self):
+        """A collection holding a cage linked from another file and instanced (File > Link,
+        Instance Collections; no override), the library saved with Store Render Mesh in File: the
+        cage shows the surface the library stored, in renders and in the viewport, and the panel
+        says so. (Linked data is read-only here: a live surface needs a library override.)"""
+        def build():
+            names, lib = asset_library("Ln", "scenes_linked_lib", store_render_mesh=True)
+            with bpy.data.libraries.load(lib, link=True) as (src, dst):
+                dst.collections = ["Asset"]
+            inst = bpy.data.objects.new("Asset instance", None)
+            inst.instance_type = 'COLLECTION'
+            inst.instance_collection = dst.collections[0]
+            bpy.context.scene.collection.objects.link(inst)
+            return names
+
+        def check(names, what):
+            cc, ss = (bpy.data.objects[n] for n in names)
+            self.assertIsNotNone(cc.library, "the cage is not linked, " + what)
+            scene = bpy.context.scene
+            seen = render_probe(scene, scene.view_layers[0].name, names)
+            self.assertTwinsEqual(seen, names, "linked collection, " + what)
+            dg = update()
+            d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
+            self.assertLessEqual(d, POS_TOL, "linked collection, viewport, " + what)
+            st = ccn.sync.status(cc)
+            self.assertIsNone(st.error, what)
+            self.assertEqual(st.showing, "stored", what)
+            self.assertIn("Linked: the surface scenes_linked_lib.blend stored, 98 vertices",
+                          " ".join(ccn.ui.status_lines(cc)), what)
+        self._setup_and_check(build, check, "scenes_linked")
 
     def test_linked_collection_override(self):
         """A collection holding a cage linked from another file and instanced (File > Link,

@@ -66,6 +66,14 @@ class _Result(unittest.TestResult):
             self.rows.append((kind, subtest, lst[-1][1]))
 
 
+def _tests(suite):
+    for t in suite:
+        if isinstance(t, unittest.TestSuite):
+            yield from _tests(t)
+        else:
+            yield t
+
+
 def main():
     bltest.install()
     loader = unittest.defaultTestLoader
@@ -79,6 +87,9 @@ def main():
                 continue
             raise
         suite.addTests(loader.loadTestsFromModule(mod))
+    pick = os.environ.get("CCN_TEST")  # e.g. "test_linked": only tests whose id holds it
+    if pick:
+        suite = unittest.TestSuite(t for t in _tests(suite) if pick in t.id())
     result = _Result()
     suite.run(result)
     failed_ids = {t.id() for k, t, _ in result.rows if k != "ok"}
