@@ -5,10 +5,12 @@
   hygiene triggers (hygiene.suspicious, object/group counts).
   Blender < 4.5, interactive: the viewport proxies get Blender's own normals while the cage keeps
   changing and a timer writes the exact ones NORMALS_DELAY after the last change (encoded custom
-  normals cost 5x the rest of an update; sync.PENDING).
+  normals cost 5x the rest of an update; sync.PENDING). With Analysis > Curvature on
+  (interactive), the analysis attributes likewise: the curvatures double the evaluation, so a
+  drag costs what it costs without analysis and the colours follow NORMALS_DELAY after it.
 * frame_change_post: frame_set, playback and every frame of a render. Viewport depsgraph: the
-  viewport proxies of the cages whose input changed, then `depsgraph.update()` so the frame shows
-  them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
+  viewport proxies of the cages whose input changed (with their analysis, not deferred: a viewport
+  render of an animation shows each frame's), then `depsgraph.update()` so the frame shows them. Render depsgraph: the render proxies at Render levels from the render-evaluated taps,
   then `depsgraph.update()` so the engine renders them (headless included); Render levels
   refused for memory are an error of the render (_render_error).
 * render_init: Cycles' Persistent Data off for the render (it would keep the first frame's
@@ -65,9 +67,10 @@ def _shown(obj, depsgraph):
     return mod.show_viewport
 
 
-NORMALS_DELAY = 0.3  # seconds of quiet before deferred exact normals are written (UI only)
-# Deferred exact normals (sync.PENDING): Blender < 4.5 in an interactive session; [0] = True
-# makes scripts and headless tests defer too (they then call write_pending_normals()).
+NORMALS_DELAY = 0.3  # seconds of quiet before deferred normals and analysis are written (UI only)
+# Deferred exact normals (sync.PENDING): Blender < 4.5 in an interactive session; deferred
+# analysis attributes: every Blender, interactive; [0] = True makes scripts and headless tests
+# defer too (they then call write_pending_normals()).
 DEFER_IN_BACKGROUND = [False]
 
 
@@ -75,10 +78,18 @@ def defer_normals():
     return not compat.FREE_NORMALS and (not bpy.app.background or DEFER_IN_BACKGROUND[0])
 
 
-def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
+def defer_analysis():
+    """The analysis attributes of an edit's update, once editing pauses (sync.PENDING): in an
+    interactive session (and in scripts that ask for it), not in background renders."""
+    return not bpy.app.background or DEFER_IN_BACKGROUND[0]
+
+
+def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None, analysis_now=False):
     """Reads the taps of `objs` from `depsgraph` and syncs their `kind` proxies (viewport
-    proxies with deferred exact normals where defer_normals(), unless defer=False). Returns the
-    number of proxies written."""
+    proxies with deferred exact normals where defer_normals() and deferred analysis attributes
+    where defer_analysis(), unless defer=False; analysis_now: the analysis is not deferred).
+    Returns the number of proxies written."""
+    defer_a = kind == 'VIEW' and defer is not False and not analysis_now and defer_analysis()
     defer = kind == 'VIEW' and (defer_normals() if defer is None else defer)
     for o in objs:
         if o.library is not None and modifier.is_cage(o) and sync.status(o, kind) is None:
@@ -94,7 +105,8 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
             sync.missing_tap(obj, kind)
             continue
         before = sync.stats["syncs"]
-        sync.sync_object(obj, kind, cage, force=force, defer_normals=defer)
+        sync.sync_object(obj, kind, cage, force=force, defer_normals=defer,
+                         defer_analysis=defer_a)
         written += sync.stats["syncs"] - before
         if kind == 'VIEW' and obj.ccnurbs.store_render_mesh and bpy.app.background:
             sync.sync_object(obj, 'RENDER', cage)  # farm files from scripts: no idle timer here
@@ -105,7 +117,7 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
             bpy.app.timers.unregister(_render_timer)
         bpy.app.timers.register(_render_timer, first_interval=RENDER_DELAY)
     # each update: the delay again
-    if defer and not bpy.app.background and state.any_flag("pending_normals"):
+    if (defer or defer_a) and not bpy.app.background and state.any_flag("pending_normals"):
         if bpy.app.timers.is_registered(_normals_timer):
             bpy.app.timers.unregister(_normals_timer)
         bpy.app.timers.register(_normals_timer, first_interval=NORMALS_DELAY)
@@ -113,7 +125,8 @@ def sync_cages(depsgraph, objs, kind='VIEW', force=False, defer=None):
 
 
 def write_pending_normals():
-    """The exact normals of every viewport proxy that waits for them (sync.PENDING)."""
+    """The exact normals and analysis attributes of every viewport proxy that waits for them
+    (sync.PENDING)."""
     objs = sync.pending_normals()
     state.clear_field("pending_normals", False)
     if objs:
@@ -228,7 +241,8 @@ def _on_frame(depsgraph):
                                  and len(modifier.proxy(o, 'VIEW').data.vertices)
                                  else "the cage"))
         return
-    if sync_cages(depsgraph, cages_in(depsgraph), 'VIEW'):
+    # a frame's analysis at once: a viewport render of an animation shows each frame's
+    if sync_cages(depsgraph, cages_in(depsgraph), 'VIEW', analysis_now=True):
         depsgraph.update()
 
 

@@ -35,10 +35,13 @@ stats = {"handler_calls": 0, "syncs": 0, "rebuilds": 0, "position_updates": 0, "
 # Per cage and kind ('VIEW', 'RENDER'), in its state (state.py): plans (topology key, native.Plan),
 # status (Status), key_memo (the last topology keys, their inputs (cage.py), and "loose": the
 # loose counts of that topology).
-# Exact normals while editing on Blender < 4.5 (encoded custom normals: their write and every
-# evaluation of the cage afterwards cost 5x the rest of an update): with
-# defer_normals the proxy gets Blender's own normals and this key suffix, and its state is marked
-# `pending_normals`; handlers.py writes the exact normals once editing pauses.
+# What an edit's update leaves for when editing pauses, with this key suffix on the proxy and
+# its state marked `pending_normals` (handlers.py writes the rest once editing pauses):
+# * exact normals on Blender < 4.5 (defer_normals: encoded custom normals, whose write and every
+#   evaluation of the cage afterwards cost 5x the rest of an update; meanwhile Blender's own);
+# * the analysis attributes (defer_analysis: the curvatures double the library's evaluation, so
+#   while a vertex is dragged the update costs what it costs without analysis, and the colours
+#   follow once the drag pauses; meanwhile they show the last computed curvature).
 PENDING = "|normals pending"
 
 
@@ -129,10 +132,10 @@ def _write_extras(me, plan, cage, uv_chans, ekey, rebuilt):
     me[attrs.KEY_PROP] = ekey
 
 
-def sync_object(obj, kind, cage, force=False, defer_normals=False):
+def sync_object(obj, kind, cage, force=False, defer_normals=False, defer_analysis=False):
     """Brings the cage's viewport ('VIEW') or render ('RENDER') proxy up to date with `cage`
-    (the tap's arrays). defer_normals: exact normals are left for later (see PENDING). Returns
-    the Status; never raises."""
+    (the tap's arrays). defer_normals, defer_analysis: exact normals, the analysis attributes
+    are left for later (see PENDING). Returns the Status; never raises."""
     s = obj.ccnurbs
     levels = s.levels if kind == 'VIEW' else s.render_levels
     ost = state.of(obj)
@@ -174,9 +177,10 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
         proxies.sync_materials(obj.data, p)
         me = p.data
         stored = me.get(proxies.KEY_PROP)
-        if stored == key + PENDING and defer_normals:
+        curv_later = curv != 'NONE' and defer_analysis
+        if stored == key + PENDING and (defer_normals or curv_later):
             ost.pending_normals = True  # e.g. after undo: still waiting
-        if not force and (stored == key or stored == key + PENDING and defer_normals):
+        if not force and (stored == key or stored == key + PENDING and (defer_normals or curv_later)):
             stats["skipped"] += 1
             if old is None or old.error or old.key != key:  # file just loaded, or undo restored
                 old = Status(kind, levels)                  # another proxy: describe this one
@@ -197,23 +201,26 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False):
                          and len(me.vertices) == plan.sizes["num_verts"]
                          and len(me.polygons) == plan.sizes["num_faces"])
         exact = s.normals == 'EXACT'
-        deferred = exact and defer_normals
-        exact = exact and not deferred
+        deferred = exact and defer_normals or curv_later
+        exact = exact and not defer_normals
+        curv_now = curv != 'NONE' and not curv_later  # (the attributes stay as they are)
         if same_topology and me.get(proxies.KEY_PROP) == key:
             pass  # forced: the proxy is already right
         elif same_topology:
-            res = plan.evaluate(cage.positions, topology=False, curvature=curv != 'NONE')
+            res = plan.evaluate(cage.positions, topology=False, curvature=curv_now)
             proxies.write_positions(me, res, exact)
-            analysis.write(me, res.get("curvatures"), curv)
+            if not curv_later:
+                analysis.write(me, res.get("curvatures"), curv)
             stats["changed_only"] += plan.changed_only
             # a new plan (an interval edit) changes the limit UVs and attributes too
             _write_extras(me, plan, cage, uv_chans, ekey, me.get(proxies.PLAN_PROP) != topo)
             stats["position_updates"] += 1
         else:
-            res = plan.evaluate(cage.positions, topology=True, curvature=curv != 'NONE')
+            res = plan.evaluate(cage.positions, topology=True, curvature=curv_now)
             plan.face_origin, plan.corner_edge_origin = res["face_origin"], res["corner_edge_origin"]
             proxies.write_topology(me, res, cage, exact)
-            analysis.write(me, res.get("curvatures"), curv)
+            if not curv_later:  # (a new topology: the old attributes went with it)
+                analysis.write(me, res.get("curvatures"), curv)
             _write_extras(me, plan, cage, uv_chans, ekey, True)
             # the carried vertex groups' names live on the mesh, which the rebuild cleared
             modifier.ensure_proxy_groups(p, modifier.carried_groups(obj))

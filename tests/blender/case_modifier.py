@@ -360,6 +360,56 @@ class TestModifier(AddonTestCase):
         self.assertFalse(any(n in me.attributes for n in names), "Off left the attributes")
         self.assertMatchesCLI(ob)
 
+    def test_curvature_follows_once_editing_pauses(self):
+        """Interactive edits with Analysis > Curvature on: the update writes the surface (and
+        its normals) at once and the curvature attributes once editing pauses (the handlers'
+        timer; here called directly), so a drag costs what it costs without analysis. Then the
+        attributes equal `ccnurbs limit --curvature` of the edited cage; a frame change computes
+        them at once (a viewport render of an animation shows each frame's)."""
+        ob = add_modifier(load_cage("CurvLater", os.path.join(DATA, "fig16_v6.obj")), levels=2)
+        ob.ccnurbs.curvature = 'MEAN'
+        name = ccn.analysis.NAMES[1]
+
+        def mean_now():
+            me = ob.evaluated_get(update()).data
+            a = np.empty(len(me.vertices), np.float32)
+            me.attributes[name].data.foreach_get("value", a)
+            return a.astype(np.float64)
+
+        def mean_cli():
+            _, K = cagelib.cli_curvature(CLI, ob.data, 2)
+            good = np.isfinite(K).all(1)
+            return np.where(good, 0.5 * (K[:, 0] + K[:, 1]), 0.0)
+
+        before = mean_now()
+        h = ccn.handlers
+        h.DEFER_IN_BACKGROUND[0] = True
+        try:
+            for step in range(2):  # twice: the second edit happens while still pending
+                ob.data.vertices[step].co.z += 0.3
+                ob.data.update()
+                update()
+                self.assertMatchesCLI(ob, normals=False)  # the surface at once
+                self.assertEqual(ccn.sync.pending_normals(), [ob])
+                np.testing.assert_array_equal(mean_now(), before, "the curvature while pending")
+            want = mean_cli()
+            scale = np.abs(want).max()
+            self.assertGreater(np.abs(want - before).max(), 1e-3 * scale, "the edit changed nothing")
+            h.write_pending_normals()
+            self.assertEqual(ccn.sync.pending_normals(), [])
+            err = np.abs(mean_now() - want).max() / scale
+            self.assertLessEqual(err, 1e-5, "after the pause: %.3g from the CLI" % err)
+            self.assertMatchesCLI(ob)
+            # a frame change: at once
+            ob.data.vertices[2].co.z += 0.3
+            ob.data.update()
+            bpy.context.scene.frame_set(bpy.context.scene.frame_current + 1)
+            err = np.abs(mean_now() - mean_cli()).max() / scale
+            self.assertLessEqual(err, 1e-5, "a frame's curvature: %.3g from the CLI" % err)
+        finally:
+            h.DEFER_IN_BACKGROUND[0] = False
+            ccn.state.clear_field("pending_normals", False)
+
     def test_highlight_lines(self):
         """Analysis > Highlight Lines: Solid shading with the add-on's stripe matcap in the
         scene's Workbench settings (and every 3D view), rendered as stripes; Off restores Studio
