@@ -33,6 +33,8 @@
 #include "base/error.h"
 #include "refine/level.h"
 #include "rules/crease.h"
+#include "bi5/bi5.h"
+#include "surface/caps.h"
 #include "surface/limit.h"
 #include "surface/patches.h"
 
@@ -165,6 +167,74 @@ static int semi_sharp(const ccn_mesh *m) {
 
 #define CCN_FILL_MAX_LEVEL 16 /* deepest level a fill goes to when its vertices are close */
 
+/* ---- caps ---------------------------------------------------------------------------- */
+
+/* The coarsest level of a cap over a hole (cap_vertex): the export equals the limit of every
+ * plan of this output level or below (Levels 4 shows the same surface; deeper Levels show the
+ * refined limit inside the cap's faces, where it pinches at the EV). */
+#define CCN_FILL_CAP_LEVEL 4
+
+/* The irregular vertex w of T (the refinement of the cut S) as a vertex of S: T numbers face
+ * points, edge points, then vertex points (refine/level.h); -1 if w is not a vertex point. */
+static int32_t parent_vertex(const ccn_mesh *S, int32_t w) {
+    int32_t v = w - S->nf - S->ne;
+    return v >= 0 && v < S->nv ? v : -1;
+}
+
+/* A guided bi-5 cap (surface/caps.h, ccn__cap_exact) over the faces of S around vertex u,
+ * instead of refining further and filling: the faces T has not exported there are exactly the
+ * children of u's faces (their nets hold u's vertex point), and the cap joins the exported ones
+ * C1 (its ring 0 is the exact level-(K+1) surround). pl: the places of S's faces. Marks the
+ * covered faces of T in cov. 1 capped, 0 not a cap vertex, -1 out of memory. */
+static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
+                      int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov) {
+    const struct ccn__bi5 *op;
+    double *pt;
+    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, ops, &op, &pt);
+    if (r <= 0) return r;
+    int32_t n = ccn__valence(S, u), nsig = op->nsig, np = ccn__bi5_num_patches(op);
+    for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
+        if (pl[S->hface[S->vfan[k]]].cage_face < 0) { /* a face around u is not in the hole */
+            free(pt);
+            return 0;
+        }
+    static const double UNIT[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int32_t i = 0; i < np && r > 0; i++) { /* placed as surface/patch_set.c's export_cap */
+        int32_t sct = i % n, ring = i / (3 * n), part = (i / n) % 3;
+        int32_t h = S->vfan[S->vfan_start[u] + sct], f = S->hface[h];
+        int32_t j0 = h - S->fstart[f];
+        double R = 1, hole[3][2];
+        for (int32_t q = 0; q < ring && q < nsig; q++) R *= 1.0 - op->sig[q];
+        if (ring >= nsig) {
+            double z[3][2] = {{0, 0}, {R, 0}, {0, R}};
+            memcpy(hole, z, sizeof hole);
+        } else {
+            double Rn = R * (1.0 - op->sig[ring]);
+            double a[3][3][2] = {{{Rn, 0}, {R, 0}, {Rn, Rn}},
+                                 {{Rn, Rn}, {R, Rn}, {Rn, R}},
+                                 {{0, Rn}, {Rn, Rn}, {0, R}}};
+            for (int k = 0; k < 3; k++) { hole[k][0] = a[part][k][0]; hole[k][1] = a[part][k][1]; }
+        }
+        const double *o = UNIT[j0], *eu = UNIT[(j0 + 1) % 4], *ev = UNIT[(j0 + 3) % 4];
+        double rect[3][2];
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 2; d++)
+                rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
+        ccn__xplace sub;
+        ccn__xplace_sub(&pl[f], (const double(*)[2])rect, &sub);
+        double *b = pt + 108 * (size_t)i;
+        to_caller(v, b, 36);
+        if (ccn__xm_add_bezier(xm, CCN_EXPORT_FACE_BI5, 5, b, &sub) < 0) r = -1;
+    }
+    free(pt);
+    if (r > 0)
+        for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++) {
+            int32_t f = S->hface[S->vfan[k]];
+            for (int32_t c = S->fstart[f]; c < S->fstart[f + 1]; c++) cov[c] = 1;
+        }
+    return r;
+}
+
 /* ---- the levels ---------------------------------------------------------------------- */
 
 ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t level,
@@ -178,6 +248,8 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
     ccn__xplace *tpl = NULL;
     ccn__pack *pk = NULL;
     int32_t npk = 0;
+    ccn__xplace *spl = NULL;          /* places of the cut's faces (caps) */
+    struct ccn__bi5 *ops[CCN_CAP_OPS] = {0};
     ccn_status st = CCN_OK;
     if (!reg || !regpl) goto oom;
     memcpy(reg, faces, sizeof(int32_t) * (size_t)n);
@@ -193,6 +265,13 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if ((st = cut(cm, sel, level + j, &S, &fmap, err))) goto done;
         for (int32_t f = 0; f < cm->nf; f++) inv[f] = -1;
         for (int32_t f = 0; f < S->nf; f++) inv[fmap[f]] = f;
+        if (v->guided_caps) { /* the places of S's faces being refined, for caps over them */
+            free(spl);
+            spl = malloc(sizeof(ccn__xplace) * (size_t)(S->nf ? S->nf : 1));
+            if (!spl) goto oom;
+            for (int32_t f = 0; f < S->nf; f++) spl[f].cage_face = -1; /* not being refined */
+            for (int32_t i = 0; i < nreg; i++) spl[inv[reg[i]]] = regpl[i];
+        }
         ccn__level lv;
         if ((st = ccn__level_prepare_ev(&lv, S, v->scheme, v->pinned, v->crease_method, v->ev_polyhedron,
                                          v->ev_cache, err))) goto done;
@@ -243,7 +322,33 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         ccn__packs_free(pk, npk);
         pk = NULL;
         npk = 0;
-        if (last) { /* the fill faces around each irregular vertex cover what is left */
+        /* a cap where the vertex left is a smooth EV the cap can take (semi-sharp creases
+         * decayed around it): its faces are done; the other holes go on. Never at a level
+         * coarser than CCN_FILL_CAP_LEVEL or the plan's output level: the samples of a plan of
+         * that level or below in such a hole are its EV (the cap's centre, the exact limit
+         * point) and its border (the exact surround), so the export still shows what such a
+         * plan shows; a coarser cap would differ from the refined limit the plan samples
+         * inside it. */
+        if (v->guided_caps && nreg && level + j >= v->output_level && level + j >= CCN_FILL_CAP_LEVEL) {
+            uint8_t *tried = calloc((size_t)T->nv, 1), *capcov = calloc((size_t)T->nf, 1);
+            int r = tried && capcov ? 0 : -1;
+            for (int32_t i = 0; i < nreg && r >= 0; i++)
+                for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && r >= 0; h++) {
+                    int32_t w = T->hvert[h];
+                    if (tried[w] || capcov[reg[i]] || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
+                    tried[w] = 1;
+                    int32_t u = parent_vertex(S, w);
+                    if (u >= 0) r = cap_vertex(xm, v, S, T, u, spl, ops, capcov);
+                }
+            int32_t kept = 0;
+            for (int32_t i = 0; i < nreg && r >= 0; i++)
+                if (!capcov[reg[i]]) { reg[kept] = reg[i]; regpl[kept++] = regpl[i]; }
+            free(tried);
+            free(capcov);
+            if (r < 0) goto oom;
+            nreg = kept;
+        }
+        if (last && nreg) { /* the fill faces around each irregular vertex cover what is left */
             uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
             ccn__fill_level *fl = NULL;
             if (!done_v || !cov) { free(done_v); free(cov); goto oom; }
@@ -302,5 +407,7 @@ done:
     ccn_mesh_destroy(T);
     ccn_mesh_destroy(owned);
     free(reg); free(regpl); free(sel); free(vmark); free(inv); free(fmap); free(mask); free(tpl);
+    free(spl);
+    ccn__cap_ops_free(ops);
     return st;
 }

@@ -20,7 +20,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CCN_CAP_MAX_VALENCE 32
 /* Non-uniform spoke intervals get a cap only while every kappa_s = d_{s+1}/d_{s-1} is within
  * this factor of 1 (beyond it the measured curvature of the cap fails the acceptance
  * figures -- README "The guided bi-5 cap"); the others use the exact refined limit (counted as
@@ -329,6 +328,90 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     p->cap_net = malloc(sizeof(double) * 3 * (6 * (size_t)maxn + 1));
     if (!p->cap_net) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     return CCN_OK;
+}
+
+/* ---- caps from meshes alone (the CAD export's holes) --------------------------------------- */
+
+void ccn__cap_ops_free(struct ccn__bi5 **ops) {
+    for (int32_t n = 0; n < CCN_CAP_OPS; n++) {
+        ccn__bi5_destroy(ops[n]);
+        ops[n] = NULL;
+    }
+}
+
+int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int scheme,
+                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, struct ccn__bi5 **ops,
+                   const struct ccn__bi5 **op, double **patches) {
+    *patches = NULL;
+    if (ev < 0 || ev >= mK->nv || !cap_ev(mK, ev)) return 0;
+    int32_t n = ccn__valence(mK, ev);
+    if (n > CCN_CAP_MAX_VALENCE) return 0;
+    ccn_error e2;
+    if (!ops[n]) { /* the exact surround's speeds (cap_op) */
+        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
+        if (ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2)) return -1;
+    }
+    *op = ops[n];
+    int32_t *stamp = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
+    int32_t *queue = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
+    int32_t *cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));
+    int32_t *ring = malloc(sizeof(int32_t) * (2 * (size_t)n + 1));
+    double *knots = malloc(sizeof(double) * (size_t)n);
+    double *net = malloc(sizeof(double) * 3 * (6 * (size_t)n + 1));
+    double *pieces = malloc(sizeof(double) * 432 * (size_t)n);
+    double *out = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(*op));
+    double complex *taus = NULL;
+    ccn__stencil *s = malloc(sizeof *s);
+    int r = -1;
+    if (!stamp || !queue || !cnet || !ring || !knots || !net || !pieces || !out || !s) goto done;
+    r = 0;
+    for (int32_t v = 0; v < mK->nv; v++) stamp[v] = -1;
+    if (!cap_isolated(mK, ev, stamp, queue)) goto done;
+    if (!ccn__cap_surround(mK, mK1, ev, pinned, pieces)) goto done;
+    int nu = 0;
+    for (int32_t k = 0; k < n; k++) knots[k] = mK->eknot[ccn__fan_edge(mK, ev, k)];
+    for (int32_t k = 0; k < n; k++) { /* within the range where the plan's caps are whole */
+        double kap = knots[(k + 1) % n] / knots[(k + n - 1) % n];
+        nu |= fabs(kap - 1.0) > 1e-12;
+        if (fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL)) goto done;
+    }
+    if (nu) {
+        taus = malloc(sizeof(double complex) * 36 * (size_t)n);
+        if (!taus) { r = -1; goto done; }
+        if (ccn__bi5_nu_taus(*op, knots, taus, &e2)) goto done;
+    }
+    if (ccn__ev_limit(mK, ev, scheme, ev_poly, cache, s, &e2)) goto done;
+    ccn__ev_ring(mK, ev, ring);
+    double ctr[3] = {0, 0, 0}, tu[3] = {0, 0, 0}, tv[3] = {0, 0, 0}, nrm[3];
+    for (int32_t j = 0; j < 2 * n + 1; j++)
+        for (int i = 0; i < 3; i++) {
+            double x = mK->pos[3 * (size_t)ring[j] + i];
+            ctr[i] += s->wp[j] * x;
+            tu[i] += s->wu[j] * x;
+            tv[i] += s->wv[j] * x;
+        }
+    ccn__unit_normal(tu, tv, nrm);
+    cap_cnet(mK, ev, n, cnet);
+    /* built around the EV's limit point as origin (the construction is affine invariant): a
+     * hole some levels down is small against its coordinates, and its inner rings far smaller;
+     * in absolute coordinates their joins lost G1 to rounding (1e-7 rad at level 7) */
+    double org[3] = {ctr[0], ctr[1], ctr[2]};
+    for (int32_t j = 0; j < 6 * n + 1; j++)
+        for (int i = 0; i < 3; i++) net[3 * j + i] = mK->pos[3 * (size_t)cnet[j] + i] - org[i];
+    for (size_t j = 0; j < 144 * (size_t)n; j++)
+        for (int i = 0; i < 3; i++) pieces[3 * j + i] -= org[i];
+    for (int i = 0; i < 3; i++) ctr[i] = 0;
+    if (ccn__bi5_apply_pieces(*op, net, pieces, knots, taus, ctr, isfinite(nrm[0]) ? nrm : NULL, out, &e2))
+        goto done;
+    for (size_t j = 0; j < 36 * (size_t)ccn__bi5_num_patches(*op); j++)
+        for (int i = 0; i < 3; i++) out[3 * j + i] += org[i];
+    *patches = out;
+    out = NULL;
+    r = 1;
+done:
+    free(stamp); free(queue); free(cnet); free(ring); free(knots); free(net); free(pieces);
+    free(out); free(taus); free(s);
+    return r;
 }
 
 /* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h). */

@@ -145,6 +145,8 @@ void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v) {
     v->crease_method = p->opts.crease_method;
     v->ev_polyhedron = p->opts.ev_polyhedron;
     v->ev_cache = p->ev_cache;
+    v->guided_caps = p->opts.cap == CCN_CAP_GUIDED_BI5;
+    v->output_level = p->L;
 }
 
 /* ---- ccn_plan_patches ------------------------------------------------------------ */

@@ -54,6 +54,8 @@ typedef struct {
     int32_t ev_polyhedron;     /* ccn_options.ev_polyhedron */
     ccn__ev_cache *ev_cache;   /* the plan's eigen polyhedron choices (refinement and limits
                                   elsewhere must make the plan's choice) */
+    int guided_caps;           /* options.cap == CCN_CAP_GUIDED_BI5 */
+    int32_t output_level;      /* options.levels (the level the plan's output samples) */
 } ccn__plan_view;
 void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v);
 

@@ -327,6 +327,7 @@ static void test_cages(void) {
     check_cage("fig16_v6", 0, 7);
     check_cage("mixed_boundary", 0, 11);
     check_cage("torus_semi", 1, 0);
+    check_cage("cube_semi", 1, 0); /* its corners capped once the creases decayed, no fills */
 }
 
 /* The default export of tests/data/<name>.obj at level 3 into F and info; CCN_OK or the
@@ -393,6 +394,38 @@ static void test_merged_faces(void) {
           (int)info.num_bi5, (int)info.num_bicubic);
     printf("# cube: %d faces (%d bi-5, %d bicubic) from 96 bi-5 and 72 bicubic patches\n", (int)info.num_faces,
            (int)info.num_bi5, (int)info.num_bicubic);
+    faces_free(&F);
+}
+
+/* Corners whose semi-sharp edges decay (cube_semi: sharpness 1.5) have no cap at the plan's cap
+ * level; the export caps them where they are smooth and isolated, at level 4 (the coarsest a
+ * hole's cap is made at): bi-5 faces instead of fills, G1 inside, and equal to the limit
+ * samples of the plans of levels 3 and 4 (the level-4 plan's samples in each cap are its EV
+ * and its border). */
+static void test_caps_in_holes(void) {
+    faces F;
+    ccn_export_info info;
+    CHECK(export_of("cube_semi", &F, &info) == CCN_OK, "cube_semi: export");
+    CHECK(info.num_fills == 0 && info.num_fill_faces == 0 && info.num_bi5 >= 8 * 3,
+          "cube_semi: %d fills, %d bi-5 faces (a cap at each corner)", (int)info.num_fills, (int)info.num_bi5);
+    CHECK(info.max_g1_deviation <= 1e-9, "cube_semi: G1 %g", info.max_g1_deviation);
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 4;
+    ccn_plan *p = load("cube_semi", &obj, &cage, &o);
+    CHECK(p != NULL, "cube_semi: level-4 plan");
+    if (p) {
+        double worst, fill_worst;
+        int unmatched, touched = against_limit(p, &cage, &F, &worst, &fill_worst, &unmatched);
+        CHECK(unmatched == 0 && worst <= 1e-12, "cube_semi: %d level-4 samples in no face, faces vs "
+              "them %g x size", unmatched, worst);
+        printf("# cube_semi: %d faces (%d bi-5, %d refined), G1 %.2e, %d faces touched by level-4 "
+               "samples, within %.2e x size\n", (int)info.num_faces, (int)info.num_bi5,
+               (int)info.num_refined, info.max_g1_deviation, touched, worst);
+        ccn_plan_destroy(p);
+        ccn_obj_destroy(obj);
+    }
     faces_free(&F);
 }
 
@@ -734,6 +767,7 @@ int main(void) {
     RUN(test_cages);
     RUN(test_semi_sharp_knots);
     RUN(test_merged_faces);
+    RUN(test_caps_in_holes);
     RUN(test_knot_removal);
     return TEST_SUMMARY();
 }

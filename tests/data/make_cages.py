@@ -216,6 +216,17 @@ def torus_semi(nu=8, nv=6):
     return V, F, creases
 
 
+def cube_semi():
+    """The cube, every vertex moved by a deterministic wobble, its 12 edges at sharpness 1.5:
+    the corners are creased for two levels and smooth valence-3 points after that."""
+    V, F = cube()
+    for k, p in enumerate(V):
+        for c in range(3):
+            p[c] += 0.06 * math.sin(2.1 * k + 1.3 * c + 0.4)
+    edges = sorted({tuple(sorted((f[i], f[(i + 1) % 4]))) for f in F for i in range(4)})
+    return V, F, [(e, 1.5) for e in edges]
+
+
 def prism_pyramid():
     """Triangular prism, one side quad replaced by a 4-triangle pyramid."""
     b = [[math.cos(2 * math.pi * k / 3), math.sin(2 * math.pi * k / 3), 0.0] for k in range(3)]
@@ -439,6 +450,7 @@ CAGES = [
 CREASED = [
     ("torus_semi.obj", torus_semi,
      "closed 8x6 torus, wobbled, two closed rings of semi-sharp edges (2 and 2.5) crossing"),
+    ("cube_semi.obj", cube_semi, "closed cube, wobbled, all 12 edges at sharpness 1.5"),
 ]
 
 FIGS = [
