@@ -20,11 +20,24 @@
 
 #include "base/error.h"
 
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
+
+/* Points written so far by their coordinates' bits: a point shared by several curves and
+ * surfaces (the boundary poles two faces and their edge share, bit for bit) is one
+ * CARTESIAN_POINT that all of them reference (catmark_car: a fifth of the points, 8 MB). */
+typedef struct {
+    uint64_t key[3];
+    int32_t id; /* 0: empty */
+} pt_slot;
 
 typedef struct {
     ccn__cad_out o;
     int32_t id; /* last entity id written */
+    pt_slot *pts;
+    size_t npts, cap; /* cap: a power of two (open addressing) */
+    int oom;
 } step_w;
 
 static int32_t ent(step_w *w) {
@@ -33,11 +46,48 @@ static int32_t ent(step_w *w) {
     return w->id;
 }
 
+static size_t pt_hash(const uint64_t k[3]) {
+    uint64_t h = 1469598103934665603ull;
+    for (int i = 0; i < 3; i++) h = (h ^ k[i]) * 1099511628211ull, h ^= h >> 31;
+    return (size_t)h;
+}
+
+static pt_slot *pt_find(pt_slot *tab, size_t cap, const uint64_t k[3]) {
+    for (size_t i = pt_hash(k) & (cap - 1);; i = (i + 1) & (cap - 1))
+        if (!tab[i].id || (tab[i].key[0] == k[0] && tab[i].key[1] == k[1] && tab[i].key[2] == k[2]))
+            return &tab[i];
+}
+
+static int pt_grow(step_w *w) {
+    size_t cap = w->cap ? 2 * w->cap : 4096;
+    pt_slot *tab = calloc(cap, sizeof *tab);
+    if (!tab) return -1;
+    for (size_t i = 0; i < w->cap; i++)
+        if (w->pts[i].id) *pt_find(tab, cap, w->pts[i].key) = w->pts[i];
+    free(w->pts);
+    w->pts = tab;
+    w->cap = cap;
+    return 0;
+}
+
 static int32_t point(step_w *w, const double p[3]) {
+    uint64_t k[3];
+    memcpy(k, p, sizeof k);
+    pt_slot *s = NULL;
+    if (!w->oom && 2 * (w->npts + 1) > w->cap && pt_grow(w)) w->oom = 1; /* then: no sharing */
+    if (!w->oom) {
+        s = pt_find(w->pts, w->cap, k);
+        if (s->id) return s->id;
+    }
     char a[32], b[32], c[32];
     int32_t id = ent(w);
     ccn__cad_printf(&w->o, "CARTESIAN_POINT('',(%s,%s,%s));\n", ccn__cad_real(p[0], a),
                     ccn__cad_real(p[1], b), ccn__cad_real(p[2], c));
+    if (s) {
+        memcpy(s->key, k, sizeof k);
+        s->id = id;
+        w->npts++;
+    }
     return id;
 }
 
@@ -61,23 +111,22 @@ static void flat_knot_lists(step_w *w, const double *t, int32_t nt) {
     ccn__cad_puts(&w->o, ")");
 }
 
-/* The id list of n consecutive entities starting at first, wrapped every 8 ids. */
-static void id_list(step_w *w, int32_t first, int32_t n) {
+/* The id list ids[0..n-1], wrapped every 8 ids. */
+static void id_list(step_w *w, const int32_t *ids, int32_t n) {
     ccn__cad_puts(&w->o, "(");
     for (int32_t i = 0; i < n; i++)
-        ccn__cad_printf(&w->o, "%s#%d", i ? (i % 8 ? "," : ",\n") : "", (int)(first + i));
+        ccn__cad_printf(&w->o, "%s#%d", i ? (i % 8 ? "," : ",\n") : "", (int)ids[i]);
     ccn__cad_puts(&w->o, ")");
 }
 
 static int32_t edge_curve(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
-                          const int32_t *vert_id, int32_t e, ccn__cad_curve *c) {
+                          const int32_t *vert_id, int32_t e, ccn__cad_curve *c, int32_t *ids) {
     ccn__cad_segment_curve(m, t, t->edge_seg[e], c);
-    int32_t first = w->id + 1;
-    for (int32_t i = 0; i < c->num_poles; i++) point(w, c->poles + 3 * (size_t)i);
+    for (int32_t i = 0; i < c->num_poles; i++) ids[i] = point(w, c->poles + 3 * (size_t)i);
     int closed = t->edge_vert[2 * e] == t->edge_vert[2 * e + 1];
     int32_t curve = ent(w);
     ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',%d,", (int)c->degree);
-    id_list(w, first, c->num_poles);
+    id_list(w, ids, c->num_poles);
     ccn__cad_printf(&w->o, ",.UNSPECIFIED.,%s,.F.,", closed ? ".T." : ".F.");
     flat_knot_lists(w, c->knots, c->num_poles + c->degree + 1);
     ccn__cad_puts(&w->o, ",.UNSPECIFIED.);\n");
@@ -88,18 +137,18 @@ static int32_t edge_curve(step_w *w, const ccn__cad_model *m, const ccn__cad_top
 }
 
 static int32_t face(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
-                    const int32_t *edge_id, int32_t fi) {
+                    const int32_t *edge_id, int32_t fi, int32_t *ids) {
     const ccn__cad_surface *f = &m->faces[fi];
     int32_t nu = f->num_poles[0], nv = f->num_poles[1];
-    int32_t first = w->id + 1;
     for (int32_t i = 0; i < nu; i++)
-        for (int32_t j = 0; j < nv; j++) point(w, f->poles + 3 * ((size_t)i * nv + j));
+        for (int32_t j = 0; j < nv; j++)
+            ids[(size_t)i * nv + j] = point(w, f->poles + 3 * ((size_t)i * nv + j));
     int32_t surf = ent(w);
     ccn__cad_printf(&w->o, "B_SPLINE_SURFACE_WITH_KNOTS('',%d,%d,(", (int)f->degree[0],
                     (int)f->degree[1]);
     for (int32_t i = 0; i < nu; i++) {
         ccn__cad_puts(&w->o, i ? ",\n" : "");
-        id_list(w, first + i * nv, nv);
+        id_list(w, ids + (size_t)i * nv, nv);
     }
     ccn__cad_printf(&w->o, "),.UNSPECIFIED.,%s,%s,.F.,", f->periodic[0] ? ".T." : ".F.",
                     f->periodic[1] ? ".T." : ".F.");
@@ -117,15 +166,15 @@ static int32_t face(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t,
     for (int32_t k = 0; k < f->num_knots[1]; k++)
         ccn__cad_printf(&w->o, "%s%s", k ? "," : "", ccn__cad_real(f->knots[1][k], r));
     ccn__cad_puts(&w->o, "),.UNSPECIFIED.);\n");
-    int32_t oe = w->id + 1, j0 = t->face_seg[fi], nj = t->face_seg[fi + 1] - j0;
+    int32_t j0 = t->face_seg[fi], nj = t->face_seg[fi + 1] - j0;
     for (int32_t j = j0; j < j0 + nj; j++) {
-        ent(w);
+        ids[j - j0] = ent(w);
         ccn__cad_printf(&w->o, "ORIENTED_EDGE('',*,*,#%d,%s);\n", (int)edge_id[t->seg_edge[j]],
                         t->seg_sense[j] ? ".T." : ".F.");
     }
     int32_t loop = ent(w);
     ccn__cad_puts(&w->o, "EDGE_LOOP('',");
-    id_list(w, oe, nj);
+    id_list(w, ids, nj);
     ccn__cad_puts(&w->o, ");\n");
     int32_t bound = ent(w);
     ccn__cad_printf(&w->o, "FACE_OUTER_BOUND('',#%d,.T.);\n", (int)loop);
@@ -203,16 +252,23 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     ccn_status st = ccn__cad_topo_build(m, &t, err);
     if (st) return st;
     int32_t maxp = 0;
+    size_t maxids = 1; /* a face's poles, or its side segments */
     for (int32_t f = 0; f < m->num_faces; f++) {
         int32_t c = ccn__cad_curve_capacity(&m->faces[f]);
         maxp = c > maxp ? c : maxp;
+        size_t np = (size_t)m->faces[f].num_poles[0] * (size_t)m->faces[f].num_poles[1];
+        size_t ns = (size_t)(t.face_seg[f + 1] - t.face_seg[f]);
+        maxids = np > maxids ? np : maxids;
+        maxids = ns > maxids ? ns : maxids;
     }
+    maxids = (size_t)maxp > maxids ? (size_t)maxp : maxids;
     int32_t *vert_id = malloc(sizeof(int32_t) * (size_t)t.num_verts);
     int32_t *edge_id = malloc(sizeof(int32_t) * (size_t)t.num_edges);
     int32_t *face_id = malloc(sizeof(int32_t) * (size_t)m->num_faces);
     double *scratch = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
-    step_w *w = malloc(sizeof *w);
-    if (!vert_id || !edge_id || !face_id || !scratch || !w) {
+    int32_t *ids = malloc(sizeof(int32_t) * maxids);
+    step_w *w = calloc(1, sizeof *w);
+    if (!vert_id || !edge_id || !face_id || !scratch || !ids || !w) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }
@@ -226,8 +282,8 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         ccn__cad_printf(&w->o, "VERTEX_POINT('',#%d);\n", (int)p);
     }
     ccn__cad_curve c = {0, 0, scratch + 3 * (size_t)maxp, scratch, 0}; /* poles, then knots */
-    for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, &c);
-    for (int32_t f = 0; f < m->num_faces; f++) face_id[f] = face(w, m, &t, edge_id, f);
+    for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, &c, ids);
+    for (int32_t f = 0; f < m->num_faces; f++) face_id[f] = face(w, m, &t, edge_id, f, ids);
     int32_t shell = ent(w);
     ccn__cad_printf(&w->o, "%s('',(", t.closed ? "CLOSED_SHELL" : "OPEN_SHELL");
     for (int32_t f = 0; f < m->num_faces; f++)
@@ -240,7 +296,8 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     if (ccn__cad_flush(&w->o))
         st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
 done:
-    free(vert_id); free(edge_id); free(face_id); free(scratch); free(w);
+    if (w) free(w->pts);
+    free(vert_id); free(edge_id); free(face_id); free(scratch); free(ids); free(w);
     ccn__cad_topo_free(&t);
     return st;
 }
