@@ -1,7 +1,8 @@
 /* STEP AP214 writer of the neutral B-rep (cad.h).
  *
  * Entities, leaves first so that every reference points backwards:
- *   CARTESIAN_POINT, VERTEX_POINT (one per shared vertex),
+ *   CARTESIAN_POINT (one per distinct point: poles shared bit for bit by curves and surfaces
+ *   are referenced, not repeated), VERTEX_POINT (one per shared vertex),
  *   B_SPLINE_CURVE_WITH_KNOTS + EDGE_CURVE (one per shared edge: the iso curve of the side
  *   segment that defines it, in increasing parameter, cut to the segment when the side is
  *   split),
