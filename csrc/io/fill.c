@@ -188,38 +188,17 @@ static int32_t parent_vertex(const ccn_mesh *S, int32_t w) {
  * covered faces of T in cov. 1 capped, 0 not a cap vertex, -1 out of memory. */
 static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
                       int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov) {
+    for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
+        if (pl[S->hface[S->vfan[k]]].cage_face < 0) return 0; /* a face around u is not in the hole */
     const struct ccn__bi5 *op;
     double *pt;
     int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, ops, &op, &pt);
     if (r <= 0) return r;
-    int32_t n = ccn__valence(S, u), nsig = op->nsig, np = ccn__bi5_num_patches(op);
-    for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
-        if (pl[S->hface[S->vfan[k]]].cage_face < 0) { /* a face around u is not in the hole */
-            free(pt);
-            return 0;
-        }
-    static const double UNIT[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (int32_t i = 0; i < np && r > 0; i++) { /* placed as surface/patch_set.c's export_cap */
-        int32_t sct = i % n, ring = i / (3 * n), part = (i / n) % 3;
-        int32_t h = S->vfan[S->vfan_start[u] + sct], f = S->hface[h];
-        int32_t j0 = h - S->fstart[f];
-        double R = 1, hole[3][2];
-        for (int32_t q = 0; q < ring && q < nsig; q++) R *= 1.0 - op->sig[q];
-        if (ring >= nsig) {
-            double z[3][2] = {{0, 0}, {R, 0}, {0, R}};
-            memcpy(hole, z, sizeof hole);
-        } else {
-            double Rn = R * (1.0 - op->sig[ring]);
-            double a[3][3][2] = {{{Rn, 0}, {R, 0}, {Rn, Rn}},
-                                 {{Rn, Rn}, {R, Rn}, {Rn, R}},
-                                 {{0, Rn}, {Rn, Rn}, {0, R}}};
-            for (int k = 0; k < 3; k++) { hole[k][0] = a[part][k][0]; hole[k][1] = a[part][k][1]; }
-        }
-        const double *o = UNIT[j0], *eu = UNIT[(j0 + 1) % 4], *ev = UNIT[(j0 + 3) % 4];
+    int32_t n = ccn__valence(S, u), np = ccn__bi5_num_patches(op);
+    for (int32_t i = 0; i < np && r > 0; i++) { /* placed as the plan's caps (surface/patch_set.h) */
+        int32_t h = S->vfan[S->vfan_start[u] + i % n], f = S->hface[h];
         double rect[3][2];
-        for (int k = 0; k < 3; k++)
-            for (int d = 0; d < 2; d++)
-                rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
+        ccn__cap_patch_rect(op, n, i, h - S->fstart[f], rect);
         ccn__xplace sub;
         ccn__xplace_sub(&pl[f], (const double(*)[2])rect, &sub);
         double *b = pt + 108 * (size_t)i;

@@ -349,7 +349,8 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     ccn_error e2;
     if (!ops[n]) { /* the exact surround's speeds (cap_op) */
         static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
-        if (ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2)) return -1;
+        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2);
+        if (st) return st == CCN_ERR_MEMORY ? -1 : 0;
     }
     *op = ops[n];
     int32_t *stamp = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));

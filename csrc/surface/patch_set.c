@@ -87,9 +87,27 @@ static int export_bicubic(walk *w, int32_t lvl) {
     return 0;
 }
 
-/* The bi-5 patches of cap c: patch i = (ring r, part A/B/C, sector s) or the cap of sector s
- * (bi5.h), placed in sector s's level-K face: hole coordinates (u along spoke s, v along spoke
- * s+1, (0,0) = the EV at the face's corner j0) scaled by the ring's Lambda (ccn__bi5_eval). */
+void ccn__cap_patch_rect(const struct ccn__bi5 *op, int32_t n, int32_t i, int32_t j0, double rect[3][2]) {
+    int32_t r = i / (3 * n), part = (i / n) % 3, nsig = op->nsig;
+    double R = 1, hole[3][2]; /* hole coordinates of the patch's (0,0), (1,0), (0,1) */
+    for (int32_t q = 0; q < r && q < nsig; q++) R *= 1.0 - op->sig[q];
+    if (r >= nsig) {
+        double z[3][2] = {{0, 0}, {R, 0}, {0, R}};
+        memcpy(hole, z, sizeof hole);
+    } else {
+        double Rn = R * (1.0 - op->sig[r]);
+        double a[3][3][2] = {{{Rn, 0}, {R, 0}, {Rn, Rn}},      /* A: u in [Rn,R], v in [0,Rn] */
+                             {{Rn, Rn}, {R, Rn}, {Rn, R}},     /* B */
+                             {{0, Rn}, {Rn, Rn}, {0, R}}};     /* C: u in [0,Rn], v in [Rn,R] */
+        for (int k = 0; k < 3; k++) { hole[k][0] = a[part][k][0]; hole[k][1] = a[part][k][1]; }
+    }
+    const double *o = UNIT[j0], *eu = UNIT[(j0 + 1) % 4], *ev = UNIT[(j0 + 3) % 4];
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 2; d++)
+            rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
+}
+
+/* The bi-5 patches of cap c, each placed in its sector's level-K face (ccn__cap_patch_rect). */
 static void export_cap(walk *w, int32_t c) {
     const ccn_plan *p = w->p;
     const ccn__cap *cp = &p->caps[c];
@@ -98,24 +116,8 @@ static void export_cap(walk *w, int32_t c) {
     for (int32_t i = 0; i < np; i++) {
         int32_t s = i % n, r = i / (3 * n), part = (i / n) % 3;
         int32_t h = mK->vfan[mK->vfan_start[cp->cnet[0]] + s], f = mK->hface[h];
-        int32_t j0 = h - mK->fstart[f];
-        double R = 1, hole[3][2]; /* hole coordinates of the patch's (0,0), (1,0), (0,1) */
-        for (int32_t q = 0; q < r && q < nsig; q++) R *= 1.0 - cp->op->sig[q];
-        if (r >= nsig) {
-            double z[3][2] = {{0, 0}, {R, 0}, {0, R}};
-            memcpy(hole, z, sizeof hole);
-        } else {
-            double Rn = R * (1.0 - cp->op->sig[r]);
-            double a[3][3][2] = {{{Rn, 0}, {R, 0}, {Rn, Rn}},      /* A: u in [Rn,R], v in [0,Rn] */
-                                 {{Rn, Rn}, {R, Rn}, {Rn, R}},     /* B */
-                                 {{0, Rn}, {Rn, Rn}, {0, R}}};     /* C: u in [0,Rn], v in [Rn,R] */
-            for (int k = 0; k < 3; k++) { hole[k][0] = a[part][k][0]; hole[k][1] = a[part][k][1]; }
-        }
-        const double *o = UNIT[j0], *eu = UNIT[(j0 + 1) % 4], *ev = UNIT[(j0 + 3) % 4];
         double rect[3][2];
-        for (int k = 0; k < 3; k++)
-            for (int d = 0; d < 2; d++)
-                rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
+        ccn__cap_patch_rect(cp->op, n, i, h - mK->fstart[f], rect);
         emit(w, r >= nsig ? CCN__PATCH_CAP : CCN__PATCH_CAP_RING, 5, cp->patches + 108 * (size_t)i,
              p->K, f, (const double(*)[2])rect, c, s, r, r >= nsig ? -1 : part);
     }

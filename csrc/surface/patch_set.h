@@ -40,6 +40,13 @@ typedef void (*ccn__place_fn)(void *user, const ccn__patch_place *p);
  * plan has no patch for (CCN__PATCH_HOLE) reported where ccn_plan_patches counts it. */
 ccn_status ccn__plan_patches_placed(const ccn_plan *p, ccn__place_fn fn, void *user);
 
+/* Where bi-5 patch i of a valence-n cap (bi5.h: ring r = i / 3n, part A/B/C = (i / n) % 3,
+ * sector s = i % n; the cap of sector s after the rings) lies in its sector's face, whose corner
+ * j0 is the EV: hole coordinates (u along spoke s, v along spoke s+1) scaled by the ring's
+ * Lambda (ccn__bi5_eval), as the (0,0), (1,0), (0,1) of the patch in the face's [0,1]^2. */
+struct ccn__bi5;
+void ccn__cap_patch_rect(const struct ccn__bi5 *op, int32_t n, int32_t i, int32_t j0, double rect[3][2]);
+
 /* What a plan exposes to the export: its meshes (lev[0] = the cage, positions of the last
  * evaluate in the unit box: caller coordinates = centre + scale * pos), the patch level
  * (the cap level K, or the deepest level without caps) and the rules. */
