@@ -1,5 +1,7 @@
 """The modifier on a plain cage: equals `ccnurbs limit`, live updates, render levels, errors,
 save/reload without the add-on, panels, remove."""
+import contextlib
+
 from bltest import *  # noqa: F401,F403
 
 import case_creases
@@ -132,34 +134,52 @@ class TestModifier(AddonTestCase):
         ob.ccnurbs.levels = 3
         self.assertGreater(len(self.assertMatchesCLI(ob)), n2)
 
+    @contextlib.contextmanager
+    def deferring(self):
+        """What an interactive session defers (exact normals before 4.5, the analysis) is
+        deferred here too; write_pending_normals() is the pause's timer."""
+        h = ccn.handlers
+        h.DEFER_IN_BACKGROUND[0] = True
+        try:
+            yield h
+        finally:
+            h.DEFER_IN_BACKGROUND[0] = False
+            ccn.state.clear_field("pending_normals", False)
+
+    def edit_twice(self, ob, check):
+        """Two edits in a row (the second while the first is still pending), check() after each."""
+        for step in range(2):
+            ob.data.vertices[step].co.z += 0.3
+            ob.data.update()
+            update()
+            check()
+
     def test_exact_normals_after_editing_pauses(self):
         """Blender < 4.5 (encoded custom normals, 5x the rest of an update): while editing the
         limit has Blender's own normals and its exact normals follow once editing pauses (the
         handlers' timer; here called directly, scripts do not defer). 4.5+: exact at once."""
         ob = load_cage("Fig16", os.path.join(DATA, "fig16_v6.obj"))
         add_modifier(ob, levels=2)
-        h = ccn.handlers
-        h.DEFER_IN_BACKGROUND[0] = True
-        try:
-            for step in range(2):  # twice: the second edit happens while still pending
-                ob.data.vertices[step].co.z += 0.3
-                ob.data.update()
-                update()
-                key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
-                if ccn.compat.FREE_NORMALS:
-                    self.assertMatchesCLI(ob)
-                    self.assertEqual(ccn.sync.pending_normals(), [])
-                    self.assertFalse(key.endswith(ccn.sync.PENDING), key)
-                    continue
-                self.assertMatchesCLI(ob, normals=False)  # positions exact at once
-                self.assertEqual(ccn.sync.pending_normals(), [ob])
-                self.assertTrue(key.endswith(ccn.sync.PENDING), key)
-                me = ccn.modifier.proxy(ob, 'VIEW').data
-                # < 4.1: custom normals are shown only with auto smooth, which is turned off;
-                # 4.1-4.4 have no cheap way to drop them (the last exact ones stay shown until
-                # the pending ones are written, below)
-                if hasattr(me, "use_auto_smooth"):
-                    self.assertIs(me.use_auto_smooth, False, "custom normals still shown")
+
+        def check():
+            key = ccn.modifier.proxy(ob, 'VIEW').data.get(ccn.proxies.KEY_PROP)
+            if ccn.compat.FREE_NORMALS:
+                self.assertMatchesCLI(ob)
+                self.assertEqual(ccn.sync.pending_normals(), [])
+                self.assertFalse(key.endswith(ccn.sync.PENDING), key)
+                return
+            self.assertMatchesCLI(ob, normals=False)  # positions exact at once
+            self.assertEqual(ccn.sync.pending_normals(), [ob])
+            self.assertTrue(key.endswith(ccn.sync.PENDING), key)
+            me = ccn.modifier.proxy(ob, 'VIEW').data
+            # < 4.1: custom normals are shown only with auto smooth, which is turned off;
+            # 4.1-4.4 have no cheap way to drop them (the last exact ones stay shown until
+            # the pending ones are written, below)
+            if hasattr(me, "use_auto_smooth"):
+                self.assertIs(me.use_auto_smooth, False, "custom normals still shown")
+
+        with self.deferring() as h:
+            self.edit_twice(ob, check)
             st = dict(ccn.sync.stats)
             h.write_pending_normals()
             update()
@@ -173,9 +193,6 @@ class TestModifier(AddonTestCase):
                 update()
             self.assertEqual(ccn.sync.stats["syncs"] - st["syncs"],
                              0 if ccn.compat.FREE_NORMALS else 1)
-        finally:
-            h.DEFER_IN_BACKGROUND[0] = False
-            ccn.state.clear_field("pending_normals", False)
 
     def test_edit_mode_updates(self):
         ob = add_modifier(grid(4))
@@ -382,16 +399,14 @@ class TestModifier(AddonTestCase):
             return np.where(good, 0.5 * (K[:, 0] + K[:, 1]), 0.0)
 
         before = mean_now()
-        h = ccn.handlers
-        h.DEFER_IN_BACKGROUND[0] = True
-        try:
-            for step in range(2):  # twice: the second edit happens while still pending
-                ob.data.vertices[step].co.z += 0.3
-                ob.data.update()
-                update()
-                self.assertMatchesCLI(ob, normals=False)  # the surface at once
-                self.assertEqual(ccn.sync.pending_normals(), [ob])
-                np.testing.assert_array_equal(mean_now(), before, "the curvature while pending")
+
+        def check():
+            self.assertMatchesCLI(ob, normals=False)  # the surface at once
+            self.assertEqual(ccn.sync.pending_normals(), [ob])
+            np.testing.assert_array_equal(mean_now(), before, "the curvature while pending")
+
+        with self.deferring() as h:
+            self.edit_twice(ob, check)
             want = mean_cli()
             scale = np.abs(want).max()
             self.assertGreater(np.abs(want - before).max(), 1e-3 * scale, "the edit changed nothing")
@@ -406,9 +421,6 @@ class TestModifier(AddonTestCase):
             bpy.context.scene.frame_set(bpy.context.scene.frame_current + 1)
             err = np.abs(mean_now() - mean_cli()).max() / scale
             self.assertLessEqual(err, 1e-5, "a frame's curvature: %.3g from the CLI" % err)
-        finally:
-            h.DEFER_IN_BACKGROUND[0] = False
-            ccn.state.clear_field("pending_normals", False)
 
     def test_highlight_lines(self):
         """Analysis > Highlight Lines: Solid shading with the add-on's stripe matcap in the

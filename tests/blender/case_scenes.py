@@ -45,6 +45,19 @@ def asset_library(prefix, stem, **settings):
     return names, lib
 
 
+def linked_instance(prefix, stem, **settings):
+    """asset_library's collection linked into a new file (File > Link) and instanced there by an
+    Empty (Instance Collections). Returns the twins' names and the instancing Empty."""
+    names, lib = asset_library(prefix, stem, **settings)
+    with bpy.data.libraries.load(lib, link=True) as (src, dst):
+        dst.collections = ["Asset"]
+    inst = bpy.data.objects.new("Asset instance", None)
+    inst.instance_type = 'COLLECTION'
+    inst.instance_collection = dst.collections[0]
+    bpy.context.scene.collection.objects.link(inst)
+    return names, inst
+
+
 def positions_in(dg, ob):
     me = ob.evaluated_get(dg).data
     P = np.empty(3 * len(me.vertices))
@@ -109,6 +122,15 @@ class TestScenes(AddonTestCase):
         d = max(set_distance(P, Q), set_distance(Q, P))
         self.assertLessEqual(d, POS_TOL, "%s: %.3g from Subdivision Surface" % (what, d))
 
+    def assertRendersAndShowsTwins(self, names, cc, ss, what):
+        """The scene's render and the viewport show the cage cc's surface as its Subdivision
+        Surface twin ss shows its own."""
+        scene = bpy.context.scene
+        self.assertTwinsEqual(render_probe(scene, scene.view_layers[0].name, names), names, what)
+        dg = update()
+        d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
+        self.assertLessEqual(d, POS_TOL, "%s, viewport" % what)
+
     def _setup_and_check(self, build, check, stem):
         """build() makes the structure and returns the twins' names; check(names, what) looks
         at the surface; then saved, reopened and checked again."""
@@ -170,13 +192,8 @@ class TestScenes(AddonTestCase):
             return names
 
         def check(names, what):
-            scene = bpy.context.scene
-            seen = render_probe(scene, scene.view_layers[0].name, names)
-            self.assertTwinsEqual(seen, names, "appended collection, " + what)
-            dg = update()  # and the viewport
             cc, ss = (bpy.data.objects[n] for n in names)
-            d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
-            self.assertLessEqual(d, POS_TOL, "appended collection, viewport, " + what)
+            self.assertRendersAndShowsTwins(names, cc, ss, "appended collection, " + what)
         self._setup_and_check(build, check, "scenes_appended")
 
     def test_linked_collection(self):
@@ -185,24 +202,12 @@ class TestScenes(AddonTestCase):
         cage shows the surface the library stored, in renders and in the viewport, and the panel
         says so. (Linked data is read-only here: a live surface needs a library override.)"""
         def build():
-            names, lib = asset_library("Ln", "scenes_linked_lib", store_render_mesh=True)
-            with bpy.data.libraries.load(lib, link=True) as (src, dst):
-                dst.collections = ["Asset"]
-            inst = bpy.data.objects.new("Asset instance", None)
-            inst.instance_type = 'COLLECTION'
-            inst.instance_collection = dst.collections[0]
-            bpy.context.scene.collection.objects.link(inst)
-            return names
+            return linked_instance("Ln", "scenes_linked_lib", store_render_mesh=True)[0]
 
         def check(names, what):
             cc, ss = (bpy.data.objects[n] for n in names)
             self.assertIsNotNone(cc.library, "the cage is not linked, " + what)
-            scene = bpy.context.scene
-            seen = render_probe(scene, scene.view_layers[0].name, names)
-            self.assertTwinsEqual(seen, names, "linked collection, " + what)
-            dg = update()
-            d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
-            self.assertLessEqual(d, POS_TOL, "linked collection, viewport, " + what)
+            self.assertRendersAndShowsTwins(names, cc, ss, "linked collection, " + what)
             st = ccn.sync.status(cc)
             self.assertIsNone(st.error, what)
             self.assertEqual(st.showing, "stored", what)
@@ -219,13 +224,7 @@ class TestScenes(AddonTestCase):
             return next(o for o in bpy.data.objects if o.name == name and o.library is None)
 
         def build():
-            names, lib = asset_library("Ov", "scenes_override_lib")
-            with bpy.data.libraries.load(lib, link=True) as (src, dst):
-                dst.collections = ["Asset"]
-            inst = bpy.data.objects.new("Asset instance", None)
-            inst.instance_type = 'COLLECTION'
-            inst.instance_collection = dst.collections[0]
-            bpy.context.scene.collection.objects.link(inst)
+            names, inst = linked_instance("Ov", "scenes_override_lib")
             bpy.context.view_layer.update()  # the new object's base, so that it can be selected
             for o in bpy.context.view_layer.objects:
                 o.select_set(o == inst)
@@ -236,12 +235,7 @@ class TestScenes(AddonTestCase):
         def check(names, what):
             cc, ss = (local(n) for n in names)
             self.assertIsNotNone(cc.override_library, "the cage is not an override, " + what)
-            scene = bpy.context.scene
-            seen = render_probe(scene, scene.view_layers[0].name, names)
-            self.assertTwinsEqual(seen, names, "overridden linked collection, " + what)
-            dg = update()
-            d = set_distance(positions_in(dg, cc), positions_in(dg, ss))
-            self.assertLessEqual(d, POS_TOL, "overridden linked collection, viewport, " + what)
+            self.assertRendersAndShowsTwins(names, cc, ss, "overridden linked collection, " + what)
         self._setup_and_check(build, check, "scenes_override")
         cc = local("OvCCNURBS")
         cc.ccnurbs.levels = LEVELS + 1  # an override's settings are its own
