@@ -451,11 +451,22 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
                 tv[i] += cp->l0[4 * n + 2 + j] * x;
             }
         ccn__unit_normal(tu, tv, nrm);
+        /* built around the EV's limit point as origin (the construction is affine invariant):
+         * a cap is small against its coordinates, its inner rings far smaller, and their joins
+         * keep G1 to the rounding of the cap's own size, not of its place (the unit cube's
+         * exported caps met within 1.1e-11 rad in absolute coordinates, 3.4e-13 so; the cube
+         * moved to (1000, 1000, 1000): 1.2e-7 against 7.6e-10) */
+        double org[3] = {ctr[0], ctr[1], ctr[2]};
+        for (int32_t j = 0; j < nc; j++)
+            for (int i = 0; i < 3; i++) net[3 * j + i] -= org[i];
+        ctr[0] = ctr[1] = ctr[2] = 0;
         ccn_status st;
         if (cp->exact_surround) {
             int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
             if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
+            for (size_t j = 0; j < 144 * (size_t)n; j++)
+                for (int i = 0; i < 3; i++) cp->pieces[3 * j + i] -= org[i];
             st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, cp->taus, ctr,
                                        isfinite(nrm[0]) ? nrm : NULL, cp->patches, err);
         } else if (isfinite(nrm[0])) {
@@ -464,6 +475,8 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
             st = ccn__bi5_apply_cached(cp->op, net, cp->knots, cp->taus, ctr, cp->patches, err);
         }
         if (st) return st;
+        for (size_t j = 0; j < 36 * (size_t)ccn__bi5_num_patches(cp->op); j++)
+            for (int i = 0; i < 3; i++) cp->patches[3 * j + i] += org[i];
     }
     for (int32_t i = 0; i < p->nhv; i++) {
         const ccn__cap *cp = &p->caps[p->hv_cap[i]];

@@ -429,6 +429,33 @@ static void test_caps_in_holes(void) {
     faces_free(&F);
 }
 
+/* The same cube far from the origin (moved by 1000 along each axis): its caps still meet G1
+ * to the rounding of their own size (they are built around their EVs), not of their place. */
+static void test_far_from_origin(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    o.levels = 3;
+    ccn_plan *p = load("cube", &obj, &cage, &o);
+    CHECK(p != NULL, "cube: plan");
+    if (!p) return;
+    double *far = malloc(sizeof(double) * 3 * (size_t)cage.num_verts);
+    for (int32_t i = 0; i < 3 * cage.num_verts; i++) far[i] = cage.positions[i] + 1000.0;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(ccn_plan_export(p, far, &eo, sink_fn, &s, &info, &err) == CCN_OK, "far cube: export: %s", err.message);
+    CHECK(info.num_bi5 > 0 && info.max_g1_deviation <= 1e-8, "far cube: %d bi-5 faces, G1 %g",
+          (int)info.num_bi5, info.max_g1_deviation);
+    printf("# the cube moved by 1000: G1 %.2e\n", info.max_g1_deviation);
+    free(s.d);
+    free(far);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
 /* ---- knot removal (io/knot_removal.c), against a refinement made here ----------------------- */
 
 /* Boehm: u inserted into flat knots t (n + p + 1) of a row of n poles (3 each; room for n + 1). */
@@ -768,6 +795,7 @@ int main(void) {
     RUN(test_semi_sharp_knots);
     RUN(test_merged_faces);
     RUN(test_caps_in_holes);
+    RUN(test_far_from_origin);
     RUN(test_knot_removal);
     return TEST_SUMMARY();
 }
