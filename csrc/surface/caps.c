@@ -31,6 +31,11 @@
  * largest |log kappa_s| goes from log(CCN_CAP_KAPPA_FULL) to log(CCN_CAP_KAPPA_RANGE), so the
  * surface does not jump where an EV's spokes leave the range. */
 #define CCN_CAP_KAPPA_FULL 1.04
+/* Equal spoke intervals take the uniform operator on the level-K net; a research build may take
+ * the exact surround there too (tests/experiments/RESULTS.md: the same fairness). */
+#ifndef CCN_CAP_EXACT_SURROUND_ALWAYS
+#define CCN_CAP_EXACT_SURROUND_ALWAYS 0
+#endif
 
 /* Sharp edges or vertex sharpness at v (boundary edges not counted)? */
 static int creased(const ccn_mesh *m, int32_t v) {
@@ -247,7 +252,8 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
          * is the limit itself. Any other intervals (kappa = 1 alternating and period 4 too, whose
          * level-K surround is not the limit: measured 5e-5 .. 6e-3 off): the exact
          * level-(K+1) surround and the exact centre normal (bi5.h [R13], [R14]). */
-        if (ok && t->uni) ok = ccn__bi5_apply_cached(c->op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
+        if (ok && t->uni && !CCN_CAP_EXACT_SURROUND_ALWAYS)
+            ok = ccn__bi5_apply_cached(c->op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
         else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
         free(zero);
     }
