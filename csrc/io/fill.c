@@ -244,7 +244,15 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if ((st = cut(cm, sel, level + j, &S, &fmap, err))) goto done;
         for (int32_t f = 0; f < cm->nf; f++) inv[f] = -1;
         for (int32_t f = 0; f < S->nf; f++) inv[fmap[f]] = f;
-        if (v->guided_caps) { /* the places of S's faces being refined, for caps over them */
+        /* a cap where the vertex left is a smooth EV the cap can take (semi-sharp creases
+         * decayed around it): its faces are done; the other holes go on. Never at a level
+         * coarser than CCN_FILL_CAP_LEVEL or the plan's output level: the samples of a plan of
+         * that level or below in such a hole are its EV (the cap's centre, the exact limit
+         * point) and its border (the exact surround), so the export still shows what such a
+         * plan shows; a coarser cap would differ from the refined limit the plan samples
+         * inside it. */
+        int capping = v->guided_caps && level + j >= v->output_level && level + j >= CCN_FILL_CAP_LEVEL;
+        if (capping) { /* the places of S's faces being refined, for caps over them */
             free(spl);
             spl = malloc(sizeof(ccn__xplace) * (size_t)(S->nf ? S->nf : 1));
             if (!spl) goto oom;
@@ -301,14 +309,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         ccn__packs_free(pk, npk);
         pk = NULL;
         npk = 0;
-        /* a cap where the vertex left is a smooth EV the cap can take (semi-sharp creases
-         * decayed around it): its faces are done; the other holes go on. Never at a level
-         * coarser than CCN_FILL_CAP_LEVEL or the plan's output level: the samples of a plan of
-         * that level or below in such a hole are its EV (the cap's centre, the exact limit
-         * point) and its border (the exact surround), so the export still shows what such a
-         * plan shows; a coarser cap would differ from the refined limit the plan samples
-         * inside it. */
-        if (v->guided_caps && nreg && level + j >= v->output_level && level + j >= CCN_FILL_CAP_LEVEL) {
+        if (capping && nreg) { /* the caps (above) */
             uint8_t *tried = calloc((size_t)T->nv, 1), *capcov = calloc((size_t)T->nf, 1);
             int r = tried && capcov ? 0 : -1;
             for (int32_t i = 0; i < nreg && r >= 0; i++)

@@ -338,6 +338,34 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
 
 /* ---- caps from meshes alone (the CAD export's holes) --------------------------------------- */
 
+/* The EV's limit point ctr and unit normal nrm from its 1-ring (ring, 2n+1 points of P) and the
+ * limit weights wp, wu, wv over it. */
+static void ring_frame(const double *P, const int32_t *ring, int32_t n, const double *wp,
+                       const double *wu, const double *wv, double ctr[3], double nrm[3]) {
+    double tu[3] = {0, 0, 0}, tv[3] = {0, 0, 0};
+    ctr[0] = ctr[1] = ctr[2] = 0;
+    for (int32_t j = 0; j < 2 * n + 1; j++)
+        for (int i = 0; i < 3; i++) {
+            double x = P[3 * (size_t)ring[j] + i];
+            ctr[i] += wp[j] * x;
+            tu[i] += wu[j] * x;
+            tv[i] += wv[j] * x;
+        }
+    ccn__unit_normal(tu, tv, nrm);
+}
+
+/* Adds sign * org to np points. A cap is built with its EV's limit point as origin (the
+ * construction is affine invariant): a cap is small against its coordinates, its inner rings
+ * far smaller, and their joins keep G1 to the rounding of the cap's own size, not of its place
+ * (the unit cube's exported caps met within 1.1e-11 rad in absolute coordinates, 3.4e-13 so;
+ * the cube moved to (1000, 1000, 1000): 1.2e-7 against 7.6e-10; caps of holes 7 levels down
+ * 1e-7 against 4.5e-12). */
+static void translate(double *pts, size_t np, const double org[3], double sign) {
+    for (size_t j = 0; j < np; j++)
+        for (int i = 0; i < 3; i++) pts[3 * j + i] += sign * org[i];
+}
+
+
 void ccn__cap_ops_free(struct ccn__bi5 **ops) {
     for (int32_t n = 0; n < CCN_CAP_OPS; n++) {
         ccn__bi5_destroy(ops[n]);
@@ -389,29 +417,16 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     }
     if (ccn__ev_limit(mK, ev, scheme, ev_poly, cache, s, &e2)) goto done;
     ccn__ev_ring(mK, ev, ring);
-    double ctr[3] = {0, 0, 0}, tu[3] = {0, 0, 0}, tv[3] = {0, 0, 0}, nrm[3];
-    for (int32_t j = 0; j < 2 * n + 1; j++)
-        for (int i = 0; i < 3; i++) {
-            double x = mK->pos[3 * (size_t)ring[j] + i];
-            ctr[i] += s->wp[j] * x;
-            tu[i] += s->wu[j] * x;
-            tv[i] += s->wv[j] * x;
-        }
-    ccn__unit_normal(tu, tv, nrm);
+    double org[3], nrm[3];
+    const double zero[3] = {0, 0, 0};
+    ring_frame(mK->pos, ring, n, s->wp, s->wu, s->wv, org, nrm);
     cap_cnet(mK, ev, n, cnet);
-    /* built around the EV's limit point as origin (the construction is affine invariant): a
-     * hole some levels down is small against its coordinates, and its inner rings far smaller;
-     * in absolute coordinates their joins lost G1 to rounding (1e-7 rad at level 7) */
-    double org[3] = {ctr[0], ctr[1], ctr[2]};
-    for (int32_t j = 0; j < 6 * n + 1; j++)
-        for (int i = 0; i < 3; i++) net[3 * j + i] = mK->pos[3 * (size_t)cnet[j] + i] - org[i];
-    for (size_t j = 0; j < 144 * (size_t)n; j++)
-        for (int i = 0; i < 3; i++) pieces[3 * j + i] -= org[i];
-    for (int i = 0; i < 3; i++) ctr[i] = 0;
-    if (ccn__bi5_apply_pieces(*op, net, pieces, knots, taus, ctr, isfinite(nrm[0]) ? nrm : NULL, out, &e2))
+    for (int32_t j = 0; j < 6 * n + 1; j++) memcpy(net + 3 * j, mK->pos + 3 * (size_t)cnet[j], sizeof(double) * 3);
+    translate(net, 6 * (size_t)n + 1, org, -1);
+    translate(pieces, 144 * (size_t)n, org, -1);
+    if (ccn__bi5_apply_pieces(*op, net, pieces, knots, taus, zero, isfinite(nrm[0]) ? nrm : NULL, out, &e2))
         goto done;
-    for (size_t j = 0; j < 36 * (size_t)ccn__bi5_num_patches(*op); j++)
-        for (int i = 0; i < 3; i++) out[3 * j + i] += org[i];
+    translate(out, 36 * (size_t)ccn__bi5_num_patches(*op), org, 1);
     *patches = out;
     out = NULL;
     r = 1;
@@ -446,33 +461,16 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
     for (int32_t c = 0; c < p->ncap; c++) {
         ccn__cap *cp = &p->caps[c];
         int32_t n = cp->n, nc = 6 * n + 1;
-        double *net = p->cap_net, ctr[3] = {0, 0, 0}; /* sized for the largest cap at create */
+        double *net = p->cap_net, ctr[3] = {0, 0, 0}, org[3], nrm[3]; /* ctr: at the origin */
         for (int32_t j = 0; j < nc; j++) memcpy(net + 3 * j, P + 3 * (size_t)cp->cnet[j], sizeof(double) * 3);
-        double tu[3] = {0, 0, 0}, tv[3] = {0, 0, 0}, nrm[3];
-        for (int32_t j = 0; j < 2 * n + 1; j++)
-            for (int i = 0; i < 3; i++) {
-                double x = P[3 * (size_t)cp->ring[j] + i];
-                ctr[i] += cp->l0[j] * x;
-                tu[i] += cp->l0[2 * n + 1 + j] * x;
-                tv[i] += cp->l0[4 * n + 2 + j] * x;
-            }
-        ccn__unit_normal(tu, tv, nrm);
-        /* built around the EV's limit point as origin (the construction is affine invariant):
-         * a cap is small against its coordinates, its inner rings far smaller, and their joins
-         * keep G1 to the rounding of the cap's own size, not of its place (the unit cube's
-         * exported caps met within 1.1e-11 rad in absolute coordinates, 3.4e-13 so; the cube
-         * moved to (1000, 1000, 1000): 1.2e-7 against 7.6e-10) */
-        double org[3] = {ctr[0], ctr[1], ctr[2]};
-        for (int32_t j = 0; j < nc; j++)
-            for (int i = 0; i < 3; i++) net[3 * j + i] -= org[i];
-        ctr[0] = ctr[1] = ctr[2] = 0;
+        ring_frame(P, cp->ring, n, cp->l0, cp->l0 + 2 * n + 1, cp->l0 + 4 * n + 2, org, nrm);
+        translate(net, (size_t)nc, org, -1); /* built around the EV (translate) */
         ccn_status st;
         if (cp->exact_surround) {
             int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
             if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
-            for (size_t j = 0; j < 144 * (size_t)n; j++)
-                for (int i = 0; i < 3; i++) cp->pieces[3 * j + i] -= org[i];
+            translate(cp->pieces, 144 * (size_t)n, org, -1);
             st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, cp->taus, ctr,
                                        isfinite(nrm[0]) ? nrm : NULL, cp->patches, err);
         } else if (isfinite(nrm[0])) {
@@ -481,8 +479,7 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
             st = ccn__bi5_apply_cached(cp->op, net, cp->knots, cp->taus, ctr, cp->patches, err);
         }
         if (st) return st;
-        for (size_t j = 0; j < 36 * (size_t)ccn__bi5_num_patches(cp->op); j++)
-            for (int i = 0; i < 3; i++) cp->patches[3 * j + i] += org[i];
+        translate(cp->patches, 36 * (size_t)ccn__bi5_num_patches(cp->op), org, 1);
     }
     for (int32_t i = 0; i < p->nhv; i++) {
         const ccn__cap *cp = &p->caps[p->hv_cap[i]];

@@ -126,6 +126,13 @@ static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn
     return p;
 }
 
+/* tests/data/<name>.obj's plan at output level `levels` (raised until its caps exist). */
+static ccn_plan *load_at(const char *name, int levels, ccn_obj **obj, ccn_cage *cage) {
+    ccn_options o = {0};
+    o.levels = levels;
+    return load(name, obj, cage, &o);
+}
+
 static ccn_status run(ccn_plan *p, ccn_export_options *eo, faces *F, sink *s, ccn_export_info *info,
                       ccn_error *err) {
     if (F) {
@@ -249,9 +256,7 @@ static int against_limit(ccn_plan *p, const ccn_cage *cage, const faces *F, doub
 static void check_cage(const char *name, int closed, int fills) {
     ccn_obj *obj;
     ccn_cage cage;
-    ccn_options o = {0};
-    o.levels = 3;
-    ccn_plan *p = load(name, &obj, &cage, &o);
+    ccn_plan *p = load_at(name, 3, &obj, &cage);
     CHECK(p != NULL, "%s: plan", name);
     if (!p) return;
     ccn_export_options eo;
@@ -335,9 +340,7 @@ static void test_cages(void) {
 static ccn_status export_of(const char *name, faces *F, ccn_export_info *info) {
     ccn_obj *obj;
     ccn_cage cage;
-    ccn_options o = {0};
-    o.levels = 3;
-    ccn_plan *p = load(name, &obj, &cage, &o);
+    ccn_plan *p = load_at(name, 3, &obj, &cage);
     memset(F, 0, sizeof *F);
     if (!p) return CCN_ERR_ARGUMENT;
     ccn_export_options eo;
@@ -411,9 +414,7 @@ static void test_caps_in_holes(void) {
     CHECK(info.max_g1_deviation <= 1e-9, "cube_semi: G1 %g", info.max_g1_deviation);
     ccn_obj *obj;
     ccn_cage cage;
-    ccn_options o = {0};
-    o.levels = 4;
-    ccn_plan *p = load("cube_semi", &obj, &cage, &o);
+    ccn_plan *p = load_at("cube_semi", 4, &obj, &cage);
     CHECK(p != NULL, "cube_semi: level-4 plan");
     if (p) {
         double worst, fill_worst;
@@ -434,9 +435,7 @@ static void test_caps_in_holes(void) {
 static void test_far_from_origin(void) {
     ccn_obj *obj;
     ccn_cage cage;
-    ccn_options o = {0};
-    o.levels = 3;
-    ccn_plan *p = load("cube", &obj, &cage, &o);
+    ccn_plan *p = load_at("cube", 3, &obj, &cage);
     CHECK(p != NULL, "cube: plan");
     if (!p) return;
     double *far = malloc(sizeof(double) * 3 * (size_t)cage.num_verts);
