@@ -173,6 +173,10 @@ static int semi_sharp(const ccn_mesh *m) {
  * plan of this output level or below (Levels 4 shows the same surface; deeper Levels show the
  * refined limit inside the cap's faces, where it pinches at the EV). */
 #define CCN_FILL_CAP_LEVEL 4
+/* At the last level a smooth interior EV whose spokes leave the cap's kappa range gets the
+ * non-uniform cap (G1 exact) unless its largest |K| exceeds this many times the fill faces'
+ * (G1 approximate) over the same hole. */
+#define CCN_FILL_CAP_K_RATIO 2.0
 
 /* The irregular vertex w of T (the refinement of the cut S) as a vertex of S: T numbers face
  * points, edge points, then vertex points (refine/level.h); -1 if w is not a vertex point. */
@@ -181,19 +185,76 @@ static int32_t parent_vertex(const ccn_mesh *S, int32_t w) {
     return v >= 0 && v < S->nv ? v : -1;
 }
 
+/* The largest |Gaussian curvature| of faces [f0, f1) of xm, sampled on a 9 x 9 grid of each
+ * (exact first derivatives, second ones by their central differences over 1e-4 of the span). */
+static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
+    double kmax = 0;
+    for (int32_t f = f0; f < f1; f++) {
+        const ccn__cad_surface *s = &xm->faces[f].s;
+        double u0, u1, v0, v1;
+        ccn__cad_domain(s, 0, &u0, &u1);
+        ccn__cad_domain(s, 1, &v0, &v1);
+        double hu = 1e-4 * (u1 - u0), hv = 1e-4 * (v1 - v0);
+        for (int a = 0; a <= 8; a++)
+            for (int b = 0; b <= 8; b++) {
+                double u = u0 + (u1 - u0) * (0.01 + 0.98 * a / 8), v = v0 + (v1 - v0) * (0.01 + 0.98 * b / 8);
+                double p[3], xu[3], xv[3], q[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3];
+                ccn__cad_eval_d(s, u, v, p, xu, xv);
+                ccn__cad_eval_d(s, u + hu, v, q, au, av);
+                ccn__cad_eval_d(s, u - hu, v, q, bu, bv);
+                ccn__cad_eval_d(s, u, v + hv, q, cu, cv);
+                double n[3], xuu[3], xuv[3], xvv[3], eu[3], ev[3];
+                ccn__cad_eval_d(s, u, v - hv, q, eu, ev);
+                for (int c = 0; c < 3; c++) {
+                    xuu[c] = (au[c] - bu[c]) / (2 * hu);
+                    xuv[c] = (cu[c] - eu[c]) / (2 * hv);
+                    xvv[c] = (cv[c] - ev[c]) / (2 * hv);
+                }
+                n[0] = xu[1] * xv[2] - xu[2] * xv[1];
+                n[1] = xu[2] * xv[0] - xu[0] * xv[2];
+                n[2] = xu[0] * xv[1] - xu[1] * xv[0];
+                double E = xu[0] * xu[0] + xu[1] * xu[1] + xu[2] * xu[2];
+                double F = xu[0] * xv[0] + xu[1] * xv[1] + xu[2] * xv[2];
+                double G = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
+                double W = E * G - F * F, nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                if (!(W > 0) || !(nl > 0)) continue;
+                double L = (xuu[0] * n[0] + xuu[1] * n[1] + xuu[2] * n[2]) / nl;
+                double M = (xuv[0] * n[0] + xuv[1] * n[1] + xuv[2] * n[2]) / nl;
+                double N = (xvv[0] * n[0] + xvv[1] * n[1] + xvv[2] * n[2]) / nl;
+                double K = fabs(L * N - M * M) / W;
+                if (isfinite(K) && K > kmax) kmax = K;
+            }
+    }
+    return kmax;
+}
+
+/* Drops the faces and cells added after (nf0, nc0). */
+static void xm_rollback(ccn__xmodel *xm, int32_t nf0, int32_t nc0) {
+    for (int32_t f = nf0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
+    xm->num_faces = nf0;
+    xm->num_cells = nc0;
+}
+
 /* A guided bi-5 cap (surface/caps.h, ccn__cap_exact) over the faces of S around vertex u,
  * instead of refining further and filling: the faces T has not exported there are exactly the
  * children of u's faces (their nets hold u's vertex point), and the cap joins the exported ones
  * C1 (its ring 0 is the exact level-(K+1) surround). pl: the places of S's faces. Marks the
  * covered faces of T in cov. 1 capped, 0 not a cap vertex, -1 out of memory. */
 static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
-                      int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov) {
+                      int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov,
+                      ccn__fill_level *fl, const ccn__xplace *tpl, int32_t w) {
     for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
         if (pl[S->hface[S->vfan[k]]].cage_face < 0) return 0; /* a face around u is not in the hole */
     const struct ccn__bi5 *op;
     double *pt;
-    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, ops, &op, &pt);
+    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 0, ops, &op, &pt);
+    int compare = 0; /* spokes beyond the cap's range: the fairer of cap and fill (below) */
+    if (r == 0 && fl) {
+        r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 1, ops, &op, &pt);
+        compare = r > 0;
+    }
     if (r <= 0) return r;
+    int32_t nf0 = xm->num_faces, nc0 = xm->num_cells;
     int32_t n = ccn__valence(S, u), np = ccn__bi5_num_patches(op);
     for (int32_t i = 0; i < np && r > 0; i++) { /* placed as the plan's caps (surface/patch_set.h) */
         int32_t h = S->vfan[S->vfan_start[u] + i % n], f = S->hface[h];
@@ -206,6 +267,24 @@ static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *
         if (ccn__xm_add_bezier(xm, CCN_EXPORT_FACE_BI5, 5, b, &sub) < 0) r = -1;
     }
     free(pt);
+    if (r > 0 && compare) {
+        /* the fill faces w would get, measured and dropped: the cap stays unless its largest
+         * |K| exceeds CCN_FILL_CAP_K_RATIO times theirs (G1 exact against approximate) */
+        double kc = faces_max_k(xm, nf0, xm->num_faces), kf = INFINITY;
+        int32_t nf1 = xm->num_faces, nc1 = xm->num_cells;
+        uint8_t *tmp = calloc((size_t)T->nf, 1);
+        ccn_error e2;
+        if (!tmp) return -1;
+        ccn_status st = ccn__fill_vertex(xm, fl, w, tpl, 0, tmp, &e2);
+        free(tmp);
+        if (st == CCN_ERR_MEMORY || xm->oom) return -1;
+        if (st == CCN_OK) kf = faces_max_k(xm, nf1, xm->num_faces);
+        xm_rollback(xm, nf1, nc1);
+        if (!(kc <= CCN_FILL_CAP_K_RATIO * kf)) {
+            xm_rollback(xm, nf0, nc0);
+            return 0;
+        }
+    }
     if (r > 0)
         for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++) {
             int32_t f = S->hface[S->vfan[k]];
@@ -312,14 +391,20 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if (capping && nreg) { /* the caps (above) */
             uint8_t *tried = calloc((size_t)T->nv, 1), *capcov = calloc((size_t)T->nf, 1);
             int r = tried && capcov ? 0 : -1;
+            ccn__fill_level *cfl = NULL; /* last level: caps beyond the range against fills */
+            if (last && r == 0 && (st = ccn__fill_level_create(v, T, &cfl, err))) {
+                free(tried); free(capcov);
+                goto done;
+            }
             for (int32_t i = 0; i < nreg && r >= 0; i++)
                 for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && r >= 0; h++) {
                     int32_t w = T->hvert[h];
                     if (tried[w] || capcov[reg[i]] || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
                     tried[w] = 1;
                     int32_t u = parent_vertex(S, w);
-                    if (u >= 0) r = cap_vertex(xm, v, S, T, u, spl, ops, capcov);
+                    if (u >= 0) r = cap_vertex(xm, v, S, T, u, spl, ops, capcov, cfl, tpl, w);
                 }
+            ccn__fill_level_destroy(cfl);
             int32_t kept = 0;
             for (int32_t i = 0; i < nreg && r >= 0; i++)
                 if (!capcov[reg[i]]) { reg[kept] = reg[i]; regpl[kept++] = regpl[i]; }

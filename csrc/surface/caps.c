@@ -374,8 +374,8 @@ void ccn__cap_ops_free(struct ccn__bi5 **ops) {
 }
 
 int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int scheme,
-                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, struct ccn__bi5 **ops,
-                   const struct ccn__bi5 **op, double **patches) {
+                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa,
+                   struct ccn__bi5 **ops, const struct ccn__bi5 **op, double **patches) {
     *patches = NULL;
     if (ev < 0 || ev >= mK->nv || !cap_ev(mK, ev)) return 0;
     int32_t n = ccn__valence(mK, ev);
@@ -408,7 +408,7 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     for (int32_t k = 0; k < n; k++) { /* within the range where the plan's caps are whole */
         double kap = knots[(k + 1) % n] / knots[(k + n - 1) % n];
         nu |= fabs(kap - 1.0) > 1e-12;
-        if (fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL)) goto done;
+        if (!any_kappa && fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL)) goto done;
     }
     if (nu) {
         taus = malloc(sizeof(double complex) * 36 * (size_t)n);

@@ -460,6 +460,9 @@ FIGS = [
     ("fig16_v6.obj", 6, (1, 10, 10, 1, 1, 10)),
     ("fig17_v7.obj", 7, (1, 8, 8, 1, 1, 1, 8)),
     ("fig18_v8.obj", 8, (1, 5, 5, 1, 1, 1, 5, 1)),
+    # not a paper figure: valence 7, every spoke ratio d_{s+1}/d_{s-1} beyond the cap's range
+    # (1.2-2): the CAD export caps it at the last level of its hole instead of filling it
+    ("star7_nu.obj", 7, (1, 1.6, 2, 1.3, 1.1, 1.8, 1.2)),
     # continuity regressions: spoke intervals where a switched polyhedron choice once jumped
     # in the 9th digit (every nearby value chose another candidate)
     ("continuity_v7.obj", 7, (1, 1, 5.942921586, 1, 1, 5.942921586, 1)),
