@@ -19,16 +19,51 @@
 
 /* ---- the whole construction on m columns (SPEC §5, §6) --------------------------------- */
 
+
+/* [R15] Per-sector sampling matrices through the spoke-scaled characteristic border: the
+ * planar tensor-border omega^s raise(chi) of every sector, spoke s scaled to d_s^e, made C2
+ * with ratio kappa_s across each spoke (the C2-rule, as tau's green layers [R11]), rotated back
+ * to sector 0's frame and sampled (corners `corners`, scale mu): S (n x 36 x 28). */
+static int nu_samples(const ccn__bi5 *b, const double complex chi[16], double mu, unsigned corners,
+                      const double *kap, const double *d, double e, double *S) {
+    int32_t n = b->n;
+    double complex *G = malloc(sizeof(double complex) * 36 * (size_t)n), G0[36], t0[36];
+    if (!G) return -1;
+    ccn__bi5_raise_chi(chi, G0);
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t e = 0; e < 36; e++) G[s * 36 + e] = ccn__bi5_omega(n, s) * G0[e];
+    ccn__bi5_spoke_scale(n, d, e, G);
+    ccn__bi5_c2_rule(n, kap, 2, (double *)G);
+    for (int32_t s = 0; s < n; s++) {
+        for (int32_t e = 0; e < 36; e++) t0[e] = G[s * 36 + e] * ccn__bi5_omega(n, -s);
+        ccn__bi5_sample(n, t0, 5, mu, corners, S + (size_t)s * 36 * 28);
+    }
+    free(G);
+    return 0;
+}
+
+/* T (n x 36 x m) = per-sector S_s (36 x 28) applied to the guide gbb. */
+static void sample_border_s(int32_t n, const double *S, const double *gbb, int32_t m, double *T) {
+    memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
+    for (int32_t s = 0; s < n; s++)
+        for (int32_t e = 0; e < 36; e++)
+            for (int32_t t = 0; t < 28; t++) {
+                double w = S[((size_t)s * 36 + e) * 28 + t];
+                if (w != 0.0) ccn__bi5_axpy(T + ((size_t)s * 36 + e) * m, w, gbb + ((size_t)s * 28 + t) * m, m);
+            }
+}
+
 /* X: (6n+1) x m c-net or T0: the raised tensor-border t~^0 (n x 36 x m), b600: m centre values, d: spoke intervals (NULL: uniform), kap: C2-rule
- * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric). out: patches x 36 x m. */
+ * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric), e: the guide's domain ([R15];
+ * 0: the symmetric characteristic border, else spokes d_s^e, with kap and d). out: patches x 36 x m. */
 static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0,
                             const double *b600, int32_t m, const double *d, const double *kap,
                             const double complex *taus, const double *pieces, const double *normal,
-                            const double *p12, double *out, ccn_error *err) {
+                            const double *p12, double e, double *out, ccn_error *err) {
     int32_t n = b->n;
     size_t tsz = (size_t)n * 36 * (size_t)m, psz = 36 * (size_t)m;
     double *To = malloc(sizeof(double) * tsz), *Ti = malloc(sizeof(double) * tsz);
-    double *gbb = malloc(sizeof(double) * (size_t)n * 28 * (size_t)m);
+    double *gbb = malloc(sizeof(double) * (size_t)n * 28 * (size_t)m), *Ss = NULL;
     ccn_status st = CCN_OK;
     if (!To || !Ti || !gbb) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (construction)");
@@ -39,12 +74,31 @@ static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0
         ccn__bi5_tcc(n, X, d, m, Ti);
         ccn__bi5_raise_border(n, Ti, m, To);
     }
-    st = p12 ? ccn__bi5_guide_fit_fixed(b, To, b600, p12, m, gbb, err)
-         : normal && m == 3 ? ccn__bi5_guide_fit_plane(b, To, b600, normal, gbb, err)
-                            : ccn__bi5_guide_fit(b, To, b600, m, gbb, err);
+    int scaled = kap && d && e > 0; /* [R15]: the fit and the rings through the scaled border */
+    ccn__bi5 bf = *b;
+    const ccn__bi5 *fb = b;
+    if (scaled) {
+        Ss = malloc(sizeof(double) * (size_t)n * 36 * 28);
+        if (!Ss || nu_samples(b, b->chi_half, 1.0, 0xEu, kap, d, e, Ss)) {
+            st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (construction)");
+            goto done;
+        }
+        if ((st = ccn__bi5_guide_setup_nu(b, Ss, &bf, err))) goto done;
+        fb = &bf;
+    }
+    st = p12 ? ccn__bi5_guide_fit_fixed(fb, To, b600, p12, m, gbb, err)
+         : normal && m == 3 ? ccn__bi5_guide_fit_plane(fb, To, b600, normal, gbb, err)
+                            : ccn__bi5_guide_fit(fb, To, b600, m, gbb, err);
+    if (scaled) ccn__bi5_guide_nu_free(&bf);
     if (st) goto done;
     for (int32_t r = 0; r < b->nsig; r++) {
-        ccn__bi5_sample_border(n, b->samp[r], gbb, m, Ti);         /* t^{r+1} = [g^{r+1} o chi~] */
+        if (scaled) {                                               /* t^{r+1} = [g^{r+1} o chi~^d] */
+            if (nu_samples(b, b->chi[r], b->Lam[r], 0xEu, kap, d, e, Ss)) {
+                st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (construction)");
+                goto done;
+            }
+            sample_border_s(n, Ss, gbb, m, Ti);
+        } else ccn__bi5_sample_border(n, b->samp[r], gbb, m, Ti);  /* t^{r+1} = [g^{r+1} o chi~] */
         ccn__bi5_c2_rule(n, kap, m, Ti);                           /* t~^{r+1} */
         for (int32_t s = 0; s < n; s++) {
             double *A = out + ((size_t)(3 * r + 0) * n + s) * psz;
@@ -57,6 +111,7 @@ static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0
     }
     st = ccn__bi5_cap(b, gbb, To, m, kap, taus, out + (size_t)3 * b->nsig * n * psz, err);
 done:
+    free(Ss);
     free(To); free(Ti); free(gbb);
     return st;
 }
@@ -139,7 +194,7 @@ static ccn_status build_stencil_fixed(ccn__bi5 *b, ccn_error *err) {
         c0[nc] = 1.0;
         p12[nc + 1] = 1.0;          /* p1 column */
         p12[mf + nc + 2] = 1.0;     /* p2 column */
-        st = construct(b, X, NULL, c0, mf, NULL, NULL, NULL, NULL, NULL, p12, out, err);
+        st = construct(b, X, NULL, c0, mf, NULL, NULL, NULL, NULL, NULL, p12, 0, out, err);
     }
     for (int32_t t = 0; !st && t < nt; t++)
         memcpy(b->stencilF + (size_t)t * 36 * mf, out + (size_t)t * n * 36 * mf, sizeof(double) * 36 * (size_t)mf);
@@ -159,7 +214,7 @@ static ccn_status build_stencil(ccn__bi5 *b, ccn_error *err) {
     if (!st) {
         for (int32_t k = 0; k < nc; k++) X[(size_t)k * m + k] = 1.0;
         c0[nc] = 1.0;
-        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, NULL, NULL, NULL, out, err);
+        st = construct(b, X, NULL, c0, m, NULL, NULL, NULL, NULL, NULL, NULL, 0, out, err);
     }
     for (int32_t t = 0; !st && t < nt; t++) /* sector 0 patch of type t = patch index t*n */
         memcpy(b->stencil + (size_t)t * 36 * m, out + (size_t)t * n * 36 * m, sizeof(double) * 36 * (size_t)m);
@@ -347,9 +402,9 @@ static ccn_status apply_impl(const ccn__bi5 *b, const double *cnet, const double
     else {
         double complex *taus = taus_in ? NULL : malloc(sizeof(double complex) * 36 * (size_t)n);
         if (!taus_in)
-            st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err)
+            st = taus ? ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, NULL, 0, taus, err)
                       : ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply)");
-        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus_in ? taus_in : taus, NULL, normal, NULL, patches, err);
+        if (!st) st = construct(b, cnet, NULL, ctr, 3, spoke_knots, kap, taus_in ? taus_in : taus, NULL, normal, NULL, 0, patches, err);
         free(taus);
     }
     if (kap != kap_small) free(kap);
@@ -376,7 +431,7 @@ ccn_status ccn__bi5_apply_normal(const ccn__bi5 *b, const double *cnet, const do
     return apply_impl(b, cnet, spoke_knots, taus, center, normal, patches, err);
 }
 
-ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double complex *taus,
+ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double border_exp, double complex *taus,
                             ccn_error *err) {
     if (!b || !spoke_knots || !taus)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "bi5: NULL argument to nu_taus");
@@ -389,7 +444,7 @@ ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double
             st = ccn__fail(err, CCN_ERR_KNOTS, CCN_ELEM_EDGE, s, "bi5: spoke %d has knot interval %g",
                            (int)s, spoke_knots[s]);
     if (!st) spoke_kappas(n, spoke_knots, kap);
-    if (!st) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    if (!st) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, spoke_knots, border_exp, taus, err);
     free(kap);
     return st;
 }
@@ -442,8 +497,8 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
                        "(relative defect %g)", kap[spoke], (int)spoke, def);
         goto done;
     }
-    if (nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
-    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, NULL, NULL, NULL, patches, err);
+    if (nu) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, NULL, 0, taus, err);
+    if (!st) st = construct(b, NULL, T, center, 3, NULL, nu ? kap : NULL, nu ? taus : NULL, NULL, NULL, NULL, 0, patches, err);
     if (!st) ccn__ok(err);
 done:
     free(T); free(kap); free(taus);
@@ -451,7 +506,7 @@ done:
 }
 
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
-                                 const double *spoke_knots, const double complex *taus_in,
+                                 const double *spoke_knots, double border_exp, const double complex *taus_in,
                                  const double *center, const double *normal, double *patches,
                                  ccn_error *err) {
     ccn_status st = check_apply_args(b, cnet, b ? 6 * b->n + 1 : 0, spoke_knots, center, patches, err);
@@ -476,10 +531,10 @@ ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const do
     if (!st && !T) st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (apply_pieces)");
     if (!st && ccn__bi5_pieces_target(n, pieces, T))
         st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1, "bi5: border fit failed");
-    if (!st && nu && !taus_in) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, taus, err);
+    if (!st && nu && !taus_in) st = ccn__bi5_tau_nu(n, b->chi[b->nsig - 1], kap, spoke_knots, border_exp, taus, err);
     const double complex *tu = taus_in ? taus_in : taus;
     if (!st) st = construct(b, NULL, T, center, 3, spoke_knots, nu ? kap : NULL, nu ? tu : NULL,
-                            pieces, normal, NULL, patches, err);
+                            pieces, normal, NULL, border_exp, patches, err);
     free(kap); free(taus); free(T);
     if (!st) ccn__ok(err);
     return st;

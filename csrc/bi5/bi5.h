@@ -96,6 +96,14 @@
  *       point with that normal and the remaining parameters refitted with them fixed. The cap's
  *       centre jet is the guide's, so the cap's tangent plane at the EV is the exact limit's
  *       (the plain fit left it 0.002-0.04 rad off for non-uniform intervals).
+ *  [R15] Spoke-scaled guide domain (border_exp e > 0, ccn__bi5_apply_pieces and
+ *       ccn__bi5_nu_taus): the planar border omega^s raise(chi~) of each sector is first mapped
+ *       linearly so that spoke s has length d_s^e (over the intervals' geometric mean), then
+ *       C2-ruled; the guide is fitted through it (per-sector sampling, its own design matrix),
+ *       the rings sample the guide through it and tau's green layers come from it. With e = 1/2
+ *       the caps of holes several levels below an EV whose spoke ratios leave the plan's kappa
+ *       range fold less and bend less than with e = 0 (tests/experiments/RESULTS.md); the
+ *       plan's own caps use e = 0.
  *  Numerics: tau's equality-constrained minimum by the SVD null space of the constraints
  *  (they are redundant) and Cholesky on the reduced normal equations of F_5.
  */
@@ -139,16 +147,19 @@ ccn_status ccn__bi5_apply_border(const ccn__bi5 *b, const double *border, const 
  * v in [1/2,1]; 2: across v = 1, u in [0,1/2]; 3: across v = 1, u in [1/2,1]). The guide is
  * fitted to the pieces (their least-squares tensor-border); ring 0 takes its outer layers from
  * the pieces, the other rings and the cap are [R9]-[R12]. normal (may be NULL): the unit
- * normal of the surface at the centre; the guide's tangent plane there is set to it ([R14]). */
+ * normal of the surface at the centre; the guide's tangent plane there is set to it ([R14]).
+ * border_exp: the guide's domain ([R15]; 0 = the symmetric characteristic border); taus, when
+ * given, must come from ccn__bi5_nu_taus with the same border_exp. */
 ccn_status ccn__bi5_apply_pieces(const ccn__bi5 *b, const double *cnet, const double *pieces,
-                                 const double *spoke_knots, const double complex *taus,
+                                 const double *spoke_knots, double border_exp, const double complex *taus,
                                  const double *center, const double *normal, double *patches,
                                  ccn_error *err);
 /* The per-sector taus of non-uniform spoke intervals ([R11]; n x 36, CCN_ERR_KNOTS if tau folds):
  * they depend on the intervals only, so a caller that evaluates repeatedly computes them once
  * and passes them to ccn__bi5_apply_cached / ccn__bi5_apply_pieces (NULL there: computed per
- * call, the ~35 ms that dominate a non-uniform cap's construction). */
-ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double complex *taus,
+ * call, the ~35 ms that dominate a non-uniform cap's construction); border_exp as in
+ * ccn__bi5_apply_pieces. */
+ccn_status ccn__bi5_nu_taus(const ccn__bi5 *b, const double *spoke_knots, double border_exp, double complex *taus,
                             ccn_error *err);
 /* ccn__bi5_apply with precomputed taus (NULL: as ccn__bi5_apply). */
 ccn_status ccn__bi5_apply_cached(const ccn__bi5 *b, const double *cnet, const double *spoke_knots,

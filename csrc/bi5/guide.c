@@ -146,36 +146,29 @@ static int32_t mask_list(int32_t idx[27]) {
     return q;
 }
 
-ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
+/* The fit's design matrix J (27n x (npar-1): the sampled tensor-borders of parameters 1.. of
+ * every sector, sector s sampled by samp + s * sstride, 36 x 28) and its QR factorisations:
+ * s0 = parameter 0's border, s12 = parameters 1 and 2's, qr/qtau = QR of J, qr1/qtau1 = QR of
+ * J without parameters 1, 2 (b_510, b_501). */
+static ccn_status fit_design(const ccn__bi5 *b, const double *samp, size_t sstride, double *s0, double *s12,
+                             double *qr, double *qtau, double *qr1, double *qtau1, ccn_error *err) {
     int32_t n = b->n, P = b->npar, rows = 27 * n, idx[27];
     mask_list(idx);
-    ccn__bi5_sample(n, b->chi_half, 3, 1.0, 0xEu, b->samp0); /* corners (1,0),(1,1),(0,1) */
-    double *eye = calloc((size_t)P * (size_t)P, sizeof(double));
-    double *J = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 1));
-    b->qr1 = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 3));
-    b->qtau1 = malloc(sizeof(double) * (size_t)P);
-    b->s12 = malloc(sizeof(double) * 2 * (size_t)rows);
-    if (!eye || !J || !b->gpar || !b->qr || !b->qtau || !b->s0 || !b->qr1 || !b->qtau1 || !b->s12) {
-        free(eye); free(J);
-        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (guide, n = %d)", (int)n);
-    }
-    for (int32_t p = 0; p < P; p++) eye[(size_t)p * P + p] = 1.0;
-    ccn__bi5_guide_bb(n, eye, P, b->gpar);
-    free(eye);
+    double *J = qr;
     for (int32_t s = 0; s < n; s++)
         for (int32_t e = 0; e < 27; e++)
             for (int32_t p = 0; p < P; p++) {
                 double acc = 0;
                 for (int32_t t = 0; t < 28; t++)
-                    acc += b->samp0[idx[e] * 28 + t] * b->gpar[((size_t)s * 28 + t) * P + p];
-                if (p == 0) b->s0[s * 27 + e] = acc;
+                    acc += samp[(size_t)s * sstride + idx[e] * 28 + t] * b->gpar[((size_t)s * 28 + t) * P + p];
+                if (p == 0) s0[s * 27 + e] = acc;
                 else J[(size_t)(p - 1) * rows + s * 27 + e] = acc;
             }
     /* parameters 1, 2 (b_510, b_501) apart, and the QR of the other columns */
-    memcpy(b->s12, J, sizeof(double) * 2 * (size_t)rows);
-    memcpy(b->qr1, J + 2 * (size_t)rows, sizeof(double) * (size_t)rows * (size_t)(P - 3));
-    lapack_int info1 = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 3, b->qr1, rows, b->qtau1);
-    lapack_int info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 1, J, rows, b->qtau);
+    memcpy(s12, J, sizeof(double) * 2 * (size_t)rows);
+    memcpy(qr1, J + 2 * (size_t)rows, sizeof(double) * (size_t)rows * (size_t)(P - 3));
+    lapack_int info1 = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 3, qr1, rows, qtau1);
+    lapack_int info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, rows, P - 1, J, rows, qtau);
     if (info1 != 0) info = info1;
     double rmin = INFINITY, rmax = 0;
     for (int32_t p = 0; p < P - 1; p++) {
@@ -183,8 +176,6 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
         rmin = r < rmin ? r : rmin;
         rmax = r > rmax ? r : rmax;
     }
-    memcpy(b->qr, J, sizeof(double) * (size_t)rows * (size_t)(P - 1));
-    free(J);
     if (info != 0 || !(rmin > 1e-12 * rmax))
         return ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_NONE, -1,
                          "bi5: guide least-squares matrix (27n x 12n+9, n = %d) is rank deficient "
@@ -192,6 +183,46 @@ ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
     return CCN_OK;
 }
 
+ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err) {
+    int32_t n = b->n, P = b->npar, rows = 27 * n;
+    ccn__bi5_sample(n, b->chi_half, 3, 1.0, 0xEu, b->samp0); /* corners (1,0),(1,1),(0,1) */
+    double *eye = calloc((size_t)P * (size_t)P, sizeof(double));
+    b->qr1 = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 3));
+    b->qtau1 = malloc(sizeof(double) * (size_t)P);
+    b->s12 = malloc(sizeof(double) * 2 * (size_t)rows);
+    if (!eye || !b->gpar || !b->qr || !b->qtau || !b->s0 || !b->qr1 || !b->qtau1 || !b->s12) {
+        free(eye);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (guide, n = %d)", (int)n);
+    }
+    for (int32_t p = 0; p < P; p++) eye[(size_t)p * P + p] = 1.0;
+    ccn__bi5_guide_bb(n, eye, P, b->gpar);
+    free(eye);
+    return fit_design(b, b->samp0, 0, b->s0, b->s12, b->qr, b->qtau, b->qr1, b->qtau1, err);
+}
+
+/* The design matrices of a fit whose sampling differs per sector (samp0s: n x 36 x 28, the
+ * corner jets of [. o phi_s] at (1,0), (1,1), (0,1)): a copy of b with its own qr, qtau, s0,
+ * qr1, qtau1, s12 (ccn__bi5_guide_nu_free releases them). */
+ccn_status ccn__bi5_guide_setup_nu(const ccn__bi5 *b, const double *samp0s, ccn__bi5 *out, ccn_error *err) {
+    int32_t n = b->n, P = b->npar, rows = 27 * n;
+    *out = *b;
+    out->qr = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 1));
+    out->qtau = malloc(sizeof(double) * (size_t)P);
+    out->s0 = malloc(sizeof(double) * (size_t)rows);
+    out->qr1 = malloc(sizeof(double) * (size_t)rows * (size_t)(P - 3));
+    out->qtau1 = malloc(sizeof(double) * (size_t)P);
+    out->s12 = malloc(sizeof(double) * 2 * (size_t)rows);
+    ccn_status st = !out->qr || !out->qtau || !out->s0 || !out->qr1 || !out->qtau1 || !out->s12
+                        ? ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (guide, n = %d)", (int)n)
+                        : fit_design(b, samp0s, 36 * 28, out->s0, out->s12, out->qr, out->qtau, out->qr1, out->qtau1, err);
+    if (st) ccn__bi5_guide_nu_free(out);
+    return st;
+}
+
+void ccn__bi5_guide_nu_free(ccn__bi5 *c) {
+    free(c->qr); free(c->qtau); free(c->s0); free(c->qr1); free(c->qtau1); free(c->s12);
+    c->qr = c->qtau = c->s0 = c->qr1 = c->qtau1 = c->s12 = NULL;
+}
 
 /* The guide's Bezier coefficients from its parameters: gbb = gpar * par (m columns). */
 static void guide_from_params(const ccn__bi5 *b, const double *par, int32_t m, double *gbb) {

@@ -18,6 +18,10 @@ void ccn__bi5_sample(int32_t n, const double complex *phi, int32_t d, double mu,
                      unsigned corners, double S[36 * 28]);
 /* Design matrix and its QR factorisation (SPEC §4.4). */
 ccn_status ccn__bi5_guide_setup(ccn__bi5 *b, ccn_error *err);
+/* The fit's design matrices for per-sector sampling maps (samp0s: n x 36 x 28): a copy of b
+ * owning new qr, qtau, s0, qr1, qtau1, s12 (freed by ccn__bi5_guide_nu_free). */
+ccn_status ccn__bi5_guide_setup_nu(const ccn__bi5 *b, const double *samp0s, ccn__bi5 *out, ccn_error *err);
+void ccn__bi5_guide_nu_free(ccn__bi5 *c);
 /* Least-squares guide fit: tcc (n x 36 x m, raised t_CC), b600 (m) -> gbb (n x 28 x m). */
 ccn_status ccn__bi5_guide_fit(const ccn__bi5 *b, const double *tcc, const double *b600,
                               int32_t m, double *gbb, ccn_error *err);

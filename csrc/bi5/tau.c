@@ -213,8 +213,7 @@ static const int32_t *free_list(void) {
 
 static int is_fixed(int32_t e) { return e / 6 >= 4 || e % 6 >= 4 || e == 21; }
 
-/* raise(chi~) (bi-3 -> bi-5) as a complex 6x6 patch. */
-static void raise_chi(const double complex chi[16], double complex G[36]) {
+void ccn__bi5_raise_chi(const double complex chi[16], double complex G[36]) {
     static const double E[6][4] = {{1, 0, 0, 0}, {0.4, 0.6, 0, 0}, {0.1, 0.6, 0.3, 0},
                                    {0, 0.3, 0.6, 0.1}, {0, 0, 0.6, 0.4}, {0, 0, 0, 1}};
     for (int32_t i = 0; i < 6; i++)
@@ -320,7 +319,7 @@ done:
 ccn_status ccn__bi5_tau(int32_t n, const double complex chi[16], double complex tau[36],
                         ccn_error *err) {
     double complex G[36];
-    raise_chi(chi, G);
+    ccn__bi5_raise_chi(chi, G);
     tau_problem P = {n, 1, NULL, G};
     return tau_solve(&P, tau, err);
 }
@@ -339,14 +338,36 @@ static double tau_min_jacobian(const double complex tau[36], double B[21][6], do
     return jmin;
 }
 
-ccn_status ccn__bi5_tau_nu(int32_t n, const double complex chi[16], const double *kap,
+/* [R15] Sector s of the planar border G (n x 36, omega^s raise(chi~) per sector) mapped by the
+ * real-linear map that takes omega^s to d_s^e omega^s and omega^{s+1} to d_{s+1}^e omega^{s+1}
+ * (d normalised by its geometric mean): the spokes of the guide's domain get lengths from
+ * their intervals, so that the cross-spoke ratios come out as (d_{s+1}/d_{s-1})^e before the
+ * C2-rule makes them kappa_s. */
+void ccn__bi5_spoke_scale(int32_t n, const double *d, double e, double complex *G) {
+    double gm = 0;
+    for (int32_t s = 0; s < n; s++) gm += log(d[s]) / n;
+    for (int32_t s = 0; s < n; s++) {
+        double complex w0 = ccn__bi5_omega(n, s), w1 = ccn__bi5_omega(n, s + 1);
+        double l0 = exp(e * (log(d[s]) - gm)), l1 = exp(e * (log(d[(s + 1) % n]) - gm));
+        double det = creal(w0) * cimag(w1) - cimag(w0) * creal(w1);
+        for (int32_t k = 0; k < 36; k++) {
+            double complex z = G[s * 36 + k];
+            double a = (creal(z) * cimag(w1) - cimag(z) * creal(w1)) / det;
+            double b = (creal(w0) * cimag(z) - cimag(w0) * creal(z)) / det;
+            G[s * 36 + k] = a * l0 * w0 + b * l1 * w1;
+        }
+    }
+}
+
+ccn_status ccn__bi5_tau_nu(int32_t n, const double complex chi[16], const double *kap, const double *d, double e,
                            double complex *tau, ccn_error *err) {
     double complex *G = malloc(sizeof(double complex) * 36 * (size_t)n);
     if (!G) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (tau)");
     double complex G0[36];
-    raise_chi(chi, G0);
+    ccn__bi5_raise_chi(chi, G0);
     for (int32_t s = 0; s < n; s++)
         for (int32_t e = 0; e < 36; e++) G[s * 36 + e] = ccn__bi5_omega(n, s) * G0[e];
+    if (d && e > 0) ccn__bi5_spoke_scale(n, d, e, G);
     ccn__bi5_c2_rule(n, kap, 2, (double *)G); /* green layers carry the NU C1 ratio */
     tau_problem P = {n, n, kap, G};
     ccn_status st = tau_solve(&P, tau, err);

@@ -235,56 +235,80 @@ static void xm_rollback(ccn__xmodel *xm, int32_t nf0, int32_t nc0) {
     xm->num_cells = nc0;
 }
 
-/* A guided bi-5 cap (surface/caps.h, ccn__cap_exact) over the faces of S around vertex u,
- * instead of refining further and filling: the faces T has not exported there are exactly the
- * children of u's faces (their nets hold u's vertex point), and the cap joins the exported ones
- * C1 (its ring 0 is the exact level-(K+1) surround). pl: the places of S's faces. Marks the
- * covered faces of T in cov. 1 capped, 0 not a cap vertex, -1 out of memory. */
-static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
-                      int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov,
-                      ccn__fill_level *fl, const ccn__xplace *tpl, int32_t w) {
-    for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
-        if (pl[S->hface[S->vfan[k]]].cage_face < 0) return 0; /* a face around u is not in the hole */
-    const struct ccn__bi5 *op;
-    double *pt;
-    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 0, ops, &op, &pt);
-    int compare = 0; /* spokes beyond the cap's range: the fairer of cap and fill (below) */
-    if (r == 0 && fl) {
-        r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 1, ops, &op, &pt);
-        compare = r > 0;
-    }
-    if (r <= 0) return r;
-    int32_t nf0 = xm->num_faces, nc0 = xm->num_cells;
+/* Adds the cap patches pt (around vertex u of S, operator op) to xm, placed as the plan's caps
+ * (surface/patch_set.h). 1, or -1 out of memory. */
+static int add_cap(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, int32_t u,
+                   const ccn__xplace *pl, const struct ccn__bi5 *op, const double *pt) {
     int32_t n = ccn__valence(S, u), np = ccn__bi5_num_patches(op);
-    for (int32_t i = 0; i < np && r > 0; i++) { /* placed as the plan's caps (surface/patch_set.h) */
+    double b[108];
+    for (int32_t i = 0; i < np; i++) {
         int32_t h = S->vfan[S->vfan_start[u] + i % n], f = S->hface[h];
         double rect[3][2];
         ccn__cap_patch_rect(op, n, i, h - S->fstart[f], rect);
         ccn__xplace sub;
         ccn__xplace_sub(&pl[f], (const double(*)[2])rect, &sub);
-        double *b = pt + 108 * (size_t)i;
+        memcpy(b, pt + 108 * (size_t)i, sizeof b);
         to_caller(v, b, 36);
-        if (ccn__xm_add_bezier(xm, CCN_EXPORT_FACE_BI5, 5, b, &sub) < 0) r = -1;
+        if (ccn__xm_add_bezier(xm, CCN_EXPORT_FACE_BI5, 5, b, &sub) < 0) return -1;
     }
-    free(pt);
-    if (r > 0 && compare) {
-        /* the fill faces w would get, measured and dropped: the cap stays unless its largest
-         * |K| exceeds CCN_FILL_CAP_K_RATIO times theirs (G1 exact against approximate) */
-        double kc = faces_max_k(xm, nf0, xm->num_faces), kf = INFINITY;
-        int32_t nf1 = xm->num_faces, nc1 = xm->num_cells;
-        uint8_t *tmp = calloc((size_t)T->nf, 1);
-        ccn_error e2;
-        if (!tmp) return -1;
-        ccn_status st = ccn__fill_vertex(xm, fl, w, tpl, 0, tmp, &e2);
-        free(tmp);
-        if (st == CCN_ERR_MEMORY || xm->oom) return -1;
-        if (st == CCN_OK) kf = faces_max_k(xm, nf1, xm->num_faces);
-        xm_rollback(xm, nf1, nc1);
-        if (!(kc <= CCN_FILL_CAP_K_RATIO * kf)) {
+    return 1;
+}
+
+/* The guide's domains tried for a cap beyond the plan's kappa range (bi5.h [R15]): the
+ * symmetric one and spokes d_s^(1/2); each is the fairer on some stars (measured,
+ * tests/experiments/RESULTS.md). The second replaces the first only when its largest |K| is
+ * below CCN_FILL_CAP_PREFER times the first's, so that near ties (where rounding could
+ * decide) keep the plan's domain on every platform. */
+static const double beyond_exps[2] = {0.0, 0.5};
+#define CCN_FILL_CAP_PREFER 0.9
+
+/* A guided bi-5 cap (surface/caps.h, ccn__cap_exact) over the faces of S around vertex u,
+ * instead of refining further and filling: the faces T has not exported there are exactly the
+ * children of u's faces (their nets hold u's vertex point), and the cap joins the exported ones
+ * C1 (its ring 0 is the exact level-(K+1) surround). pl: the places of S's faces. Marks the
+ * covered faces of T in cov. fl (the last level only): spokes beyond the cap's kappa range are
+ * capped too, with the fairest of the caps of beyond_exps and the fill faces of w (T's vertex
+ * of u, places tpl) that would close the hole instead: both are built and sampled, and a cap
+ * stays unless its largest |K| exceeds CCN_FILL_CAP_K_RATIO times the fill's (G1 exact against
+ * approximate). 1 capped, 0 not capped, -1 out of memory. */
+static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
+                      int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov,
+                      ccn__fill_level *fl, const ccn__xplace *tpl, int32_t w) {
+    for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++)
+        if (pl[S->hface[S->vfan[k]]].cage_face < 0) return 0; /* a face around u is not in the hole */
+    const struct ccn__bi5 *op = NULL;
+    double *pt = NULL;
+    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 0, 0, ops, &op, &pt);
+    if (r == 0 && fl) { /* beyond the range: the fairest cap, against the fill */
+        double kbest = INFINITY;
+        for (int q = 0; q < 2 && r >= 0; q++) {
+            const struct ccn__bi5 *oq;
+            double *pq;
+            int rq = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 1,
+                                    beyond_exps[q], ops, &oq, &pq);
+            if (rq < 0) r = -1;
+            if (rq <= 0) continue;
+            int32_t nf0 = xm->num_faces, nc0 = xm->num_cells;
+            double k = add_cap(xm, v, S, u, pl, oq, pq) > 0 ? faces_max_k(xm, nf0, xm->num_faces) : NAN;
             xm_rollback(xm, nf0, nc0);
-            return 0;
+            if (isnan(k) || xm->oom) { free(pq); r = -1; continue; }
+            if (k < CCN_FILL_CAP_PREFER * kbest) { free(pt); pt = pq; op = oq; kbest = k; }
+            else free(pq);
+        }
+        if (r >= 0 && pt) {
+            int32_t nf1 = xm->num_faces, nc1 = xm->num_cells;
+            uint8_t *tmp = calloc((size_t)T->nf, 1);
+            ccn_error e2;
+            ccn_status st = tmp ? ccn__fill_vertex(xm, fl, w, tpl, 0, tmp, &e2) : CCN_ERR_MEMORY;
+            free(tmp);
+            double kf = st == CCN_OK ? faces_max_k(xm, nf1, xm->num_faces) : INFINITY;
+            xm_rollback(xm, nf1, nc1);
+            if (st == CCN_ERR_MEMORY || xm->oom) r = -1;
+            else r = kbest <= CCN_FILL_CAP_K_RATIO * kf;
         }
     }
+    if (r > 0) r = add_cap(xm, v, S, u, pl, op, pt);
+    free(pt);
     if (r > 0)
         for (int32_t k = S->vfan_start[u]; k < S->vfan_start[u + 1]; k++) {
             int32_t f = S->hface[S->vfan[k]];

@@ -144,7 +144,7 @@ static int cap_use_surround(ccn_plan *p, ccn__cap *c, int32_t ev, const double *
     c->pieces = calloc(432 * (size_t)c->n, sizeof(double));
     return c->patches && c->pieces &&
            ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], ev, pinned, NULL) &&
-           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, c->taus, zero, NULL, c->patches, e2) == CCN_OK;
+           ccn__bi5_apply_pieces(op, zero, c->pieces, c->knots, 0, c->taus, zero, NULL, c->patches, e2) == CCN_OK;
 }
 
 /* a plan made with options.previous: the earlier plan's cap at EV ev of level K, if it has taus and the same
@@ -236,7 +236,7 @@ static void taus_range(void *ctx, int32_t begin, int32_t end) {
         cap_todo *t = &j->todo[i];
         ccn__cap *c = &j->caps[i];
         ccn_error e2;
-        t->ok = ccn__bi5_nu_taus(c->op, c->knots, c->taus, &e2) == CCN_OK;
+        t->ok = ccn__bi5_nu_taus(c->op, c->knots, 0, c->taus, &e2) == CCN_OK;
     }
 }
 
@@ -374,7 +374,7 @@ void ccn__cap_ops_free(struct ccn__bi5 **ops) {
 }
 
 int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int scheme,
-                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa,
+                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa, double border_exp,
                    struct ccn__bi5 **ops, const struct ccn__bi5 **op, double **patches) {
     *patches = NULL;
     if (ev < 0 || ev >= mK->nv || !cap_ev(mK, ev)) return 0;
@@ -403,17 +403,19 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     for (int32_t v = 0; v < mK->nv; v++) stamp[v] = -1;
     if (!cap_isolated(mK, ev, stamp, queue)) goto done;
     if (!ccn__cap_surround(mK, mK1, ev, pinned, pieces)) goto done;
-    int nu = 0;
+    int nu = 0, beyond = 0;
     for (int32_t k = 0; k < n; k++) knots[k] = mK->eknot[ccn__fan_edge(mK, ev, k)];
     for (int32_t k = 0; k < n; k++) { /* within the range where the plan's caps are whole */
         double kap = knots[(k + 1) % n] / knots[(k + n - 1) % n];
         nu |= fabs(kap - 1.0) > 1e-12;
-        if (!any_kappa && fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL)) goto done;
+        beyond |= fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL);
     }
+    if (beyond && !any_kappa) goto done;
+    if (!beyond) border_exp = 0; /* within the range: the plan's construction */
     if (nu) {
         taus = malloc(sizeof(double complex) * 36 * (size_t)n);
         if (!taus) { r = -1; goto done; }
-        if (ccn__bi5_nu_taus(*op, knots, taus, &e2)) goto done;
+        if (ccn__bi5_nu_taus(*op, knots, border_exp, taus, &e2)) goto done;
     }
     if (ccn__ev_limit(mK, ev, scheme, ev_poly, cache, s, &e2)) goto done;
     ccn__ev_ring(mK, ev, ring);
@@ -424,7 +426,7 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     for (int32_t j = 0; j < 6 * n + 1; j++) memcpy(net + 3 * j, mK->pos + 3 * (size_t)cnet[j], sizeof(double) * 3);
     translate(net, 6 * (size_t)n + 1, org, -1);
     translate(pieces, 144 * (size_t)n, org, -1);
-    if (ccn__bi5_apply_pieces(*op, net, pieces, knots, taus, zero, isfinite(nrm[0]) ? nrm : NULL, out, &e2))
+    if (ccn__bi5_apply_pieces(*op, net, pieces, knots, border_exp, taus, zero, isfinite(nrm[0]) ? nrm : NULL, out, &e2))
         goto done;
     translate(out, 36 * (size_t)ccn__bi5_num_patches(*op), org, 1);
     *patches = out;
@@ -471,7 +473,7 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
             if (!ccn__cap_surround(p->lev[p->K], p->lev[p->K + 1], cp->cnet[0], pinned, cp->pieces))
                 return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "cap surround lost");
             translate(cp->pieces, 144 * (size_t)n, org, -1);
-            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, cp->taus, ctr,
+            st = ccn__bi5_apply_pieces(cp->op, net, cp->pieces, cp->knots, 0, cp->taus, ctr,
                                        isfinite(nrm[0]) ? nrm : NULL, cp->patches, err);
         } else if (isfinite(nrm[0])) {
             st = ccn__bi5_apply_normal(cp->op, net, cp->knots, cp->taus, ctr, nrm, cp->patches, err);

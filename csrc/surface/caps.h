@@ -21,11 +21,12 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
  * (ccn__bi5_num_patches(*op) x 36 x 3 doubles, mK's coordinates; caller frees) when ev is a
  * smooth interior EV, isolated by three regular rings, its spokes within the cap's kappa
  * range (no blending with the refined limit; any_kappa: any spoke ratios, the non-uniform
- * construction of bi5.h [R8]-[R13] wherever its tau does not fold), and the construction
- * succeeds; 0 when it does not qualify; -1 out of memory. */
+ * construction of bi5.h [R8]-[R13] wherever its tau does not fold, beyond the range with the
+ * guide's domain border_exp of [R15]), and the construction succeeds; 0 when it does not
+ * qualify; -1 out of memory. */
 #define CCN_CAP_OPS (CCN_CAP_MAX_VALENCE + 1)
 int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int scheme,
-                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa,
+                   int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa, double border_exp,
                    struct ccn__bi5 **ops, const struct ccn__bi5 **op, double **patches);
 void ccn__cap_ops_free(struct ccn__bi5 **ops);
 

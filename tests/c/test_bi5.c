@@ -752,7 +752,7 @@ static void test_nu_classes(void) {
         double complex chi[16], tau[36], *taus = malloc(sizeof(double complex) * 36 * (size_t)nn);
         ccn__bi5_charmap(nn, 0.875, chi, NULL, &err);
         CHECK(ccn__bi5_tau(nn, chi, tau, &err) == CCN_OK, "tau");
-        CHECK(ccn__bi5_tau_nu(nn, chi, kap1, taus, &err) == CCN_OK, "tau_nu: %s", err.message);
+        CHECK(ccn__bi5_tau_nu(nn, chi, kap1, NULL, 0, taus, &err) == CCN_OK, "tau_nu: %s", err.message);
         for (int s = 0; s < nn; s++)
             for (int k = 0; k < 36; k++) et = fmax(et, cabs(taus[s * 36 + k] - cexp(CCN_BI5_I * TWO_PI * s / nn) * tau[k]));
         free(taus);

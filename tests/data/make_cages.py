@@ -463,6 +463,9 @@ FIGS = [
     # not a paper figure: valence 7, every spoke ratio d_{s+1}/d_{s-1} beyond the cap's range
     # (1.2-2): the CAD export caps it at the last level of its hole instead of filling it
     ("star7_nu.obj", 7, (1, 1.6, 2, 1.3, 1.1, 1.8, 1.2)),
+    # ... and valence 5 with spoke ratios up to 4, where the cap with the symmetric guide domain
+    # folds and the one with spokes d^(1/2) (bi5.h [R15]) does not
+    ("star5_nu.obj", 5, (1, 2.2, 4, 1.5, 3)),
     # continuity regressions: spoke intervals where a switched polyhedron choice once jumped
     # in the 9th digit (every nearby value chose another candidate)
     ("continuity_v7.obj", 7, (1, 1, 5.942921586, 1, 1, 5.942921586, 1)),

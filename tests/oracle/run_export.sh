@@ -110,6 +110,7 @@ check fig16_v6 tests/data/fig16_v6.obj 3
 check fig17_v7 tests/data/fig17_v7.obj 3
 check fig18_v8 tests/data/fig18_v8.obj 3
 check star7_nu tests/data/star7_nu.obj 3
+check star5_nu tests/data/star5_nu.obj 3
 check tearbox "$T/tearbox.obj" 3
 check ngon_prism tests/data/ngon_prism.obj 3
 check lshape tests/data/lshape.obj 3
