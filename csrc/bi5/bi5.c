@@ -19,7 +19,6 @@
 
 /* ---- the whole construction on m columns (SPEC §5, §6) --------------------------------- */
 
-
 /* [R15] Per-sector sampling matrices through the spoke-scaled characteristic border: the
  * planar tensor-border omega^s raise(chi) of every sector, spoke s scaled to d_s^e, made C2
  * with ratio kappa_s across each spoke (the C2-rule, as tau's green layers [R11]), rotated back
@@ -31,11 +30,11 @@ static int nu_samples(const ccn__bi5 *b, const double complex chi[16], double mu
     if (!G) return -1;
     ccn__bi5_raise_chi(chi, G0);
     for (int32_t s = 0; s < n; s++)
-        for (int32_t e = 0; e < 36; e++) G[s * 36 + e] = ccn__bi5_omega(n, s) * G0[e];
+        for (int32_t k = 0; k < 36; k++) G[s * 36 + k] = ccn__bi5_omega(n, s) * G0[k];
     ccn__bi5_spoke_scale(n, d, e, G);
     ccn__bi5_c2_rule(n, kap, 2, (double *)G);
     for (int32_t s = 0; s < n; s++) {
-        for (int32_t e = 0; e < 36; e++) t0[e] = G[s * 36 + e] * ccn__bi5_omega(n, -s);
+        for (int32_t k = 0; k < 36; k++) t0[k] = G[s * 36 + k] * ccn__bi5_omega(n, -s);
         ccn__bi5_sample(n, t0, 5, mu, corners, S + (size_t)s * 36 * 28);
     }
     free(G);

@@ -198,13 +198,14 @@ static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
         for (int a = 0; a <= 8; a++)
             for (int b = 0; b <= 8; b++) {
                 double u = u0 + (u1 - u0) * (0.01 + 0.98 * a / 8), v = v0 + (v1 - v0) * (0.01 + 0.98 * b / 8);
-                double p[3], xu[3], xv[3], q[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3];
+                /* first derivatives at (u, v) and at (u +- hu, v), (u, v +- hv) */
+                double p[3], xu[3], xv[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3], eu[3], ev[3];
                 ccn__cad_eval_d(s, u, v, p, xu, xv);
-                ccn__cad_eval_d(s, u + hu, v, q, au, av);
-                ccn__cad_eval_d(s, u - hu, v, q, bu, bv);
-                ccn__cad_eval_d(s, u, v + hv, q, cu, cv);
-                double n[3], xuu[3], xuv[3], xvv[3], eu[3], ev[3];
-                ccn__cad_eval_d(s, u, v - hv, q, eu, ev);
+                ccn__cad_eval_d(s, u + hu, v, p, au, av);
+                ccn__cad_eval_d(s, u - hu, v, p, bu, bv);
+                ccn__cad_eval_d(s, u, v + hv, p, cu, cv);
+                ccn__cad_eval_d(s, u, v - hv, p, eu, ev);
+                double n[3], xuu[3], xuv[3], xvv[3];
                 for (int c = 0; c < 3; c++) {
                     xuu[c] = (au[c] - bu[c]) / (2 * hu);
                     xuv[c] = (cu[c] - eu[c]) / (2 * hv);
