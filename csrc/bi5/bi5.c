@@ -41,17 +41,6 @@ static int nu_samples(const ccn__bi5 *b, const double complex chi[16], double mu
     return 0;
 }
 
-/* T (n x 36 x m) = per-sector S_s (36 x 28) applied to the guide gbb. */
-static void sample_border_s(int32_t n, const double *S, const double *gbb, int32_t m, double *T) {
-    memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
-    for (int32_t s = 0; s < n; s++)
-        for (int32_t e = 0; e < 36; e++)
-            for (int32_t t = 0; t < 28; t++) {
-                double w = S[((size_t)s * 36 + e) * 28 + t];
-                if (w != 0.0) ccn__bi5_axpy(T + ((size_t)s * 36 + e) * m, w, gbb + ((size_t)s * 28 + t) * m, m);
-            }
-}
-
 /* X: (6n+1) x m c-net or T0: the raised tensor-border t~^0 (n x 36 x m), b600: m centre values, d: spoke intervals (NULL: uniform), kap: C2-rule
  * ratios (NULL: 1), taus: per-sector cap taus (NULL: symmetric), e: the guide's domain ([R15];
  * 0: the symmetric characteristic border, else spokes d_s^e, with kap and d). out: patches x 36 x m. */
@@ -96,8 +85,8 @@ static ccn_status construct(const ccn__bi5 *b, const double *X, const double *T0
                 st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "bi5: out of memory (construction)");
                 goto done;
             }
-            sample_border_s(n, Ss, gbb, m, Ti);
-        } else ccn__bi5_sample_border(n, b->samp[r], gbb, m, Ti);  /* t^{r+1} = [g^{r+1} o chi~] */
+            ccn__bi5_sample_border(n, Ss, 36 * 28, gbb, m, Ti);
+        } else ccn__bi5_sample_border(n, b->samp[r], 0, gbb, m, Ti); /* t^{r+1} = [g^{r+1} o chi~] */
         ccn__bi5_c2_rule(n, kap, m, Ti);                           /* t~^{r+1} */
         for (int32_t s = 0; s < n; s++) {
             double *A = out + ((size_t)(3 * r + 0) * n + s) * psz;

@@ -149,13 +149,15 @@ void ccn__bi5_ring_sector_pieces(const double *P, const double *Ti, int32_t m, d
     tmul(P6, Ti, P6, 0, 3, 0, 3, 3, 3, m, B);
 }
 
-/* T (n x 36 x m) = samp (36 x 28) applied to every sector of the guide gbb (n x 28 x m). */
-void ccn__bi5_sample_border(int32_t n, const double *samp, const double *gbb, int32_t m, double *T) {
+/* T (n x 36 x m) = the sampling matrix of sector s, samp + s * sstride (36 x 28; sstride 0: one
+ * for every sector), applied to the guide gbb (n x 28 x m). */
+void ccn__bi5_sample_border(int32_t n, const double *samp, size_t sstride, const double *gbb, int32_t m,
+                            double *T) {
     memset(T, 0, sizeof(double) * (size_t)n * 36 * (size_t)m);
     for (int32_t s = 0; s < n; s++)
         for (int32_t e = 0; e < 36; e++)
             for (int32_t t = 0; t < 28; t++) {
-                double w = samp[e * 28 + t];
+                double w = samp[(size_t)s * sstride + e * 28 + t];
                 if (w != 0.0)
                     ccn__bi5_axpy(T + ((size_t)s * 36 + e) * m, w, gbb + ((size_t)s * 28 + t) * m, m);
             }

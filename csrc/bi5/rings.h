@@ -13,8 +13,10 @@ void ccn__bi5_tcc(int32_t n, const double *X, const double *d, int32_t m, double
 /* Raises bicubic tensor-borders p (n x 16 x m, [a*4+b], p_00 unused) to bi-5 on the mask:
  * T (n x 36 x m), zero elsewhere (SPEC §2.2). */
 void ccn__bi5_raise_border(int32_t n, const double *p, int32_t m, double *T);
-/* T (n x 36 x m) = samp (36 x 28) applied to every sector of the guide gbb (n x 28 x m). */
-void ccn__bi5_sample_border(int32_t n, const double *samp, const double *gbb, int32_t m, double *T);
+/* T (n x 36 x m) = sector s's sampling matrix samp + s * sstride (36 x 28; sstride 0: one for
+ * every sector) applied to the guide gbb (n x 28 x m). */
+void ccn__bi5_sample_border(int32_t n, const double *samp, size_t sstride, const double *gbb, int32_t m,
+                            double *T);
 /* Patches A, B, C (36 x m each) of one sector from the outer border To (level r-1) and the
  * inner border Ti (level r) (SPEC §2.5, §5 step 4). */
 void ccn__bi5_ring_sector(const double *To, const double *Ti, double sigma, int32_t m,

@@ -35,6 +35,7 @@
 #include "rules/crease.h"
 #include "bi5/bi5.h"
 #include "surface/caps.h"
+#include "surface/curvature.h"
 #include "surface/limit.h"
 #include "surface/patches.h"
 
@@ -186,7 +187,8 @@ static int32_t parent_vertex(const ccn_mesh *S, int32_t w) {
 }
 
 /* The largest |Gaussian curvature| of faces [f0, f1) of xm, sampled on a 9 x 9 grid of each
- * (exact first derivatives, second ones by their central differences over 1e-4 of the span). */
+ * (exact first derivatives, second ones by their central differences over 1e-4 of the span;
+ * the principal curvatures of surface/curvature.h). */
 static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
     double kmax = 0;
     for (int32_t f = f0; f < f1; f++) {
@@ -198,31 +200,20 @@ static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
         for (int a = 0; a <= 8; a++)
             for (int b = 0; b <= 8; b++) {
                 double u = u0 + (u1 - u0) * (0.01 + 0.98 * a / 8), v = v0 + (v1 - v0) * (0.01 + 0.98 * b / 8);
-                /* first derivatives at (u, v) and at (u +- hu, v), (u, v +- hv) */
-                double p[3], xu[3], xv[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3], eu[3], ev[3];
-                ccn__cad_eval_d(s, u, v, p, xu, xv);
+                /* d: S_u, S_v, S_uu, S_uv, S_vv; first derivatives at (u +- hu, v), (u, v +- hv) */
+                double d[5][3], p[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3], eu[3], ev[3], k1, k2;
+                ccn__cad_eval_d(s, u, v, p, d[0], d[1]);
                 ccn__cad_eval_d(s, u + hu, v, p, au, av);
                 ccn__cad_eval_d(s, u - hu, v, p, bu, bv);
                 ccn__cad_eval_d(s, u, v + hv, p, cu, cv);
                 ccn__cad_eval_d(s, u, v - hv, p, eu, ev);
-                double n[3], xuu[3], xuv[3], xvv[3];
                 for (int c = 0; c < 3; c++) {
-                    xuu[c] = (au[c] - bu[c]) / (2 * hu);
-                    xuv[c] = (cu[c] - eu[c]) / (2 * hv);
-                    xvv[c] = (cv[c] - ev[c]) / (2 * hv);
+                    d[2][c] = (au[c] - bu[c]) / (2 * hu);
+                    d[3][c] = (cu[c] - eu[c]) / (2 * hv);
+                    d[4][c] = (cv[c] - ev[c]) / (2 * hv);
                 }
-                n[0] = xu[1] * xv[2] - xu[2] * xv[1];
-                n[1] = xu[2] * xv[0] - xu[0] * xv[2];
-                n[2] = xu[0] * xv[1] - xu[1] * xv[0];
-                double E = xu[0] * xu[0] + xu[1] * xu[1] + xu[2] * xu[2];
-                double F = xu[0] * xv[0] + xu[1] * xv[1] + xu[2] * xv[2];
-                double G = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
-                double W = E * G - F * F, nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-                if (!(W > 0) || !(nl > 0)) continue;
-                double L = (xuu[0] * n[0] + xuu[1] * n[1] + xuu[2] * n[2]) / nl;
-                double M = (xuv[0] * n[0] + xuv[1] * n[1] + xuv[2] * n[2]) / nl;
-                double N = (xvv[0] * n[0] + xvv[1] * n[1] + xvv[2] * n[2]) / nl;
-                double K = fabs(L * N - M * M) / W;
+                ccn__principal_curvatures((const double(*)[3])d, &k1, &k2, NULL);
+                double K = fabs(k1 * k2);
                 if (isfinite(K) && K > kmax) kmax = K;
             }
     }

@@ -380,38 +380,45 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     if (ev < 0 || ev >= mK->nv || !cap_ev(mK, ev)) return 0;
     int32_t n = ccn__valence(mK, ev);
     if (n > CCN_CAP_MAX_VALENCE) return 0;
-    ccn_error e2;
-    if (!ops[n]) { /* the exact surround's speeds (cap_op) */
-        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
-        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2);
-        if (st) return st == CCN_ERR_MEMORY ? -1 : 0;
-    }
-    *op = ops[n];
-    int32_t *stamp = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
-    int32_t *queue = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
-    int32_t *cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));
-    int32_t *ring = malloc(sizeof(int32_t) * (2 * (size_t)n + 1));
     double *knots = malloc(sizeof(double) * (size_t)n);
-    double *net = malloc(sizeof(double) * 3 * (6 * (size_t)n + 1));
-    double *pieces = malloc(sizeof(double) * 432 * (size_t)n);
-    double *out = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(*op));
-    double complex *taus = NULL;
-    ccn__stencil *s = malloc(sizeof *s);
-    int r = -1;
-    if (!stamp || !queue || !cnet || !ring || !knots || !net || !pieces || !out || !s) goto done;
-    r = 0;
-    for (int32_t v = 0; v < mK->nv; v++) stamp[v] = -1;
-    if (!cap_isolated(mK, ev, stamp, queue)) goto done;
-    if (!ccn__cap_surround(mK, mK1, ev, pinned, pieces)) goto done;
-    int nu = 0, beyond = 0;
+    if (!knots) return -1;
+    int nu = 0, beyond = 0; /* the spoke ratios first: outside the range nothing else is needed */
     for (int32_t k = 0; k < n; k++) knots[k] = mK->eknot[ccn__fan_edge(mK, ev, k)];
     for (int32_t k = 0; k < n; k++) { /* within the range where the plan's caps are whole */
         double kap = knots[(k + 1) % n] / knots[(k + n - 1) % n];
         nu |= fabs(kap - 1.0) > 1e-12;
         beyond |= fabs(log(kap)) > log(CCN_CAP_KAPPA_FULL);
     }
-    if (beyond && !any_kappa) goto done;
+    if (beyond && !any_kappa) {
+        free(knots);
+        return 0;
+    }
     if (!beyond) border_exp = 0; /* within the range: the plan's construction */
+    ccn_error e2;
+    if (!ops[n]) { /* the exact surround's speeds (cap_op) */
+        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
+        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2);
+        if (st) {
+            free(knots);
+            return st == CCN_ERR_MEMORY ? -1 : 0;
+        }
+    }
+    *op = ops[n];
+    int32_t *stamp = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
+    int32_t *queue = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
+    int32_t *cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));
+    int32_t *ring = malloc(sizeof(int32_t) * (2 * (size_t)n + 1));
+    double *net = malloc(sizeof(double) * 3 * (6 * (size_t)n + 1));
+    double *pieces = malloc(sizeof(double) * 432 * (size_t)n);
+    double *out = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(*op));
+    double complex *taus = NULL;
+    ccn__stencil *s = malloc(sizeof *s);
+    int r = -1;
+    if (!stamp || !queue || !cnet || !ring || !net || !pieces || !out || !s) goto done;
+    r = 0;
+    for (int32_t v = 0; v < mK->nv; v++) stamp[v] = -1;
+    if (!cap_isolated(mK, ev, stamp, queue)) goto done;
+    if (!ccn__cap_surround(mK, mK1, ev, pinned, pieces)) goto done;
     if (nu) {
         taus = malloc(sizeof(double complex) * 36 * (size_t)n);
         if (!taus) { r = -1; goto done; }
