@@ -28,6 +28,7 @@
 #include "io/fill.h"
 
 #include "io/fill_faces.h"
+#include "io/fill_g1.h"
 #include "io/packs.h"
 
 #include "base/error.h"
@@ -175,8 +176,11 @@ static int semi_sharp(const ccn_mesh *m) {
  * refined limit inside the cap's faces, where it pinches at the EV). */
 #define CCN_FILL_CAP_LEVEL 4
 /* At the last level a smooth interior EV whose spokes leave the cap's kappa range gets the
- * non-uniform cap (G1 exact) unless its largest |K| exceeds this many times the fill faces'
- * (G1 approximate) over the same hole. */
+ * non-uniform cap unless the fill faces over the same hole are fairer (both G1 exact: their
+ * largest |K| below CCN_FILL_CAP_PREFER times the cap's, so that near ties decide alike on
+ * every platform), or unless the cap's largest |K| exceeds this many times theirs where the
+ * fill is G1 only approximately (io/fill_g1.c found no exact form: G1 exactness is worth that
+ * much curvature). */
 #define CCN_FILL_CAP_K_RATIO 2.0
 
 /* The irregular vertex w of T (the refinement of the cut S) as a vertex of S: T numbers face
@@ -260,9 +264,8 @@ static const double beyond_exps[2] = {0.0, 0.5};
  * C1 (its ring 0 is the exact level-(K+1) surround). pl: the places of S's faces. Marks the
  * covered faces of T in cov. fl (the last level only): spokes beyond the cap's kappa range are
  * capped too, with the fairest of the caps of beyond_exps and the fill faces of w (T's vertex
- * of u, places tpl) that would close the hole instead: both are built and sampled, and a cap
- * stays unless its largest |K| exceeds CCN_FILL_CAP_K_RATIO times the fill's (G1 exact against
- * approximate). 1 capped, 0 not capped, -1 out of memory. */
+ * of u, places tpl) that would close the hole instead: both are built and sampled, and the
+ * fairer stays (CCN_FILL_CAP_K_RATIO above). 1 capped, 0 not capped, -1 out of memory. */
 static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, const ccn_mesh *T,
                       int32_t u, const ccn__xplace *pl, struct ccn__bi5 **ops, uint8_t *cov,
                       ccn__fill_level *fl, const ccn__xplace *tpl, int32_t w) {
@@ -291,11 +294,13 @@ static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *
             int32_t nf1 = xm->num_faces, nc1 = xm->num_cells;
             uint8_t *tmp = calloc((size_t)T->nf, 1);
             ccn_error e2;
-            ccn_status st = tmp ? ccn__fill_vertex(xm, fl, w, tpl, 0, tmp, &e2) : CCN_ERR_MEMORY;
+            double fdev = INFINITY;
+            ccn_status st = tmp ? ccn__fill_vertex(xm, fl, w, tpl, 0, tmp, &fdev, &e2) : CCN_ERR_MEMORY;
             free(tmp);
             double kf = st == CCN_OK ? faces_max_k(xm, nf1, xm->num_faces) : INFINITY;
             xm_rollback(xm, nf1, nc1);
             if (st == CCN_ERR_MEMORY || xm->oom) r = -1;
+            else if (fdev <= CCN_FILL_G1_EXACT) r = !(kf < CCN_FILL_CAP_PREFER * kbest);
             else r = kbest <= CCN_FILL_CAP_K_RATIO * kf;
         }
     }
@@ -440,7 +445,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
                     int32_t w = T->hvert[h];
                     if (done_v[w] || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
                     done_v[w] = 1;
-                    st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, err);
+                    st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
                 }
             ccn__fill_level_destroy(fl);
             for (int32_t i = 0; i < nreg && !st; i++)

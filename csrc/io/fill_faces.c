@@ -32,6 +32,7 @@
  * whose rule is the smooth one, so the curve is no B-spline of its polygon there) is built like
  * a smooth spoke: C0, close to the crease, its distance to the limit measured like the rest. */
 #include "io/fill_faces.h"
+#include "io/fill_g1.h"
 
 #include "base/error.h"
 #include "refine/level.h"
@@ -333,7 +334,7 @@ static double spoke_deviation(double (*cs)[5][5][3], int32_t nfan, int32_t nsp, 
 }
 
 ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, const ccn__xplace *fpl,
-                            int32_t fill_id, uint8_t *covered, ccn_error *err) {
+                            int32_t fill_id, uint8_t *covered, double *spoke_dev, ccn_error *err) {
     const ccn_mesh *m = fl->m;
     const ccn__plan_view *v = fl->v;
     int32_t nfan = m->vfan_start[w + 1] - m->vfan_start[w], nsp = ccn__valence(m, w), nsharp = 0;
@@ -348,6 +349,7 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
     uint8_t *sharp = malloc((size_t)nsp + 1);                         /* C0 spokes */
     uint8_t *filled = malloc((size_t)nfan + 1); /* fan faces in irregular sectors: filled */
     double (*cs)[5][5][3] = NULL; /* the fills' poles, per sector */
+    double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3] = NULL; /* their exactly G1 form */
     if (!sp || !nb || !bk || !N || !Ns || !sharp || !filled) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
     if ((st = vertex_limit(fl, w, P, N, err))) goto done;
     for (int32_t k = 0; k < nsp; k++) {
@@ -462,7 +464,22 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
         }
     }
     memcpy(cs, cbest, sizeof *cs * (size_t)nfan);
-    static const double K[9] = {0, 0, 0, 0, 1, 2, 2, 2, 2};
+    /* exactly G1 across the smooth spokes where the bicubic fill is not (io/fill_g1.c): the
+     * same fill raised to degree 5 and corrected; kept when it deviates less */
+    if (best > CCN_FILL_G1_EXACT) {
+        double qdev = INFINITY;
+        q = malloc(sizeof *q * (size_t)nfan);
+        int r = q ? ccn__fill_g1((const double(*)[5][5][3])cs, nfan, nsp, sharp, filled, q, &qdev) : -1;
+        if (r < 0) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
+        if (!r || !(qdev < best)) {
+            free(q);
+            q = NULL;
+        } else {
+            best = qdev;
+        }
+    }
+    if (spoke_dev) *spoke_dev = best;
+    static const double K[9] = {0, 0, 0, 0, 1, 2, 2, 2, 2}, KQ[15] = CCN_FILL_G1_KNOTS;
     for (int32_t k = 0; k < nfan && !st; k++) {
         if (!filled[k]) continue;
         double (*c)[5][3] = cs[k];
@@ -471,13 +488,15 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
         ccn__xplace_rotate(&fpl[g], r, &q1); /* the sector's [0,1]^2: its face at w */
         double twice[3][2] = {{0, 0}, {2, 0}, {0, 2}};
         ccn__xplace_sub(&q1, (const double(*)[2])twice, &q2);
-        to_caller(v, &c[0][0][0], 25);
-        int32_t f = ccn__xm_add_face(xm, CCN_EXPORT_FACE_FILL, 3, 3, 5, 5, 1, 1);
-        if (f < 0 || ccn__xm_set_flat(xm, f, 0, K) || ccn__xm_set_flat(xm, f, 1, K)) {
+        int deg = q ? 5 : 3, np = q ? CCN_FILL_G1_POLES : 5;
+        double *poles = q ? &q[k][0][0][0] : &c[0][0][0];
+        to_caller(v, poles, np * np);
+        int32_t f = ccn__xm_add_face(xm, CCN_EXPORT_FACE_FILL, deg, deg, np, np, 1, 1);
+        if (f < 0 || ccn__xm_set_flat(xm, f, 0, q ? KQ : K) || ccn__xm_set_flat(xm, f, 1, q ? KQ : K)) {
             st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)");
             break;
         }
-        memcpy((void *)xm->faces[f].s.poles, c, sizeof cs[k]);
+        memcpy((void *)xm->faces[f].s.poles, poles, sizeof(double) * 3 * (size_t)(np * np));
         xm->faces[f].fill = fill_id;
         ccn__xcell *cl = &xm->cells[xm->faces[f].cell0];
         cl->uv[0] = 0; cl->uv[1] = 2; cl->uv[2] = 0; cl->uv[3] = 2;
@@ -494,6 +513,7 @@ done:
     free(sharp);
     free(filled);
     free(cs);
+    free(q);
     return st;
 }
 

@@ -88,6 +88,30 @@ static void feval(const face *f, double u, double v, double out[3]) {
     }
 }
 
+/* Point and exact first derivatives: N'_{i,p} = p N_{i,p-1} / (t_{i+p} - t_i)
+ * - p N_{i+1,p-1} / (t_{i+p+1} - t_{i+1}). */
+static double cdb_d(const double *t, int i, int p, double x, double end) {
+    double a = 0, b = 0;
+    if (t[i + p] > t[i]) a = p / (t[i + p] - t[i]) * cdb(t, i, p - 1, x, end);
+    if (t[i + p + 1] > t[i + 1]) b = p / (t[i + p + 1] - t[i + 1]) * cdb(t, i + 1, p - 1, x, end);
+    return a - b;
+}
+
+static void feval_d(const face *f, double u, double v, double P[3], double Su[3], double Sv[3]) {
+    double u1 = f->t[0][f->np[0]], v1 = f->t[1][f->np[1]];
+    for (int k = 0; k < 3; k++) P[k] = Su[k] = Sv[k] = 0;
+    for (int i = 0; i < f->np[0]; i++) {
+        double a = cdb(f->t[0], i, f->deg[0], u, u1), da = cdb_d(f->t[0], i, f->deg[0], u, u1);
+        for (int j = 0; j < f->np[1]; j++) {
+            double b = cdb(f->t[1], j, f->deg[1], v, v1), db = cdb_d(f->t[1], j, f->deg[1], v, v1);
+            for (int k = 0; k < 3; k++) {
+                double x = f->P[3 * (i * f->np[1] + j) + k];
+                P[k] += a * b * x, Su[k] += da * b * x, Sv[k] += a * db * x;
+            }
+        }
+    }
+}
+
 /* ---- helpers ------------------------------------------------------------------------ */
 
 typedef struct { char *d; size_t n, cap; int fail_after; } sink;
@@ -328,7 +352,7 @@ static void test_cages(void) {
     check_cage("lshape", 0, 6);
     check_cage("pole12", 0, 0);
     check_cage("flip35", 0, 4);
-    check_cage("fig18_v8", 0, 8); /* 8 boundary corners; the centre (spoke ratio 5) capped */
+    check_cage("fig18_v8", 0, 9); /* 8 boundary corners; the centre (spoke ratio 5): its G1 fill is fairer than the cap */
     check_cage("fig16_v6", 0, 7);
     check_cage("mixed_boundary", 0, 11);
     check_cage("torus_semi", 1, 0);
@@ -337,7 +361,7 @@ static void test_cages(void) {
 
 /* The default export of tests/data/<name>.obj at level 3 into F and info; CCN_OK or the
  * failure (F then empty). */
-static ccn_status export_cap(const char *name, ccn_cap cap, faces *F, ccn_export_info *info) {
+static ccn_status export_cap_at(const char *name, ccn_cap cap, int fill_levels, faces *F, ccn_export_info *info) {
     ccn_obj *obj;
     ccn_cage cage;
     ccn_options o = {0};
@@ -348,6 +372,7 @@ static ccn_status export_cap(const char *name, ccn_cap cap, faces *F, ccn_export
     if (!p) return CCN_ERR_ARGUMENT;
     ccn_export_options eo;
     memset(&eo, 0, sizeof eo);
+    eo.fill_levels = fill_levels;
     sink s = {NULL, 0, 0, -1};
     ccn_error err;
     ccn_status st = run(p, &eo, F, &s, info, &err);
@@ -359,6 +384,10 @@ static ccn_status export_cap(const char *name, ccn_cap cap, faces *F, ccn_export
     ccn_plan_destroy(p);
     ccn_obj_destroy(obj);
     return st;
+}
+
+static ccn_status export_cap(const char *name, ccn_cap cap, faces *F, ccn_export_info *info) {
+    return export_cap_at(name, cap, 0, F, info);
 }
 
 static ccn_status export_of(const char *name, faces *F, ccn_export_info *info) {
@@ -437,9 +466,10 @@ static void test_caps_in_holes(void) {
     faces_free(&F);
 }
 
-/* Largest |Gaussian curvature| (and the smallest K into *kmin) of face f over a 13 x 13 grid inside it, from this file's own
- * Cox-de Boor evaluation (poles taken relative to c, so that tiny faces far from the origin
- * keep their digits; second derivatives by central differences over 1e-3 of the span). Sample
+/* Largest |Gaussian curvature| (and the smallest K into *kmin) of face f over a 25 x 25 grid
+ * inside it (to 0.005 of its sides), from this file's own Cox-de Boor evaluation (poles taken
+ * relative to c, so that tiny faces far from the origin keep their digits; second derivatives
+ * by central differences over 1e-4 of the span). Sample
  * points within [rmin, rmax) of c only (rmax <= 0: all). */
 static double face_max_k(const face *f, const double c[3], double rmin, double rmax, double *dmax, double *kmin) {
     face g = *f;
@@ -448,10 +478,10 @@ static double face_max_k(const face *f, const double c[3], double rmin, double r
     for (size_t i = 0; i < np; i++)
         for (int k = 0; k < 3; k++) g.P[3 * i + k] = f->P[3 * i + k] - c[k];
     double u0 = f->t[0][f->deg[0]], u1 = f->t[0][f->np[0]], v0 = f->t[1][f->deg[1]], v1 = f->t[1][f->np[1]];
-    double hu = 1e-3 * (u1 - u0), hv = 1e-3 * (v1 - v0), kmax = 0;
-    for (int a = 0; a <= 12; a++)
-        for (int b = 0; b <= 12; b++) {
-            double u = u0 + (u1 - u0) * (0.02 + 0.96 * a / 12), v = v0 + (v1 - v0) * (0.02 + 0.96 * b / 12);
+    double hu = 1e-4 * (u1 - u0), hv = 1e-4 * (v1 - v0), kmax = 0;
+    for (int a = 0; a <= 24; a++)
+        for (int b = 0; b <= 24; b++) {
+            double u = u0 + (u1 - u0) * (0.005 + 0.99 * a / 24), v = v0 + (v1 - v0) * (0.005 + 0.99 * b / 24);
             double P[3][3][3], xu[3], xv[3], xuu[3], xuv[3], xvv[3], n[3];
             for (int i = 0; i < 3; i++)
                 for (int j = 0; j < 3; j++) feval(&g, u + (i - 1) * hu, v + (j - 1) * hv, P[i][j]);
@@ -480,10 +510,10 @@ static double face_max_k(const face *f, const double c[3], double rmin, double r
 }
 
 /* An interior EV whose spoke ratios leave the cap's range: the export caps its hole at the
- * last level (G1 to rounding) where fill faces would be G1 only approximately, and keeps the cap
- * because it is fairer than they are. Measured here, on the exported faces, against the fill
- * faces that close the same hole with --cap refine (G1 only to 1e-6 or worse): the cap's largest
- * |K| is not above theirs and within 5x the largest of the exact pieces around it (its
+ * last level (G1 to rounding) and keeps the cap because it is fairer than the fill faces (G1
+ * too, io/fill_g1.c) would be. Measured here, on the exported faces, against the fill faces
+ * that close the same hole at the same level with --cap refine: the cap's largest |K| is not
+ * above theirs and within 5x the largest of the exact pieces around it (its
  * curvature rises towards the EV), and where it dips into a saddle (a spot next to the centre;
  * the surface around is elliptic) its |K| stays below theirs. star7_nu (valence 7, ratios 1.2-2);
  * star5_nu (valence 5, ratios up to 4: the cap with the symmetric guide domain folds, the one
@@ -512,6 +542,10 @@ static void cap_beyond_range(const char *name, int corners) {
     ccn_export_info ri;
     double kf = 0, kfmin = INFINITY;
     CHECK(export_cap(name, CCN_CAP_REFINE, &R, &ri) == CCN_OK, "%s: export with --cap refine", name);
+    int fl = 6 + info.fill_level - ri.fill_level; /* fill_levels count from the patch level */
+    faces_free(&R);
+    CHECK(export_cap_at(name, CCN_CAP_REFINE, fl, &R, &ri) == CCN_OK && ri.fill_level == info.fill_level,
+          "%s: export with --cap refine, fills at level %d (%d)", name, (int)info.fill_level, (int)ri.fill_level);
     for (int i = 0; i < R.n; i++) {
         double dmin = INFINITY;
         if (R.f[i].kind != CCN_EXPORT_FACE_FILL) continue;
@@ -525,9 +559,9 @@ static void cap_beyond_range(const char *name, int corners) {
           "from %g to %g)", name, kcmin, kfmin, krmin, kr);
     CHECK(kr > 0 && kc <= 5 * kr && kc <= kf, "%s: the cap's max |K| %g, the fills' %g, the exact pieces' around it %g",
           name, kc, kf, kr);
-    CHECK(ri.max_fill_g1_deviation > 1e-6, "%s: the fills are %g rad off G1", name, ri.max_fill_g1_deviation);
+    CHECK(ri.max_fill_g1_deviation <= 1e-9, "%s: the fills are %g rad off G1", name, ri.max_fill_g1_deviation);
     printf("# %s: %d faces (%d bi-5, %d fill), G1 %.2e; the cap's K in [%.3g, %.3g], %.2f x the largest of the "
-           "exact pieces within 2x its reach (K >= %.3g there); fills instead: K in [%.3g, %.3g], %.2e rad off G1\n",
+           "exact pieces within 2x its reach (K >= %.3g there); fills instead: K in [%.3g, %.3g], G1 %.2e\n",
            name, (int)info.num_faces, (int)info.num_bi5, (int)info.num_fill_faces, info.max_g1_deviation, kcmin,
            kc, kr > 0 ? kc / kr : 0.0, krmin, kfmin, kf, ri.max_fill_g1_deviation);
     faces_free(&R);
@@ -895,6 +929,72 @@ static void test_bad_input(void) {
     ccn_obj_destroy(obj);
 }
 
+/* The fill faces' normals across the spokes they share, from this file's own evaluation (exact
+ * first derivatives): the fills are G1 there (io/fill_g1.c) where the bicubic fills deviated
+ * by up to 6e-2 rad (Fig. 17), 3.6e-2 (mixed_boundary's boundary EVs), 4.7e-3 (bfan5), 8e-4
+ * (continuity_cube's valence-3 points, intervals 1 : 22.4); now within the CAD target 1e-8 (to
+ * the consistency of the data the relations start from: the tangent vectors at the vertex and
+ * the C1 data at the far end agree to 1e-9 of their size, and that is what is left, 4e-10 on
+ * mixed_boundary here, 1.8e-9 with another LAPACK). Two fill faces share a spoke when
+ * 7 points along a side of each coincide (either direction); the angle between their normals is
+ * taken as it is (a fold would show as pi). */
+static double fill_spoke_angle(const char *name, int *pairs) {
+    faces F;
+    ccn_export_info info;
+    *pairs = 0;
+    if (export_of(name, &F, &info) != CCN_OK) return INFINITY;
+    double worst = 0;
+    for (int a = 0; a < F.n; a++)
+        for (int b = a + 1; b < F.n; b++) {
+            const face *A = &F.f[a], *B = &F.f[b];
+            if (A->kind != CCN_EXPORT_FACE_FILL || B->kind != CCN_EXPORT_FACE_FILL) continue;
+            double ua[2] = {A->t[0][A->deg[0]], A->t[0][A->np[0]]}, va[2] = {A->t[1][A->deg[1]], A->t[1][A->np[1]]};
+            double ub[2] = {B->t[0][B->deg[0]], B->t[0][B->np[0]]}, vb[2] = {B->t[1][B->deg[1]], B->t[1][B->np[1]]};
+            for (int sa = 0; sa < 4; sa++)
+                for (int sb = 0; sb < 4; sb++)
+                    for (int rev = 0; rev < 2; rev++) {
+                        double pa[7][3], pb[7][3], na[7][3], nb[7][3], d = 0, size = 0;
+                        for (int q = 0; q < 7; q++) {
+                            double x = (q + 1) / 8.0, y = rev ? 1 - x : x, P[3], Su[3], Sv[3];
+                            double u = sa < 2 ? ua[0] + x * (ua[1] - ua[0]) : ua[sa - 2];
+                            double v = sa < 2 ? va[sa] : va[0] + x * (va[1] - va[0]);
+                            feval_d(A, u, v, pa[q], Su, Sv);
+                            na[q][0] = Su[1] * Sv[2] - Su[2] * Sv[1], na[q][1] = Su[2] * Sv[0] - Su[0] * Sv[2],
+                            na[q][2] = Su[0] * Sv[1] - Su[1] * Sv[0];
+                            u = sb < 2 ? ub[0] + y * (ub[1] - ub[0]) : ub[sb - 2];
+                            v = sb < 2 ? vb[sb] : vb[0] + y * (vb[1] - vb[0]);
+                            feval_d(B, u, v, P, Su, Sv);
+                            memcpy(pb[q], P, sizeof P);
+                            nb[q][0] = Su[1] * Sv[2] - Su[2] * Sv[1], nb[q][1] = Su[2] * Sv[0] - Su[0] * Sv[2],
+                            nb[q][2] = Su[0] * Sv[1] - Su[1] * Sv[0];
+                            for (int k = 0; k < 3; k++) d = fmax(d, fabs(pa[q][k] - pb[q][k]));
+                        }
+                        for (int k = 0; k < 3; k++) size = fmax(size, fabs(pa[6][k] - pa[0][k]));
+                        if (!(d <= 1e-9 * size)) continue;
+                        (*pairs)++;
+                        for (int q = 0; q < 7; q++) {
+                            double c[3] = {na[q][1] * nb[q][2] - na[q][2] * nb[q][1], na[q][2] * nb[q][0] - na[q][0] * nb[q][2],
+                                           na[q][0] * nb[q][1] - na[q][1] * nb[q][0]};
+                            double ang = atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]),
+                                               na[q][0] * nb[q][0] + na[q][1] * nb[q][1] + na[q][2] * nb[q][2]);
+                            if (!(ang <= worst)) worst = ang;
+                        }
+                    }
+        }
+    faces_free(&F);
+    return worst;
+}
+
+static void test_fills_g1(void) {
+    static const char *cages[] = {"lshape", "bfan5", "mixed_boundary", "fig16_v6", "fig17_v7", "continuity_cube"};
+    for (int i = 0; i < (int)(sizeof cages / sizeof *cages); i++) {
+        int pairs;
+        double ang = fill_spoke_angle(cages[i], &pairs);
+        CHECK(pairs > 0 && ang <= 1e-8, "%s: %d fill spokes, normals across them up to %g rad", cages[i], pairs, ang);
+        printf("# %s: %d fill spokes, normals across them <= %.2e rad\n", cages[i], pairs, ang);
+    }
+}
+
 int main(void) {
     RUN(test_bad_input);
     RUN(test_torus_pack);
@@ -904,6 +1004,7 @@ int main(void) {
     RUN(test_merged_faces);
     RUN(test_caps_in_holes);
     RUN(test_caps_beyond_range);
+    RUN(test_fills_g1);
     RUN(test_far_from_origin);
     RUN(test_knot_removal);
     return TEST_SUMMARY();

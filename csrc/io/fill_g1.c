@@ -1,0 +1,384 @@
+/* Fill faces made exactly G1 across their smooth spokes (io/fill_g1.h).
+ *
+ * Why: a bicubic fill face has four free poles per sector once its outer two layers (the C1
+ * join to the exact pieces), its spokes and the tangent plane at the vertex are fixed; the G1
+ * relations along a spoke are more equations than that, so io/fill_faces.c meets them only
+ * approximately (measured: up to 6e-2 rad at interior EVs with spoke ratios near 10, 4e-2 at
+ * boundary EVs). Raised to degree 5 with a C2 knot in the middle (9 x 9 poles, the same
+ * surface), a sector has 36 free inner poles and each smooth spoke 5, enough for the relations
+ * of every spoke exactly.
+ *
+ * The relations (the classical linear G1 form of the vertex-enclosure analyses, Peters): along
+ * spoke k, with D_k the cross-boundary derivative of sector k (its d/dv at v = 0), D_{k-1}
+ * that of sector k-1 (its d/du at u = 0) and T the spoke's tangent,
+ *     D_k(u) + beta(u) D_{k-1}(u) - gamma(u) T(u) = 0   for u in [0, 2].
+ * The weights' end values come from the data: at u = 0 the three vectors lie in the limit
+ * tangent plane (spokes k+1, k-1, k), at u = 2 the exact pieces beyond meet C1 (beta = the
+ * parameter scale across, gamma ~ 0), each solved in least squares and checked (coplanar,
+ * beta > 0: no fold). In between they are quadratic with zero slope at u = 2,
+ * w(u) = w(2) + (w(0) - w(2)) (1 - u/2)^2: the u-derivative of the relation at u = 2 holds by
+ * the exact C2 data only if the weights are flat there, and a kink anywhere (at the C2 knot 1)
+ * would ask the cross derivative for a jump it cannot make; linear weights or ones bent at 1
+ * leave 1e-6 to 3e-5 rad. The residual is then a degree-7 polynomial on each span, so it
+ * vanishes identically when it vanishes at the 8 Gauss points of each span: those rows, linear
+ * in the poles and the same for x, y and z, are the constraints C x = r.
+ *
+ * Among the solutions, the fairest: the least thin-plate energy sum over the sectors of
+ * integral |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2 (exact Gram matrices of the basis' derivatives;
+ * + 1e-9 of its trace, so that it is definite). C's SVD gives a particular solution and the
+ * null space Z (singular values below 1e-11 of the largest: the rows are dependent, the
+ * relations hold at the span ends by the data and around an interior vertex of even valence
+ * the twists' enclosure condition repeats); the energy is minimised over Z by a Cholesky
+ * solve. Measured (tests/c/test_export.c, the OpenSubdiv shapes): normals across the spokes
+ * within 1e-12 to 4e-10 rad (what is left is the data's own consistency: the three tangent
+ * vectors at the vertex and the C1 data at the far end are coplanar to 1e-9 of their size); the
+ * fills' largest |K| below the bicubic ones' on boundary EVs
+ * (mixed_boundary 6.96 -> 4.86, the corner fan there 9e5 -> 1.4e4), up to 1.9x above at
+ * interior EVs with spoke ratios 8 to 22 where the bicubic fill was 6e-2 rad off G1. */
+#include "io/fill_g1.h"
+
+#include "io/cad.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NQ CCN_FILL_G1_POLES
+#define PQ 5 /* degree */
+#define NCOL 8 /* collocation points per span */
+
+static const double KQ[NQ + PQ + 1] = CCN_FILL_G1_KNOTS;
+static const double KC[9] = {0, 0, 0, 0, 1, 2, 2, 2, 2};
+
+/* All n basis functions of degree p (>= 2) over flat knots t at u (the span with
+ * t[s] <= u < t[s+1], the last one at the domain's end) and their first and second
+ * derivatives (d2N may be NULL): N^(k)_{i,p} = p (N^(k-1)_{i,p-1} / (t_{i+p} - t_i)
+ * - N^(k-1)_{i+1,p-1} / (t_{i+p+1} - t_{i+1})), 0/0 = 0. */
+static double ratio(double a, double l) { return l > 0 ? a / l : 0; }
+static void basis(const double *t, int p, int n, double u, double *N, double *dN, double *d2N) {
+    double a[NQ + PQ + 1], b[NQ + PQ + 1], lo[NQ + PQ + 1], d1[NQ + PQ + 1];
+    int s = p;
+    for (int i = n - 1; i >= p; i--)
+        if (t[i] <= u && t[i] < t[i + 1]) { s = i; break; }
+    int m = n + p; /* degree-0 functions 0 .. m - 1 */
+    for (int i = 0; i < m; i++) a[i] = i == s;
+    for (int d = 1; d <= p; d++) {
+        if (d == p - 1) memcpy(lo, a, sizeof(double) * (size_t)(m - d + 1)); /* degree p - 2 */
+        if (d == p) /* a: degree p - 1 */
+            for (int i = 0; i < n; i++) dN[i] = p * (ratio(a[i], t[i + p] - t[i]) - ratio(a[i + 1], t[i + p + 1] - t[i + 1]));
+        for (int i = 0; i < m - d; i++)
+            b[i] = ratio((u - t[i]) * a[i], t[i + d] - t[i]) + ratio((t[i + d + 1] - u) * a[i + 1], t[i + d + 1] - t[i + 1]);
+        memcpy(a, b, sizeof(double) * (size_t)(m - d));
+    }
+    memcpy(N, a, sizeof(double) * (size_t)n);
+    if (!d2N) return;
+    for (int i = 0; i < n + 1; i++) /* first derivatives of the degree p - 1 functions */
+        d1[i] = (p - 1) * (ratio(lo[i], t[i + p - 1] - t[i]) - ratio(lo[i + 1], t[i + p] - t[i + 1]));
+    for (int i = 0; i < n; i++) d2N[i] = p * (ratio(d1[i], t[i + p] - t[i]) - ratio(d1[i + 1], t[i + p + 1] - t[i + 1]));
+}
+
+/* A[k] = the Gram matrices of the quintic basis' k-th derivatives over [0, 2] (Gauss-Legendre,
+ * 6 points per span: exact for the degree-10 products). */
+static void gram(double A[3][NQ][NQ]) {
+    static const double X[6] = {-0.9324695142031521, -0.6612093864662645, -0.2386191860831969,
+                                0.2386191860831969,  0.6612093864662645,  0.9324695142031521};
+    static const double Wt[6] = {0.1713244923791704, 0.3607615730481386, 0.4679139345726910,
+                                 0.4679139345726910, 0.3607615730481386, 0.1713244923791704};
+    memset(A, 0, sizeof(double) * 3 * NQ * NQ);
+    for (int span = 0; span < 2; span++)
+        for (int g = 0; g < 6; g++) {
+            double u = span + 0.5 * (X[g] + 1), w = 0.5 * Wt[g], B[3][NQ];
+            basis(KQ, PQ, NQ, u, B[0], B[1], B[2]);
+            for (int k = 0; k < 3; k++)
+                for (int i = 0; i < NQ; i++)
+                    for (int j = 0; j < NQ; j++) A[k][i][j] += w * B[k][i] * B[k][j];
+        }
+}
+
+/* E (9 x 5): the quintic poles of each cubic B-spline (degree raising, exact: the cubic with
+ * a simple knot at 1 is C2 there, the quintic with a triple one too), by collocation at the
+ * quintic's Greville abscissae; the end rows exactly the unit ones so that spokes stay
+ * bit-identical. */
+static int raise_matrix(double E[NQ][5]) {
+    double A[NQ * NQ], B[NQ * 5], dN[NQ], Nc[5], dNc[5];
+    lapack_int ipiv[NQ];
+    for (int r = 0; r < NQ; r++) {
+        double g = 0;
+        for (int k = 1; k <= PQ; k++) g += KQ[r + k];
+        g /= PQ;
+        basis(KQ, PQ, NQ, g, A + NQ * r, dN, NULL);
+        basis(KC, 3, 5, g, Nc, dNc, NULL);
+        memcpy(B + 5 * r, Nc, sizeof Nc);
+    }
+    if (LAPACKE_dgesv(LAPACK_ROW_MAJOR, NQ, 5, A, NQ, ipiv, B, 5) != 0) return -1;
+    for (int i = 0; i < NQ; i++)
+        for (int k = 0; k < 5; k++) {
+            double e = B[5 * i + k];
+            E[i][k] = fabs(e) < 1e-13 ? 0 : e;
+        }
+    for (int k = 0; k < 5; k++) E[0][k] = k == 0, E[NQ - 1][k] = k == 4;
+    return 0;
+}
+
+/* The weights (beta, gamma) with Da + beta Db ~ gamma T in least squares; 0 when the three do
+ * not lie in one plane with Da and Db on opposite sides of T (within 1e-7). */
+static int weights(const double *Da, const double *Db, const double *T, double *beta, double *gamma) {
+    double bb = 0, bt = 0, tt = 0, ab = 0, at = 0, aa = 0;
+    for (int d = 0; d < 3; d++) {
+        bb += Db[d] * Db[d], bt += Db[d] * T[d], tt += T[d] * T[d];
+        ab += Da[d] * Db[d], at += Da[d] * T[d], aa += Da[d] * Da[d];
+    }
+    double det = bb * tt - bt * bt;
+    if (!(det > 1e-12 * bb * tt) || !(aa > 0)) return 0;
+    double be = (-ab * tt + at * bt) / det, ga = (at * bb - ab * bt) / det, res = 0;
+    for (int d = 0; d < 3; d++) {
+        double x = Da[d] + be * Db[d] - ga * T[d];
+        res += x * x;
+    }
+    if (!(res <= 1e-14 * aa) || !(be > 0)) return 0;
+    *beta = be, *gamma = ga;
+    return 1;
+}
+
+static double angle_between(const double *a, const double *b) {
+    double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    return atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+}
+
+/* Largest normal angle across the smooth spokes of the quintic fills q (16 points each). */
+static double deviation(double (*q)[NQ][NQ][3], int32_t nfan, int32_t nsp, const uint8_t *smooth) {
+    static const double kn[3] = {0, 1, 2};
+    static const int32_t mu[3] = {6, 3, 6};
+    double worst = 0;
+    for (int32_t k = 0; k < nsp; k++) {
+        if (!smooth[k]) continue;
+        int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
+        ccn__cad_surface A = {{PQ, PQ}, {NQ, NQ}, {3, 3}, {kn, kn}, {mu, mu}, &q[a][0][0][0], {0, 0}};
+        ccn__cad_surface B = A;
+        B.poles = &q[b][0][0][0];
+        for (int i = 0; i < 16; i++) {
+            double t = 2.0 * (i + 0.5) / 16, p[3], du[3], dv[3], na[3], nb[3];
+            ccn__cad_eval_d(&A, t, 0, p, du, dv);
+            na[0] = du[1] * dv[2] - du[2] * dv[1], na[1] = du[2] * dv[0] - du[0] * dv[2], na[2] = du[0] * dv[1] - du[1] * dv[0];
+            ccn__cad_eval_d(&B, 0, t, p, du, dv);
+            nb[0] = du[1] * dv[2] - du[2] * dv[1], nb[1] = du[2] * dv[0] - du[0] * dv[2], nb[2] = du[0] * dv[1] - du[1] * dv[0];
+            double ang = angle_between(na, nb);
+            if (!(ang <= worst)) worst = ang;
+        }
+    }
+    return worst;
+}
+
+/* out (n x 3) = V1 S1^-1 U1^T rhs (m x 3): the least-norm solution of C x = rhs on C's first
+ * `rank` singular triplets (C = U S V^T, row-major U m x m, VT n x n). */
+static void particular(const double *U, const double *VT, const double *sv, int32_t rank, int32_t m, int32_t n,
+                       const double *rhs, double *out) {
+    memset(out, 0, sizeof(double) * 3 * (size_t)n);
+    for (int32_t r = 0; r < rank; r++) {
+        double ur[3] = {0, 0, 0};
+        for (int32_t q = 0; q < m; q++)
+            for (int d = 0; d < 3; d++) ur[d] += U[(size_t)q * m + r] * rhs[3 * (size_t)q + d];
+        for (int32_t i = 0; i < n; i++)
+            for (int d = 0; d < 3; d++) out[3 * (size_t)i + d] += VT[(size_t)r * n + i] * ur[d] / sv[r];
+    }
+}
+
+int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
+                 const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev) {
+    if (nfan < 1 || nsp > CCN_FILL_G1_MAX_SPOKES) return 0;
+    double E[NQ][5];
+    if (raise_matrix(E)) return 0;
+    int rc = -1;
+    double (*x)[NQ][NQ][3] = malloc(sizeof *x * (size_t)nfan); /* raised, then the fairest G1 */
+    int32_t (*idx)[NQ][NQ] = malloc(sizeof *idx * (size_t)nfan);
+    uint8_t *smooth = calloc((size_t)nsp + 1, 1);
+    double *W = NULL, *C = NULL, *Y = NULL, *G = NULL, *R = NULL, *sv = NULL, *U = NULL, *VT = NULL, *sup = NULL, *H = NULL;
+    if (!x || !idx || !smooth) goto done;
+    /* the same surfaces, degree 5: x = E c E^T, rows first (spokes: bit-identical, E's first
+     * row is the unit one) */
+    for (int32_t k = 0; k < nfan; k++) {
+        if (!filled[k]) { memset(x[k], 0, sizeof x[k]); continue; }
+        double t[NQ][5][3];
+        for (int i = 0; i < NQ; i++)
+            for (int b = 0; b < 5; b++)
+                for (int d = 0; d < 3; d++) {
+                    double s = 0;
+                    for (int a = 0; a < 5; a++) s += E[i][a] * cs[k][a][b][d];
+                    t[i][b][d] = s;
+                }
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NQ; j++)
+                for (int d = 0; d < 3; d++) {
+                    double s = 0;
+                    for (int b = 0; b < 5; b++) s += t[i][b][d] * E[j][b];
+                    x[k][i][j][d] = s;
+                }
+    }
+    /* unknowns: per smooth spoke its poles 2..6, per filled sector its inner poles 1..6 x 1..6 */
+    int32_t nvar = 0, nsm = 0;
+    int32_t *spk = malloc(sizeof(int32_t) * (size_t)(nsp + 1));
+    if (!spk) goto done;
+    for (int32_t k = 0; k < nsp; k++) {
+        int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
+        smooth[k] = !sharp[k] && k < nfan && filled[a] && filled[b] && (nsp == nfan || k > 0);
+        spk[k] = smooth[k] ? nvar : -1;
+        if (smooth[k]) nvar += 5, nsm++;
+    }
+    for (int32_t k = 0, blk = 0; k < nfan; k++) {
+        int32_t k1 = (k + 1) % nsp;
+        int own = filled[k] && (spk[k] >= 0 || spk[k1] >= 0); /* a sector between two sharp spokes stays */
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NQ; j++) {
+                int32_t v = -1;
+                if (!own) {
+                } else if (j == 0) {
+                    if (i >= 2 && i <= 6 && spk[k] >= 0) v = spk[k] + i - 2;
+                } else if (i == 0) {
+                    if (j >= 2 && j <= 6 && spk[k1] >= 0) v = spk[k1] + j - 2;
+                } else if (i <= 6 && j <= 6 && !(j == 1 && i >= 2 && spk[k] < 0) && !(i == 1 && j >= 2 && spk[k1] < 0)) {
+                    /* not the cross-derivative row along a sharp spoke: its crease keeps the
+                     * normals it was built with */
+                    v = 5 * nsm + 36 * blk + 6 * (i - 1) + (j - 1);
+                }
+                idx[k][i][j] = v;
+            }
+        if (own) blk++, nvar += 36;
+    }
+    free(spk);
+    if (!nsm) { rc = 0; goto done; }
+    int32_t m = 2 * NCOL * nsm, n = nvar;
+    W = calloc((size_t)n * n, sizeof(double));
+    C = calloc((size_t)m * n, sizeof(double));
+    R = calloc((size_t)(m > n ? m : n) * 3, sizeof(double));
+    Y = malloc(sizeof(double) * (size_t)n * n);
+    G = malloc(sizeof(double) * (size_t)n * n);
+    U = malloc(sizeof(double) * (size_t)m * m);
+    VT = malloc(sizeof(double) * (size_t)n * n);
+    sv = malloc(sizeof(double) * (size_t)(m + n));
+    sup = malloc(sizeof(double) * (size_t)(m + n));
+    H = calloc((size_t)n * 9, sizeof(double)); /* the energy's gradient at the raised fill, dp, del */
+    if (!H || !W || !C || !R || !Y || !G || !U || !VT || !sv || !sup) goto done;
+    /* the G1 rows: sector a = k (spoke k is its u-axis), b = k - 1 (its v-axis) */
+    static const double GL[NCOL] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                    -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                    0.7966664774136267,  0.9602898564975363};
+    int32_t row = 0;
+    rc = 0;
+    for (int32_t k = 0; k < nsp; k++) {
+        if (!smooth[k]) continue;
+        int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
+        double Da0[3], Db0[3], T0[3], Da2[3], Db2[3], T2[3], be0, ga0, be2, ga2;
+        for (int d = 0; d < 3; d++) {
+            Da0[d] = x[a][0][1][d] - x[a][0][0][d], Db0[d] = x[b][1][0][d] - x[b][0][0][d];
+            T0[d] = x[a][1][0][d] - x[a][0][0][d];
+            Da2[d] = x[a][8][1][d] - x[a][8][0][d], Db2[d] = x[b][1][8][d] - x[b][0][8][d];
+            T2[d] = x[a][8][0][d] - x[a][7][0][d];
+        }
+        if (!weights(Da0, Db0, T0, &be0, &ga0) || !weights(Da2, Db2, T2, &be2, &ga2)) goto done;
+        for (int span = 0; span < 2; span++)
+            for (int c = 0; c < NCOL; c++, row++) {
+                double u = span + 0.5 * (GL[c] + 1), N[NQ], dN[NQ];
+                basis(KQ, PQ, NQ, u, N, dN, NULL);
+                /* true derivatives: d/dv at v = 0 is 5 (x_i1 - x_i0) (first knot span 1), the
+                 * spoke's d/du sum dN_i x_i0; the end values above have the same factors */
+                double f = (1 - u / 2) * (1 - u / 2), be = be2 + (be0 - be2) * f, ga = (ga2 + (ga0 - ga2) * f) / 5;
+                for (int i = 0; i < NQ; i++) {
+                    /* D_k: x_a[i][1] - x_a[i][0]; D_{k-1}: x_b[1][i] - x_b[0][i], where x_b[0][i]
+                     * is the spoke's x_a[i][0] (one unknown) */
+                    struct { int32_t s, ii, jj; double c; } term[3] = {
+                        {a, i, 1, N[i]}, {a, i, 0, -N[i] - be * N[i] - ga * dN[i]}, {b, 1, i, be * N[i]}};
+                    for (int t = 0; t < 3; t++) {
+                        int32_t v = idx[term[t].s][term[t].ii][term[t].jj];
+                        const double *val = x[term[t].s][term[t].ii][term[t].jj];
+                        if (v >= 0) C[(size_t)row * n + v] += term[t].c;
+                        for (int d = 0; d < 3; d++) R[3 * (size_t)row + d] -= term[t].c * val[d];
+                    }
+                }
+            }
+    }
+    /* the energy of x = x0 + delta (x0 the raised fill, delta on the unknowns): the thin-plate
+     * functional over every filled sector, sum over (i,j), (i',j') of x_ij x_i'j'
+     * (A2 A0 + 2 A1 A1 + A0 A2) = delta^T W delta + 2 H^T delta + const */
+    double A[3][NQ][NQ];
+    gram(A);
+    for (int32_t k = 0; k < nfan; k++) {
+        if (!filled[k]) continue;
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NQ; j++) {
+                int32_t v = idx[k][i][j];
+                if (v < 0) continue; /* also every pole of a sector without unknowns */
+                for (int i2 = 0; i2 < NQ; i2++)
+                    for (int j2 = 0; j2 < NQ; j2++) {
+                        double e = A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
+                        int32_t v2 = idx[k][i2][j2];
+                        if (v2 >= 0) W[(size_t)v * n + v2] += e;
+                        for (int d = 0; d < 3; d++) H[3 * (size_t)v + d] += e * x[k][i2][j2][d];
+                    }
+            }
+    }
+    /* the constraints' SVD C = U S V^T: a particular solution V1 S1^-1 U1^T r, the null space
+     * Z = V2 (singular values below 1e-11 of the largest: the dependent rows) */
+    if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', m, n, C, n, sv, U, m, VT, n, sup) != 0) goto done;
+    int32_t rank = 0, mn = m < n ? m : n;
+    while (rank < mn && sv[rank] > 1e-11 * sv[0]) rank++;
+    int32_t nz = n - rank;
+    double *dp = H + 3 * (size_t)n, *del = dp + 3 * (size_t)n; /* the particular solution, the correction */
+    particular(U, VT, sv, rank, m, n, R, dp);
+    /* the least energy in dp + Z y: (Z^T W Z) y = -Z^T (W dp + H) */
+    double tr = 0;
+    for (int32_t i = 0; i < n; i++) tr += W[(size_t)i * n + i];
+    for (int32_t i = 0; i < n; i++) W[(size_t)i * n + i] += 1e-9 * tr / n;
+    for (int32_t z = 0; z < nz; z++) /* Y = W Z (n x nz) */
+        for (int32_t i = 0; i < n; i++) {
+            double acc = 0;
+            for (int32_t j = 0; j < n; j++) acc += W[(size_t)i * n + j] * VT[(size_t)(rank + z) * n + j];
+            Y[(size_t)i * nz + z] = acc;
+        }
+    for (int32_t z = 0; z < nz; z++) {
+        for (int32_t z2 = 0; z2 < nz; z2++) {
+            double acc = 0;
+            for (int32_t i = 0; i < n; i++) acc += VT[(size_t)(rank + z) * n + i] * Y[(size_t)i * nz + z2];
+            G[(size_t)z * nz + z2] = acc;
+        }
+        for (int d = 0; d < 3; d++) {
+            double acc = 0;
+            for (int32_t i = 0; i < n; i++)
+                acc += Y[(size_t)i * nz + z] * dp[3 * i + d] + VT[(size_t)(rank + z) * n + i] * H[3 * (size_t)i + d];
+            R[3 * (size_t)z + d] = -acc;
+        }
+    }
+    if (nz > 0 && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', nz, 3, G, nz, R, 3) != 0) goto done;
+    for (int32_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) {
+            double acc = dp[3 * (size_t)i + d];
+            for (int32_t z = 0; z < nz; z++) acc += VT[(size_t)(rank + z) * n + i] * R[3 * (size_t)z + d];
+            del[3 * (size_t)i + d] = acc;
+        }
+    for (int32_t k = 0; k < nfan; k++)
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NQ; j++) {
+                int32_t v = idx[k][i][j];
+                if (v < 0) continue;
+                for (int d = 0; d < 3; d++) x[k][i][j][d] += del[3 * (size_t)v + d];
+            }
+    /* a shared spoke pole is one unknown: both sectors got the same sum */
+    *dev = deviation(x, nfan, nsp, smooth);
+    memcpy(q, x, sizeof *x * (size_t)nfan);
+    rc = 1;
+done:
+    free(x);
+    free(idx);
+    free(smooth);
+    free(W);
+    free(C);
+    free(Y);
+    free(G);
+    free(R);
+    free(sv);
+    free(U);
+    free(VT);
+    free(sup);
+    free(H);
+    return rc;
+}

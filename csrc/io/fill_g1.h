@@ -1,0 +1,35 @@
+/* Fill faces made exactly G1 across their smooth spokes (internal; io/fill_g1.c, used by
+ * io/fill_faces.c). */
+#ifndef CCN_IO_FILL_G1_H
+#define CCN_IO_FILL_G1_H
+
+#include <stdint.h>
+
+/* The quintic fill: per sector a degree-5 B-spline with 2 x 2 spans, knots
+ * CCN_FILL_G1_KNOTS in units of the fill level's faces, 9 x 9 poles, pole (i, j) i along the
+ * sector's spoke k (its u-axis), j along spoke k + 1. */
+#define CCN_FILL_G1_POLES 9
+#define CCN_FILL_G1_KNOTS {0, 0, 0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 2, 2, 2}
+
+/* From the bicubic fills cs (per fan face k: 5 x 5 poles of the clamped 2-span cubic, knots
+ * 0000 1 2222; spoke k = sector k's u-axis and sector k-1's v-axis, shared bit for bit; the
+ * spoke's inner pole in the limit tangent plane; the outer two layers the exact C1 data), the
+ * quintic fills q that are exactly G1 across every smooth spoke (sharp[k] = 0, both sectors
+ * filled): of all quintic fills with the G1 relations
+ *     D_k(u) + beta(u) D_{k-1}(u) = gamma(u) T(u),  u in [0, 2]
+ * (D the two sectors' cross-boundary derivatives, T the spoke's tangent, the weights fixed by
+ * the data at both ends) the one of least thin-plate energy. The limit point, the spokes' first
+ * poles (the tangent plane), the sharp spokes and the outer two layers (the C1 join) are the
+ * bicubic fill's, degree-raised. bnd: w on the boundary (nsp = nfan + 1 spokes, else nsp =
+ * nfan). Returns 1 with q and *dev (the largest normal angle across the smooth spokes, 16
+ * points each), 0 when the relations have no solution (no common tangent plane or a folded
+ * corner, more than CCN_FILL_G1_MAX_SPOKES spokes: the cost grows with their cube, 6 s at 32;
+ * q untouched), -1 out of memory. */
+#define CCN_FILL_G1_MAX_SPOKES 32
+/* Bicubic fills that deviate less than this (rad) across their spokes are kept as they are
+ * (smooth valence-2 corners: 1e-21). */
+#define CCN_FILL_G1_EXACT 1e-10
+int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
+                 const uint8_t *filled, double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3], double *dev);
+
+#endif
