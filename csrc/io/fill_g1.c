@@ -185,7 +185,7 @@ static void particular(const double *U, const double *VT, const double *sv, int3
 }
 
 int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
-                 const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev) {
+                 const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev, double *energy) {
     if (nfan < 1 || nsp > CCN_FILL_G1_MAX_SPOKES) return 0;
     double E[NQ][5];
     if (raise_matrix(E)) return 0;
@@ -364,6 +364,16 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
             }
     /* a shared spoke pole is one unknown: both sectors got the same sum */
     *dev = deviation(x, nfan, nsp, smooth);
+    double en = 0;
+    for (int32_t k = 0; k < nfan; k++) /* the thin-plate energy of the result */
+        for (int i = 0; i < NQ && filled[k]; i++)
+            for (int j = 0; j < NQ; j++)
+                for (int i2 = 0; i2 < NQ; i2++)
+                    for (int j2 = 0; j2 < NQ; j2++) {
+                        double e = A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
+                        for (int d = 0; d < 3; d++) en += e * x[k][i][j][d] * x[k][i2][j2][d];
+                    }
+    *energy = en;
     memcpy(q, x, sizeof *x * (size_t)nfan);
     rc = 1;
 done:

@@ -21,15 +21,19 @@
  * the data at both ends) the one of least thin-plate energy. The limit point, the spokes' first
  * poles (the tangent plane), the sharp spokes and the outer two layers (the C1 join) are the
  * bicubic fill's, degree-raised. bnd: w on the boundary (nsp = nfan + 1 spokes, else nsp =
- * nfan). Returns 1 with q and *dev (the largest normal angle across the smooth spokes, 16
- * points each), 0 when the relations have no solution (no common tangent plane or a folded
+ * nfan). Returns 1 with q, *dev (the largest normal angle across the smooth spokes, 16
+ * points each) and *energy (q's thin-plate energy, to compare fills of different spoke data), 0 when the relations have no solution (no common tangent plane or a folded
  * corner, more than CCN_FILL_G1_MAX_SPOKES spokes: the cost grows with their cube, 6 s at 32;
  * q untouched), -1 out of memory. */
 #define CCN_FILL_G1_MAX_SPOKES 32
 /* Bicubic fills that deviate less than this (rad) across their spokes are kept as they are
  * (smooth valence-2 corners: 1e-21). */
 #define CCN_FILL_G1_EXACT 1e-10
+/* Quintic fills within this (rad) are G1 as CAD readers take it (their spokes' data is
+ * consistent to about 1e-9 of its size, io/fill_g1.c): among them the fairest is kept. */
+#define CCN_FILL_G1_TARGET 1e-8
 int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
-                 const uint8_t *filled, double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3], double *dev);
+                 const uint8_t *filled, double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3], double *dev,
+                 double *energy);
 
 #endif
