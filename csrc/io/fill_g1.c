@@ -317,44 +317,74 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                     }
             }
     }
-    /* the constraints' SVD C = U S V^T: a particular solution V1 S1^-1 U1^T r, the null space
-     * Z = V2 (singular values below 1e-11 of the largest: the dependent rows) */
-    if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', m, n, C, n, sv, U, m, VT, n, sup) != 0) goto done;
-    int32_t rank = 0, mn = m < n ? m : n;
+    /* Only the unknowns next to the smooth spokes appear in C (the columns c); the others (f)
+     * are free. The SVD of C's columns c, C_c = U S V^T, gives a particular solution dp =
+     * V1 S1^-1 U1^T r and the null space Z = V2 (singular values below 1e-11 of the largest:
+     * the dependent rows). The unknowns are then delta_c = dp + Z^T y and delta_f, and the
+     * energy's normal equations in (y, delta_f), M = B^T W B with B = diag(Z^T, I), are solved by
+     * Cholesky; the SVD and the products stay the size of the spokes' neighbourhood. */
+    int32_t nc = 0, nf = 0, *cm = malloc(sizeof(int32_t) * (size_t)n), *col = malloc(sizeof(int32_t) * (size_t)n);
+    if (!cm || !col) { free(cm); free(col); rc = -1; goto done; }
+    for (int32_t i = 0; i < n; i++) {
+        int used = 0;
+        for (int32_t r = 0; r < m && !used; r++) used = C[(size_t)r * n + i] != 0;
+        cm[i] = used;
+    }
+    for (int32_t i = 0; i < n; i++) if (cm[i]) col[nc++] = i; /* c first, then f */
+    for (int32_t i = 0; i < n; i++) if (!cm[i]) col[nc + nf++] = i;
+    for (int32_t r = 0; r < m; r++) /* C_c, packed into C's first rows of nc */
+        for (int32_t j = 0; j < nc; j++) Y[(size_t)r * nc + j] = C[(size_t)r * n + col[j]];
+    int svd = LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', m, nc, Y, nc, sv, U, m, VT, nc, sup);
+    if (svd != 0) { free(cm); free(col); goto done; }
+    int32_t rank = 0, mn = m < nc ? m : nc;
     while (rank < mn && sv[rank] > 1e-11 * sv[0]) rank++;
-    int32_t nz = n - rank;
+    int32_t nz = nc - rank, N = nz + nf;
     double *dp = H + 3 * (size_t)n, *del = dp + 3 * (size_t)n; /* the particular solution, the correction */
-    particular(U, VT, sv, rank, m, n, R, dp);
-    /* the least energy in dp + Z y: (Z^T W Z) y = -Z^T (W dp + H) */
+    particular(U, VT, sv, rank, m, nc, R, dp);
     double tr = 0;
     for (int32_t i = 0; i < n; i++) tr += W[(size_t)i * n + i];
     for (int32_t i = 0; i < n; i++) W[(size_t)i * n + i] += 1e-9 * tr / n;
-    for (int32_t z = 0; z < nz; z++) /* Y = W Z (n x nz) */
-        for (int32_t i = 0; i < n; i++) {
+    /* G (n x N): W B, column by column (B's column z < nz: Z's row z on c; else the unit f) */
+    for (int32_t i = 0; i < n; i++)
+        for (int32_t z = 0; z < N; z++) {
             double acc = 0;
-            for (int32_t j = 0; j < n; j++) acc += W[(size_t)i * n + j] * VT[(size_t)(rank + z) * n + j];
-            Y[(size_t)i * nz + z] = acc;
+            if (z < nz)
+                for (int32_t j = 0; j < nc; j++) acc += W[(size_t)i * n + col[j]] * VT[(size_t)(rank + z) * nc + j];
+            else
+                acc = W[(size_t)i * n + col[nc + z - nz]];
+            G[(size_t)i * N + z] = acc;
         }
-    for (int32_t z = 0; z < nz; z++) {
-        for (int32_t z2 = 0; z2 < nz; z2++) {
+    /* M = B^T (W B) into Y (N x N), g = B^T (W dp + H) into R */
+    for (int32_t z = 0; z < N; z++) {
+        for (int32_t z2 = 0; z2 < N; z2++) {
             double acc = 0;
-            for (int32_t i = 0; i < n; i++) acc += VT[(size_t)(rank + z) * n + i] * Y[(size_t)i * nz + z2];
-            G[(size_t)z * nz + z2] = acc;
+            if (z < nz)
+                for (int32_t j = 0; j < nc; j++) acc += VT[(size_t)(rank + z) * nc + j] * G[(size_t)col[j] * N + z2];
+            else
+                acc = G[(size_t)col[nc + z - nz] * N + z2];
+            Y[(size_t)z * N + z2] = acc;
         }
         for (int d = 0; d < 3; d++) {
             double acc = 0;
-            for (int32_t i = 0; i < n; i++)
-                acc += Y[(size_t)i * nz + z] * dp[3 * i + d] + VT[(size_t)(rank + z) * n + i] * H[3 * (size_t)i + d];
+            for (int32_t j = 0; j < nc; j++) acc += G[(size_t)col[j] * N + z] * dp[3 * (size_t)j + d];
+            if (z < nz)
+                for (int32_t j = 0; j < nc; j++) acc += VT[(size_t)(rank + z) * nc + j] * H[3 * (size_t)col[j] + d];
+            else
+                acc += H[3 * (size_t)col[nc + z - nz] + d];
             R[3 * (size_t)z + d] = -acc;
         }
     }
-    if (nz > 0 && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', nz, 3, G, nz, R, 3) != 0) goto done;
-    for (int32_t i = 0; i < n; i++)
+    if (N > 0 && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', N, 3, Y, N, R, 3) != 0) { free(cm); free(col); goto done; }
+    for (int32_t j = 0; j < nc; j++) /* delta on c: dp + Z^T y; on f: its own */
         for (int d = 0; d < 3; d++) {
-            double acc = dp[3 * (size_t)i + d];
-            for (int32_t z = 0; z < nz; z++) acc += VT[(size_t)(rank + z) * n + i] * R[3 * (size_t)z + d];
-            del[3 * (size_t)i + d] = acc;
+            double acc = dp[3 * (size_t)j + d];
+            for (int32_t z = 0; z < nz; z++) acc += VT[(size_t)(rank + z) * nc + j] * R[3 * (size_t)z + d];
+            del[3 * (size_t)col[j] + d] = acc;
         }
+    for (int32_t j = 0; j < nf; j++)
+        for (int d = 0; d < 3; d++) del[3 * (size_t)col[nc + j] + d] = R[3 * (size_t)(nz + j) + d];
+    free(cm);
+    free(col);
     for (int32_t k = 0; k < nfan; k++)
         for (int i = 0; i < NQ; i++)
             for (int j = 0; j < NQ; j++) {

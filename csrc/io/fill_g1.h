@@ -23,7 +23,7 @@
  * bicubic fill's, degree-raised. bnd: w on the boundary (nsp = nfan + 1 spokes, else nsp =
  * nfan). Returns 1 with q, *dev (the largest normal angle across the smooth spokes, 16
  * points each) and *energy (q's thin-plate energy, to compare fills of different spoke data), 0 when the relations have no solution (no common tangent plane or a folded
- * corner, more than CCN_FILL_G1_MAX_SPOKES spokes: the cost grows with their cube, 6 s at 32;
+ * corner, more than CCN_FILL_G1_MAX_SPOKES spokes: the cost grows with their cube, 2 s at 32;
  * q untouched), -1 out of memory. */
 #define CCN_FILL_G1_MAX_SPOKES 32
 /* Bicubic fills that deviate less than this (rad) across their spokes are kept as they are
