@@ -190,9 +190,11 @@ static int32_t parent_vertex(const ccn_mesh *S, int32_t w) {
     return v >= 0 && v < S->nv ? v : -1;
 }
 
-/* The largest |Gaussian curvature| of faces [f0, f1) of xm, sampled on a 9 x 9 grid of each
- * (exact first derivatives, second ones by their central differences over 1e-4 of the span;
- * the principal curvatures of surface/curvature.h). */
+/* The largest |Gaussian curvature| of faces [f0, f1) of xm, sampled on a 17 x 17 grid of each
+ * to 0.005 of its sides (exact first derivatives, second ones by their central differences over
+ * 1e-4 of the span; the principal curvatures of surface/curvature.h). Caps and fills put their
+ * largest |K| next to a side (a saddle spot by the cap's centre, the fill's vertex): a 9 x 9
+ * grid to 0.01 of the sides chose the less fair closure on 2 of 42 random stars. */
 static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
     double kmax = 0;
     for (int32_t f = f0; f < f1; f++) {
@@ -201,9 +203,9 @@ static double faces_max_k(const ccn__xmodel *xm, int32_t f0, int32_t f1) {
         ccn__cad_domain(s, 0, &u0, &u1);
         ccn__cad_domain(s, 1, &v0, &v1);
         double hu = 1e-4 * (u1 - u0), hv = 1e-4 * (v1 - v0);
-        for (int a = 0; a <= 8; a++)
-            for (int b = 0; b <= 8; b++) {
-                double u = u0 + (u1 - u0) * (0.01 + 0.98 * a / 8), v = v0 + (v1 - v0) * (0.01 + 0.98 * b / 8);
+        for (int a = 0; a <= 16; a++)
+            for (int b = 0; b <= 16; b++) {
+                double u = u0 + (u1 - u0) * (0.005 + 0.99 * a / 16), v = v0 + (v1 - v0) * (0.005 + 0.99 * b / 16);
                 /* d: S_u, S_v, S_uu, S_uv, S_vv; first derivatives at (u +- hu, v), (u, v +- hv) */
                 double d[5][3], p[3], au[3], av[3], bu[3], bv[3], cu[3], cv[3], eu[3], ev[3], k1, k2;
                 ccn__cad_eval_d(s, u, v, p, d[0], d[1]);
