@@ -25,11 +25,11 @@
  *
  * Among the solutions, the fairest: the least thin-plate energy sum over the sectors of
  * integral |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2 (exact Gram matrices of the basis' derivatives;
- * + 1e-9 of its trace, so that it is definite). C's SVD gives a particular solution and the
- * null space Z (singular values below 1e-11 of the largest: the rows are dependent, the
- * relations hold at the span ends by the data and around an interior vertex of even valence
- * the twists' enclosure condition repeats); the energy is minimised over Z by a Cholesky
- * solve. Measured (tests/c/test_export.c, the OpenSubdiv shapes): normals across the spokes
+ * + 1e-9 of its trace, so that it is definite). The SVD of C's columns (the unknowns next to
+ * the spokes) gives a particular solution and the null space Z (singular values below 1e-11 of
+ * the largest: the rows are dependent, the relations hold at the span ends by the data and
+ * around an interior vertex of even valence the twists' enclosure condition repeats); the
+ * energy is minimised over Z and the other unknowns by a Cholesky solve (least_energy). Measured (tests/c/test_export.c, the OpenSubdiv shapes): normals across the spokes
  * within 1e-12 to 4e-10 rad (what is left is the data's own consistency: the three tangent
  * vectors at the vertex and the C1 data at the far end are coplanar to 1e-9 of their size); the
  * fills' largest |K| below the bicubic ones' on boundary EVs
@@ -184,19 +184,10 @@ static void particular(const double *U, const double *VT, const double *sv, int3
     }
 }
 
-int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
-                 const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev, double *energy) {
-    if (nfan < 1 || nsp > CCN_FILL_G1_MAX_SPOKES) return 0;
-    double E[NQ][5];
-    if (raise_matrix(E)) return 0;
-    int rc = -1;
-    double (*x)[NQ][NQ][3] = malloc(sizeof *x * (size_t)nfan); /* raised, then the fairest G1 */
-    int32_t (*idx)[NQ][NQ] = malloc(sizeof *idx * (size_t)nfan);
-    uint8_t *smooth = calloc((size_t)nsp + 1, 1);
-    double *W = NULL, *C = NULL, *Y = NULL, *G = NULL, *R = NULL, *sv = NULL, *U = NULL, *VT = NULL, *sup = NULL, *H = NULL;
-    if (!x || !idx || !smooth) goto done;
-    /* the same surfaces, degree 5: x = E c E^T, rows first (spokes: bit-identical, E's first
-     * row is the unit one) */
+/* x = E c E^T per filled sector: the bicubic fills degree-raised, rows first (spokes stay
+ * bit-identical: E's first row is the unit one). */
+static void raise_fills(double E[NQ][5], const double (*cs)[5][5][3], const uint8_t *filled, int32_t nfan,
+                        double (*x)[NQ][NQ][3]) {
     for (int32_t k = 0; k < nfan; k++) {
         if (!filled[k]) { memset(x[k], 0, sizeof x[k]); continue; }
         double t[NQ][5][3];
@@ -215,19 +206,27 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                     x[k][i][j][d] = s;
                 }
     }
-    /* unknowns: per smooth spoke its poles 2..6, per filled sector its inner poles 1..6 x 1..6 */
-    int32_t nvar = 0, nsm = 0;
-    int32_t *spk = malloc(sizeof(int32_t) * (size_t)(nsp + 1));
-    if (!spk) goto done;
+}
+
+/* The unknowns: per smooth spoke (smooth[k] set here) its poles 2..6, per filled sector with a
+ * smooth spoke its inner poles 1..6 x 1..6 except the cross-derivative row along a sharp spoke
+ * (its crease keeps the normals it was built with); a sector between two sharp spokes stays.
+ * idx[k][i][j] = the unknown of sector k's pole (i, j), -1 if fixed. Returns their number
+ * (*nsm: the smooth spokes), -1 out of memory. */
+static int32_t number_unknowns(int32_t nfan, int32_t nsp, const uint8_t *sharp, const uint8_t *filled,
+                               uint8_t *smooth, int32_t (*idx)[NQ][NQ], int32_t *nsm) {
+    int32_t nvar = 0, *spk = malloc(sizeof(int32_t) * (size_t)(nsp + 1));
+    if (!spk) return -1;
+    *nsm = 0;
     for (int32_t k = 0; k < nsp; k++) {
         int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
         smooth[k] = !sharp[k] && k < nfan && filled[a] && filled[b] && (nsp == nfan || k > 0);
         spk[k] = smooth[k] ? nvar : -1;
-        if (smooth[k]) nvar += 5, nsm++;
+        if (smooth[k]) nvar += 5, (*nsm)++;
     }
     for (int32_t k = 0, blk = 0; k < nfan; k++) {
         int32_t k1 = (k + 1) % nsp;
-        int own = filled[k] && (spk[k] >= 0 || spk[k1] >= 0); /* a sector between two sharp spokes stays */
+        int own = filled[k] && (spk[k] >= 0 || spk[k1] >= 0);
         for (int i = 0; i < NQ; i++)
             for (int j = 0; j < NQ; j++) {
                 int32_t v = -1;
@@ -237,34 +236,24 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                 } else if (i == 0) {
                     if (j >= 2 && j <= 6 && spk[k1] >= 0) v = spk[k1] + j - 2;
                 } else if (i <= 6 && j <= 6 && !(j == 1 && i >= 2 && spk[k] < 0) && !(i == 1 && j >= 2 && spk[k1] < 0)) {
-                    /* not the cross-derivative row along a sharp spoke: its crease keeps the
-                     * normals it was built with */
-                    v = 5 * nsm + 36 * blk + 6 * (i - 1) + (j - 1);
+                    v = 5 * *nsm + 36 * blk + 6 * (i - 1) + (j - 1);
                 }
                 idx[k][i][j] = v;
             }
         if (own) blk++, nvar += 36;
     }
     free(spk);
-    if (!nsm) { rc = 0; goto done; }
-    int32_t m = 2 * NCOL * nsm, n = nvar;
-    W = calloc((size_t)n * n, sizeof(double));
-    C = calloc((size_t)m * n, sizeof(double));
-    R = calloc((size_t)(m > n ? m : n) * 3, sizeof(double));
-    Y = malloc(sizeof(double) * (size_t)n * n);
-    G = malloc(sizeof(double) * (size_t)n * n);
-    U = malloc(sizeof(double) * (size_t)m * m);
-    VT = malloc(sizeof(double) * (size_t)n * n);
-    sv = malloc(sizeof(double) * (size_t)(m + n));
-    sup = malloc(sizeof(double) * (size_t)(m + n));
-    H = calloc((size_t)n * 9, sizeof(double)); /* the energy's gradient at the raised fill, dp, del */
-    if (!H || !W || !C || !R || !Y || !G || !U || !VT || !sv || !sup) goto done;
-    /* the G1 rows: sector a = k (spoke k is its u-axis), b = k - 1 (its v-axis) */
+    return nvar;
+}
+
+/* The G1 rows C delta = R (n unknowns, 2 NCOL rows per smooth spoke) at x; 0 when a spoke's end
+ * data admits no weights. Sector a = k (spoke k is its u-axis), b = k - 1 (its v-axis). */
+static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan, int32_t nsp, const uint8_t *smooth,
+                   int32_t n, double *C, double *R) {
     static const double GL[NCOL] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
                                     -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
                                     0.7966664774136267,  0.9602898564975363};
     int32_t row = 0;
-    rc = 0;
     for (int32_t k = 0; k < nsp; k++) {
         if (!smooth[k]) continue;
         int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
@@ -275,7 +264,7 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
             Da2[d] = x[a][8][1][d] - x[a][8][0][d], Db2[d] = x[b][1][8][d] - x[b][0][8][d];
             T2[d] = x[a][8][0][d] - x[a][7][0][d];
         }
-        if (!weights(Da0, Db0, T0, &be0, &ga0) || !weights(Da2, Db2, T2, &be2, &ga2)) goto done;
+        if (!weights(Da0, Db0, T0, &be0, &ga0) || !weights(Da2, Db2, T2, &be2, &ga2)) return 0;
         for (int span = 0; span < 2; span++)
             for (int c = 0; c < NCOL; c++, row++) {
                 double u = span + 0.5 * (GL[c] + 1), N[NQ], dN[NQ];
@@ -297,11 +286,14 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                 }
             }
     }
-    /* the energy of x = x0 + delta (x0 the raised fill, delta on the unknowns): the thin-plate
-     * functional over every filled sector, sum over (i,j), (i',j') of x_ij x_i'j'
-     * (A2 A0 + 2 A1 A1 + A0 A2) = delta^T W delta + 2 H^T delta + const */
-    double A[3][NQ][NQ];
-    gram(A);
+    return 1;
+}
+
+/* The energy of x + delta (delta on the unknowns): the thin-plate functional over every filled
+ * sector, sum over (i,j), (i',j') of x_ij x_i'j' (A2 A0 + 2 A1 A1 + A0 A2) = delta^T W delta +
+ * 2 H^T delta + const, W += 1e-9 of its mean diagonal (definite). */
+static void thin_plate(double A[3][NQ][NQ], double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], const uint8_t *filled,
+                       int32_t nfan, int32_t n, double *W, double *H) {
     for (int32_t k = 0; k < nfan; k++) {
         if (!filled[k]) continue;
         for (int i = 0; i < NQ; i++)
@@ -317,34 +309,45 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                     }
             }
     }
-    /* Only the unknowns next to the smooth spokes appear in C (the columns c); the others (f)
-     * are free. The SVD of C's columns c, C_c = U S V^T, gives a particular solution dp =
-     * V1 S1^-1 U1^T r and the null space Z = V2 (singular values below 1e-11 of the largest:
-     * the dependent rows). The unknowns are then delta_c = dp + Z^T y and delta_f, and the
-     * energy's normal equations in (y, delta_f), M = B^T W B with B = diag(Z^T, I), are solved by
-     * Cholesky; the SVD and the products stay the size of the spokes' neighbourhood. */
-    int32_t nc = 0, nf = 0, *cm = malloc(sizeof(int32_t) * (size_t)n), *col = malloc(sizeof(int32_t) * (size_t)n);
-    if (!cm || !col) { free(cm); free(col); rc = -1; goto done; }
-    for (int32_t i = 0; i < n; i++) {
-        int used = 0;
-        for (int32_t r = 0; r < m && !used; r++) used = C[(size_t)r * n + i] != 0;
-        cm[i] = used;
-    }
-    for (int32_t i = 0; i < n; i++) if (cm[i]) col[nc++] = i; /* c first, then f */
-    for (int32_t i = 0; i < n; i++) if (!cm[i]) col[nc + nf++] = i;
-    for (int32_t r = 0; r < m; r++) /* C_c, packed into C's first rows of nc */
-        for (int32_t j = 0; j < nc; j++) Y[(size_t)r * nc + j] = C[(size_t)r * n + col[j]];
-    int svd = LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', m, nc, Y, nc, sv, U, m, VT, nc, sup);
-    if (svd != 0) { free(cm); free(col); goto done; }
-    int32_t rank = 0, mn = m < nc ? m : nc;
-    while (rank < mn && sv[rank] > 1e-11 * sv[0]) rank++;
-    int32_t nz = nc - rank, N = nz + nf;
-    double *dp = H + 3 * (size_t)n, *del = dp + 3 * (size_t)n; /* the particular solution, the correction */
-    particular(U, VT, sv, rank, m, nc, R, dp);
     double tr = 0;
     for (int32_t i = 0; i < n; i++) tr += W[(size_t)i * n + i];
     for (int32_t i = 0; i < n; i++) W[(size_t)i * n + i] += 1e-9 * tr / n;
-    /* G (n x N): W B, column by column (B's column z < nz: Z's row z on c; else the unit f) */
+}
+
+/* The least-energy delta (n x 3) with C delta = R: only the unknowns next to the smooth spokes
+ * appear in C (the columns c); the others (f) are free. The SVD of C's columns c, C_c = U S V^T,
+ * gives a particular solution dp = V1 S1^-1 U1^T R and the null space Z = V2 (singular values
+ * below 1e-11 of the largest: the dependent rows); with delta_c = dp + Z^T y the energy's normal
+ * equations in (y, delta_f), M = B^T W B with B = diag(Z^T, I), are solved by Cholesky, so the
+ * SVD and the products stay the size of the spokes' neighbourhood. 1, 0 (no factorisation), -1
+ * out of memory. */
+static int least_energy(int32_t m, int32_t n, const double *C, const double *R, const double *W, const double *H,
+                        double *del) {
+    int rc = -1;
+    int32_t nc = 0, nf = 0, *col = malloc(sizeof(int32_t) * (size_t)n);
+    double *Y = malloc(sizeof(double) * (size_t)n * n), *G = malloc(sizeof(double) * (size_t)n * n);
+    double *U = malloc(sizeof(double) * (size_t)m * m), *VT = malloc(sizeof(double) * (size_t)n * n);
+    double *sv = malloc(sizeof(double) * (size_t)(m + n)), *sup = malloc(sizeof(double) * (size_t)(m + n));
+    double *dp = malloc(sizeof(double) * 3 * (size_t)n), *g = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!col || !Y || !G || !U || !VT || !sv || !sup || !dp || !g) goto done;
+    rc = 0;
+    for (int32_t i = 0; i < n; i++) { /* c first, then f */
+        int used = 0;
+        for (int32_t r = 0; r < m && !used; r++) used = C[(size_t)r * n + i] != 0;
+        if (used) col[nc++] = i;
+    }
+    for (int32_t i = 0, k = 0; i < n; i++) {
+        if (k < nc && col[k] == i) { k++; continue; }
+        col[nc + nf++] = i;
+    }
+    for (int32_t r = 0; r < m; r++) /* C_c */
+        for (int32_t j = 0; j < nc; j++) Y[(size_t)r * nc + j] = C[(size_t)r * n + col[j]];
+    if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', m, nc, Y, nc, sv, U, m, VT, nc, sup) != 0) goto done;
+    int32_t rank = 0, mn = m < nc ? m : nc;
+    while (rank < mn && sv[rank] > 1e-11 * sv[0]) rank++;
+    int32_t nz = nc - rank, N = nz + nf;
+    particular(U, VT, sv, rank, m, nc, R, dp);
+    /* G (n x N) = W B, column by column (B's column z < nz: Z's row z on c; else the unit f) */
     for (int32_t i = 0; i < n; i++)
         for (int32_t z = 0; z < N; z++) {
             double acc = 0;
@@ -354,7 +357,7 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                 acc = W[(size_t)i * n + col[nc + z - nz]];
             G[(size_t)i * N + z] = acc;
         }
-    /* M = B^T (W B) into Y (N x N), g = B^T (W dp + H) into R */
+    /* M = B^T (W B) into Y (N x N), g = -B^T (W dp + H) */
     for (int32_t z = 0; z < N; z++) {
         for (int32_t z2 = 0; z2 < N; z2++) {
             double acc = 0;
@@ -371,28 +374,60 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                 for (int32_t j = 0; j < nc; j++) acc += VT[(size_t)(rank + z) * nc + j] * H[3 * (size_t)col[j] + d];
             else
                 acc += H[3 * (size_t)col[nc + z - nz] + d];
-            R[3 * (size_t)z + d] = -acc;
+            g[3 * (size_t)z + d] = -acc;
         }
     }
-    if (N > 0 && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', N, 3, Y, N, R, 3) != 0) { free(cm); free(col); goto done; }
+    if (N > 0 && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', N, 3, Y, N, g, 3) != 0) goto done;
     for (int32_t j = 0; j < nc; j++) /* delta on c: dp + Z^T y; on f: its own */
         for (int d = 0; d < 3; d++) {
             double acc = dp[3 * (size_t)j + d];
-            for (int32_t z = 0; z < nz; z++) acc += VT[(size_t)(rank + z) * nc + j] * R[3 * (size_t)z + d];
+            for (int32_t z = 0; z < nz; z++) acc += VT[(size_t)(rank + z) * nc + j] * g[3 * (size_t)z + d];
             del[3 * (size_t)col[j] + d] = acc;
         }
     for (int32_t j = 0; j < nf; j++)
-        for (int d = 0; d < 3; d++) del[3 * (size_t)col[nc + j] + d] = R[3 * (size_t)(nz + j) + d];
-    free(cm);
-    free(col);
-    for (int32_t k = 0; k < nfan; k++)
+        for (int d = 0; d < 3; d++) del[3 * (size_t)col[nc + j] + d] = g[3 * (size_t)(nz + j) + d];
+    rc = 1;
+done:
+    free(col); free(Y); free(G); free(U); free(VT); free(sv); free(sup); free(dp); free(g);
+    return rc;
+}
+
+int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
+                 const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev, double *energy) {
+    if (nfan < 1 || nsp > CCN_FILL_G1_MAX_SPOKES) return 0;
+    double E[NQ][5], A[3][NQ][NQ];
+    if (raise_matrix(E)) return 0;
+    gram(A);
+    int rc = -1;
+    double (*x)[NQ][NQ][3] = malloc(sizeof *x * (size_t)nfan); /* raised, then the fairest G1 */
+    int32_t (*idx)[NQ][NQ] = malloc(sizeof *idx * (size_t)nfan), nsm = 0;
+    uint8_t *smooth = calloc((size_t)nsp + 1, 1);
+    double *W = NULL, *C = NULL, *R = NULL, *H = NULL, *del = NULL;
+    if (!x || !idx || !smooth) goto done;
+    raise_fills(E, cs, filled, nfan, x);
+    int32_t n = number_unknowns(nfan, nsp, sharp, filled, smooth, idx, &nsm), m = 2 * NCOL * nsm;
+    if (n < 0) goto done;
+    rc = 0;
+    if (!nsm) goto done;
+    rc = -1;
+    W = calloc((size_t)n * n, sizeof(double));
+    C = calloc((size_t)m * n, sizeof(double));
+    R = calloc((size_t)m * 3, sizeof(double));
+    H = calloc((size_t)n * 3, sizeof(double));
+    del = calloc((size_t)n * 3, sizeof(double));
+    if (!W || !C || !R || !H || !del) goto done;
+    rc = 0;
+    if (!g1_rows(x, idx, nfan, nsp, smooth, n, C, R)) goto done;
+    thin_plate(A, x, idx, filled, nfan, n, W, H);
+    rc = least_energy(m, n, C, R, W, H, del);
+    if (rc <= 0) goto done;
+    for (int32_t k = 0; k < nfan; k++) /* a shared spoke pole is one unknown: both sectors get it */
         for (int i = 0; i < NQ; i++)
             for (int j = 0; j < NQ; j++) {
                 int32_t v = idx[k][i][j];
                 if (v < 0) continue;
                 for (int d = 0; d < 3; d++) x[k][i][j][d] += del[3 * (size_t)v + d];
             }
-    /* a shared spoke pole is one unknown: both sectors got the same sum */
     *dev = deviation(x, nfan, nsp, smooth);
     double en = 0;
     for (int32_t k = 0; k < nfan; k++) /* the thin-plate energy of the result */
@@ -405,20 +440,14 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                     }
     *energy = en;
     memcpy(q, x, sizeof *x * (size_t)nfan);
-    rc = 1;
 done:
     free(x);
     free(idx);
     free(smooth);
     free(W);
     free(C);
-    free(Y);
-    free(G);
     free(R);
-    free(sv);
-    free(U);
-    free(VT);
-    free(sup);
     free(H);
+    free(del);
     return rc;
 }
