@@ -307,30 +307,13 @@ static void spoke_planes(double (*nb)[6][4][4][3], double (*cs)[5][5][3], int32_
     free(np);
 }
 
-/* Largest normal angle across the smooth spokes of the fills cs (8 points per spoke). */
+/* Largest normal angle across the smooth spokes of the bicubic fills cs (8 points per spoke). */
 static double spoke_deviation(double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
-                              const uint8_t *filled) {
-    static const double kn[3] = {0, 1, 2};
+                              const uint8_t *filled, uint8_t *smooth) {
     static const int32_t mu[3] = {4, 1, 4};
-    double worst = 0;
-    for (int32_t k = 0; k < nsp; k++) {
-        int32_t a = k % nfan, b = (k + nfan - 1) % nfan; /* spoke k: u-axis of a, v-axis of b */
-        if (sharp[k] || !filled[a] || !filled[b]) continue;
-        ccn__cad_surface A = {{3, 3}, {5, 5}, {3, 3}, {kn, kn}, {mu, mu}, &cs[a][0][0][0], {0, 0}};
-        ccn__cad_surface B = A;
-        B.poles = &cs[b][0][0][0];
-        for (int i = 0; i < 8; i++) {
-            double t = 2.0 * (i + 0.5) / 8, p[3], du[3], dv[3], na[3], nb[3], c[3];
-            ccn__cad_eval_d(&A, t, 0, p, du, dv);
-            cross(du, dv, na);
-            ccn__cad_eval_d(&B, 0, t, p, du, dv);
-            cross(du, dv, nb);
-            cross(na, nb, c);
-            double ang = atan2(sqrt(dot3(c, c)), dot3(na, nb));
-            if (!(ang <= worst)) worst = ang;
-        }
-    }
-    return worst;
+    for (int32_t k = 0; k < nsp; k++) /* spoke k: u-axis of sector k, v-axis of sector k-1 */
+        smooth[k] = !sharp[k] && filled[k % nfan] && filled[(k + nfan - 1) % nfan];
+    return ccn__fill_spoke_angle(&cs[0][0][0][0], 3, mu, nfan, nsp, smooth, 8);
 }
 
 ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, const ccn__xplace *fpl,
@@ -348,9 +331,10 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
     double (*Ns)[3] = malloc(sizeof *Ns * (size_t)(nsp + 1));      /* per spoke */
     uint8_t *sharp = malloc((size_t)nsp + 1);                         /* C0 spokes */
     uint8_t *filled = malloc((size_t)nfan + 1); /* fan faces in irregular sectors: filled */
+    uint8_t *smooth = malloc((size_t)nsp + 1);  /* spokes measured for G1 */
     double (*cs)[5][5][3] = NULL; /* the fills' poles, per sector */
     double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3] = NULL, (*qc)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3] = NULL; /* their exactly G1 form, a candidate */
-    if (!sp || !nb || !bk || !N || !Ns || !sharp || !filled) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
+    if (!sp || !nb || !bk || !N || !Ns || !sharp || !filled || !smooth) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)"); goto done; }
     if ((st = vertex_limit(fl, w, P, N, err))) goto done;
     for (int32_t k = 0; k < nsp; k++) {
         sharp[k] = (bnd && (k == 0 || k == nsp - 1)) || ccn__edge_splits(m, ccn__fan_edge(m, w, k));
@@ -462,7 +446,7 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
             }
         }
         spoke_planes(nb, cs, nfan, nsp, sharp, filled, Ns);
-        double dev = spoke_deviation(cs, nfan, nsp, sharp, filled);
+        double dev = spoke_deviation(cs, nfan, nsp, sharp, filled, smooth);
         if (cand < 5 && (dev < best || cand == 0)) {
             best = dev;
             memcpy(cbest, cs, sizeof *cs * (size_t)nfan);
@@ -524,6 +508,7 @@ done:
     free(Ns);
     free(sharp);
     free(filled);
+    free(smooth);
     free(cs);
     free(q);
     free(qc);

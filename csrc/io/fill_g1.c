@@ -146,19 +146,19 @@ static double angle_between(const double *a, const double *b) {
     return atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
 }
 
-/* Largest normal angle across the smooth spokes of the quintic fills q (16 points each). */
-static double deviation(double (*q)[NQ][NQ][3], int32_t nfan, int32_t nsp, const uint8_t *smooth) {
+double ccn__fill_spoke_angle(const double *poles, int32_t deg, const int32_t mu[3], int32_t nfan, int32_t nsp,
+                             const uint8_t *smooth, int samples) {
     static const double kn[3] = {0, 1, 2};
-    static const int32_t mu[3] = {6, 3, 6};
+    int32_t np = mu[0] + mu[1] + mu[2] - deg - 1; /* poles per direction */
     double worst = 0;
     for (int32_t k = 0; k < nsp; k++) {
         if (!smooth[k]) continue;
-        int32_t a = k % nfan, b = (k + nfan - 1) % nfan;
-        ccn__cad_surface A = {{PQ, PQ}, {NQ, NQ}, {3, 3}, {kn, kn}, {mu, mu}, &q[a][0][0][0], {0, 0}};
+        int32_t a = k % nfan, b = (k + nfan - 1) % nfan; /* spoke k: u-axis of a, v-axis of b */
+        ccn__cad_surface A = {{deg, deg}, {np, np}, {3, 3}, {kn, kn}, {mu, mu}, poles + 3 * (size_t)np * np * a, {0, 0}};
         ccn__cad_surface B = A;
-        B.poles = &q[b][0][0][0];
-        for (int i = 0; i < 16; i++) {
-            double t = 2.0 * (i + 0.5) / 16, p[3], du[3], dv[3], na[3], nb[3];
+        B.poles = poles + 3 * (size_t)np * np * b;
+        for (int i = 0; i < samples; i++) {
+            double t = 2.0 * (i + 0.5) / samples, p[3], du[3], dv[3], na[3], nb[3];
             ccn__cad_eval_d(&A, t, 0, p, du, dv);
             na[0] = du[1] * dv[2] - du[2] * dv[1], na[1] = du[2] * dv[0] - du[0] * dv[2], na[2] = du[0] * dv[1] - du[1] * dv[0];
             ccn__cad_eval_d(&B, 0, t, p, du, dv);
@@ -428,7 +428,8 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
                 if (v < 0) continue;
                 for (int d = 0; d < 3; d++) x[k][i][j][d] += del[3 * (size_t)v + d];
             }
-    *dev = deviation(x, nfan, nsp, smooth);
+    static const int32_t MU[3] = {6, 3, 6};
+    *dev = ccn__fill_spoke_angle(&x[0][0][0][0], PQ, MU, nfan, nsp, smooth, 16);
     double en = 0;
     for (int32_t k = 0; k < nfan; k++) /* the thin-plate energy of the result */
         for (int i = 0; i < NQ && filled[k]; i++)

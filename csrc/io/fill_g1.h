@@ -32,6 +32,12 @@
 /* Quintic fills within this (rad) are G1 as CAD readers take it (their spokes' data is
  * consistent to about 1e-9 of its size, io/fill_g1.c): among them the fairest is kept. */
 #define CCN_FILL_G1_TARGET 1e-8
+/* The largest normal angle across the smooth spokes (smooth[k]) of per-sector fill faces over
+ * [0, 2]^2 with knots 0, 1, 2 of multiplicities mu (degree deg; poles sector after sector, each
+ * square, i along its spoke k), at `samples` points of each spoke. */
+double ccn__fill_spoke_angle(const double *poles, int32_t deg, const int32_t mu[3], int32_t nfan, int32_t nsp,
+                             const uint8_t *smooth, int samples);
+
 int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
                  const uint8_t *filled, double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3], double *dev,
                  double *energy);
