@@ -29,7 +29,10 @@
  * the spokes) gives a particular solution and the null space Z (singular values below 1e-11 of
  * the largest: the rows are dependent, the relations hold at the span ends by the data and
  * around an interior vertex of even valence the twists' enclosure condition repeats); the
- * energy is minimised over Z and the other unknowns by a Cholesky solve (least_energy). Measured (tests/c/test_export.c, the OpenSubdiv shapes): normals across the spokes
+ * energy is minimised over Z and the other unknowns by a Cholesky solve (least_energy). Beyond
+ * CCN_FILL_G1_DENSE_SPOKES spokes, where that costs the cube of the unknowns, the same minimiser
+ * comes from the augmented Lagrangian on a banded factorisation (least_energy_banded; the
+ * valence-64 fan 0.2 s, OpenSubdiv's pole360 within its export's 4.4 s). Measured (tests/c/test_export.c, the OpenSubdiv shapes): normals across the spokes
  * within 1e-12 to 4e-10 rad (what is left is the data's own consistency: the three tangent
  * vectors at the vertex and the C1 data at the far end are coplanar to 1e-9 of their size); the
  * fills' largest |K| below the bicubic ones' on boundary EVs
@@ -246,10 +249,13 @@ static int32_t number_unknowns(int32_t nfan, int32_t nsp, const uint8_t *sharp, 
     return nvar;
 }
 
-/* The G1 rows C delta = R (n unknowns, 2 NCOL rows per smooth spoke) at x; 0 when a spoke's end
- * data admits no weights. Sector a = k (spoke k is its u-axis), b = k - 1 (its v-axis). */
+/* The G1 rows C delta = R (2 NCOL rows per smooth spoke, each with at most 3 NQ terms) at x; 0
+ * when a spoke's end data admits no weights. Sector a = k (spoke k is its u-axis), b = k - 1
+ * (its v-axis). */
+typedef struct { int32_t n, v[3 * NQ]; double c[3 * NQ]; } g1_row; /* sum_t c[t] delta[v[t]] */
+
 static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan, int32_t nsp, const uint8_t *smooth,
-                   int32_t n, double *C, double *R) {
+                   g1_row *C, double *R) {
     static const double GL[NCOL] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
                                     -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
                                     0.7966664774136267,  0.9602898564975363};
@@ -280,7 +286,7 @@ static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan,
                     for (int t = 0; t < 3; t++) {
                         int32_t v = idx[term[t].s][term[t].ii][term[t].jj];
                         const double *val = x[term[t].s][term[t].ii][term[t].jj];
-                        if (v >= 0) C[(size_t)row * n + v] += term[t].c;
+                        if (v >= 0) C[row].v[C[row].n] = v, C[row].c[C[row].n++] = term[t].c;
                         for (int d = 0; d < 3; d++) R[3 * (size_t)row + d] -= term[t].c * val[d];
                     }
                 }
@@ -289,11 +295,33 @@ static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan,
     return 1;
 }
 
+/* The system of the banded solve (many spokes): the unknowns permuted (perm) along the fan, so
+ * that all but the border -- the poles that close the cycle -- lie in a band of half-width kd (lower band storage, column-major, for dpbtrf); E (nb x nd, column-major) the
+ * band's coupling to the border, D (nd x nd) the border's own block. */
+typedef struct {
+    int32_t n, nb, nd, kd, ld;
+    int32_t *perm;
+    double *ab, *E, *D;
+} band;
+
+/* Adds e at (v, v2) of the symmetric matrix (called for both halves: keeps the lower one). */
+static void band_add(band *b, int32_t v, int32_t v2, double e) {
+    int32_t i = b->perm[v], j = b->perm[v2];
+    if (i < b->nb && j < b->nb) {
+        if (i >= j) b->ab[(size_t)(i - j) + (size_t)j * b->ld] += e;
+    } else if (i >= b->nb && j >= b->nb) {
+        b->D[(size_t)(i - b->nb) * b->nd + (j - b->nb)] += e;
+    } else if (j >= b->nb) {
+        b->E[(size_t)(j - b->nb) * b->nb + i] += e;
+    }
+}
+
 /* The energy of x + delta (delta on the unknowns): the thin-plate functional over every filled
  * sector, sum over (i,j), (i',j') of x_ij x_i'j' (A2 A0 + 2 A1 A1 + A0 A2) = delta^T W delta +
- * 2 H^T delta + const, W += 1e-9 of its mean diagonal (definite). */
+ * 2 H^T delta + const, W += 1e-9 of its mean diagonal (definite). W dense (n x n) or, when NULL,
+ * into the band b. */
 static void thin_plate(double A[3][NQ][NQ], double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], const uint8_t *filled,
-                       int32_t nfan, int32_t n, double *W, double *H) {
+                       int32_t nfan, int32_t n, double *W, band *b, double *H) {
     for (int32_t k = 0; k < nfan; k++) {
         if (!filled[k]) continue;
         for (int i = 0; i < NQ; i++)
@@ -304,14 +332,24 @@ static void thin_plate(double A[3][NQ][NQ], double (*x)[NQ][NQ][3], int32_t (*id
                     for (int j2 = 0; j2 < NQ; j2++) {
                         double e = A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
                         int32_t v2 = idx[k][i2][j2];
-                        if (v2 >= 0) W[(size_t)v * n + v2] += e;
+                        if (v2 >= 0) {
+                            if (W) W[(size_t)v * n + v2] += e;
+                            else band_add(b, v, v2, e);
+                        }
                         for (int d = 0; d < 3; d++) H[3 * (size_t)v + d] += e * x[k][i2][j2][d];
                     }
             }
     }
     double tr = 0;
-    for (int32_t i = 0; i < n; i++) tr += W[(size_t)i * n + i];
-    for (int32_t i = 0; i < n; i++) W[(size_t)i * n + i] += 1e-9 * tr / n;
+    if (W) {
+        for (int32_t i = 0; i < n; i++) tr += W[(size_t)i * n + i];
+        for (int32_t i = 0; i < n; i++) W[(size_t)i * n + i] += 1e-9 * tr / n;
+        return;
+    }
+    for (int32_t i = 0; i < b->nb; i++) tr += b->ab[(size_t)i * b->ld];
+    for (int32_t i = 0; i < b->nd; i++) tr += b->D[(size_t)i * b->nd + i];
+    for (int32_t i = 0; i < b->nb; i++) b->ab[(size_t)i * b->ld] += 1e-9 * tr / n;
+    for (int32_t i = 0; i < b->nd; i++) b->D[(size_t)i * b->nd + i] += 1e-9 * tr / n;
 }
 
 /* The least-energy delta (n x 3) with C delta = R: only the unknowns next to the smooth spokes
@@ -392,9 +430,164 @@ done:
     return rc;
 }
 
+/* ---- many spokes: the banded solve ------------------------------------------------------ */
+
+/* The band's order: sector 1, spoke 2, sector 2, ..., spoke N-1, sector N-1 (spoke k between
+ * the sectors k-1 and k its rows couple), then as the border the poles that close the cycle:
+ * sector 0's inner ones and spokes 0 and 1 (sector 0's energy couples them to each other); kd
+ * the widest coupling (a sector with its spokes' poles, a G1 row's terms). 1, -1 out of
+ * memory. */
+static int band_setup(band *b, int32_t (*idx)[NQ][NQ], int32_t nfan, int32_t n, const g1_row *C, int32_t m) {
+    int32_t *key = malloc(sizeof(int32_t) * (size_t)n), *cnt = calloc(2 * (size_t)nfan + 3, sizeof(int32_t));
+    b->perm = malloc(sizeof(int32_t) * (size_t)n);
+    if (!key || !cnt || !b->perm) { free(key); free(cnt); return -1; }
+    for (int32_t v = 0; v < n; v++) key[v] = -1;
+    for (int32_t k = 0; k < nfan; k++)
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NQ; j++) {
+                int32_t v = idx[k][i][j], sk = j == 0 ? k : i == 0 ? (k + 1) % nfan : -1;
+                if (v < 0) continue;
+                key[v] = sk >= 2 ? 2 * sk : sk >= 0 || k == 0 ? 2 * nfan + 1 : 2 * k + 1;
+            }
+    for (int32_t v = n - 1; v >= 0; v--) /* a sector's poles left fixed along a sharp spoke: with it */
+        if (key[v] < 0) key[v] = v + 1 < n && key[v + 1] >= 0 ? key[v + 1] : 2 * nfan + 1;
+    for (int32_t v = 0; v < n; v++) cnt[key[v] + 1]++;
+    for (int32_t q = 1; q < 2 * nfan + 3; q++) cnt[q] += cnt[q - 1];
+    b->n = n, b->nb = cnt[2 * nfan + 1], b->nd = n - b->nb;
+    for (int32_t v = 0; v < n; v++) b->perm[v] = cnt[key[v]]++;
+    int32_t kd = 0;
+    for (int32_t k = 0; k < nfan; k++) {
+        int32_t lo = n, hi = -1;
+        for (int p = 0; p < NQ * NQ; p++) {
+            int32_t v = idx[k][p / NQ][p % NQ], q = v >= 0 ? b->perm[v] : -1;
+            if (q >= 0 && q < b->nb) lo = q < lo ? q : lo, hi = q > hi ? q : hi;
+        }
+        if (hi - lo > kd) kd = hi - lo;
+    }
+    for (int32_t r = 0; r < m; r++) {
+        int32_t lo = n, hi = -1;
+        for (int32_t t = 0; t < C[r].n; t++) {
+            int32_t q = b->perm[C[r].v[t]];
+            if (q < b->nb) lo = q < lo ? q : lo, hi = q > hi ? q : hi;
+        }
+        if (hi - lo > kd) kd = hi - lo;
+    }
+    b->kd = kd, b->ld = kd + 1;
+    b->ab = calloc((size_t)b->ld * (b->nb ? b->nb : 1), sizeof(double));
+    b->E = calloc((size_t)b->nb * b->nd + 1, sizeof(double));
+    b->D = calloc((size_t)b->nd * b->nd + 1, sizeof(double));
+    free(key);
+    free(cnt);
+    return b->ab && b->E && b->D ? 1 : -1;
+}
+
+static void band_free(band *b) {
+    free(b->perm);
+    free(b->ab);
+    free(b->E);
+    free(b->D);
+}
+
+/* The least-energy delta with C delta = R for many spokes, where the dense SVD's cost (the cube
+ * of the unknowns) is out of reach: the augmented Lagrangian (the method of multipliers),
+ *     (W + rho C^T C) delta_t = -H + C^T (rho R - mu_t),   mu_{t+1} = mu_t + rho (C delta_t - R),
+ * whose iterates tend to the constrained minimiser whatever rho and whether or not C's rows are
+ * dependent (a dependent row's multiplier drifts along C's left null space, which C^T maps to
+ * 0). The matrix is factored once: banded Cholesky (dpbtrf) of the band and the border's Schur
+ * complement S = D - E^T B^-1 E (dpotrf), so a pass costs the band's back substitution.
+ * rho = CCN__G1_RHO x W's mean diagonal over C^T C's: a row direction of singular value s
+ * converges by the factor 1 / (1 + rho s^2 / lambda) per pass, so rho must be large where rows
+ * are nearly dependent (measured with every fill solved this way: rho 1e6 leaves 1e-6 rad on the
+ * Fig. 16-18 fills, 1e9 up to 2e-7, 1e11 and 1e12 1e-12 to 1e-9 in 3-12 passes; the poles then
+ * differ from the dense solve's by up to 1e-5 of the model along directions the energy hardly
+ * sees). The passes stop when the largest row residual has not fallen for three of them.
+ * 1, 0 (no factorisation), -1 out of memory. */
+#define CCN__G1_RHO 1e11
+#define CCN__G1_PASSES 200
+static int least_energy_banded(int32_t m, int32_t n, const g1_row *C, const double *R, band *b, const double *H,
+                               double *del) {
+    int32_t nb = b->nb, nd = b->nd, ld = b->ld, kd = b->kd;
+    double wd = 0, cd = 0;
+    for (int32_t i = 0; i < nb; i++) wd += b->ab[(size_t)i * ld];
+    for (int32_t i = 0; i < nd; i++) wd += b->D[(size_t)i * nd + i];
+    for (int32_t r = 0; r < m; r++)
+        for (int32_t t = 0; t < C[r].n; t++) cd += C[r].c[t] * C[r].c[t];
+    if (!(wd > 0) || !(cd > 0)) return 0;
+    double rho = CCN__G1_RHO * wd / cd;
+    for (int32_t r = 0; r < m; r++)
+        for (int32_t t = 0; t < C[r].n; t++)
+            for (int32_t t2 = 0; t2 < C[r].n; t2++) band_add(b, C[r].v[t], C[r].v[t2], rho * C[r].c[t] * C[r].c[t2]);
+    int rc = -1;
+    double *Y = malloc(sizeof(double) * ((size_t)nb * nd + 1)), *S = malloc(sizeof(double) * ((size_t)nd * nd + 1));
+    double *mu = calloc(3 * (size_t)m, sizeof(double)), *rhs = malloc(sizeof(double) * 3 * (size_t)n);
+    double *buf = malloc(sizeof(double) * 3 * (size_t)n), *res = malloc(sizeof(double) * 3 * (size_t)m);
+    if (!Y || !S || !mu || !rhs || !buf || !res) goto done;
+    rc = 0;
+    if (nb && LAPACKE_dpbtrf(LAPACK_COL_MAJOR, 'L', nb, kd, b->ab, ld) != 0) goto done;
+    if (nd) {
+        memcpy(Y, b->E, sizeof(double) * (size_t)nb * nd);
+        if (nb && LAPACKE_dpbtrs(LAPACK_COL_MAJOR, 'L', nb, kd, nd, b->ab, ld, Y, nb) != 0) goto done;
+        for (int32_t i = 0; i < nd; i++)
+            for (int32_t j = 0; j < nd; j++) {
+                double acc = b->D[(size_t)i * nd + j];
+                for (int32_t l = 0; l < nb; l++) acc -= b->E[(size_t)i * nb + l] * Y[(size_t)j * nb + l];
+                S[(size_t)j * nd + i] = acc;
+            }
+        if (LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', nd, S, nd) != 0) goto done;
+    }
+    double best = INFINITY;
+    for (int pass = 0, stall = 0; pass < CCN__G1_PASSES && stall < 3; pass++) {
+        for (int32_t v = 0; v < n; v++)
+            for (int d = 0; d < 3; d++) rhs[3 * (size_t)v + d] = -H[3 * (size_t)v + d];
+        for (int32_t r = 0; r < m; r++)
+            for (int32_t t = 0; t < C[r].n; t++)
+                for (int d = 0; d < 3; d++)
+                    rhs[3 * (size_t)C[r].v[t] + d] += C[r].c[t] * (rho * R[3 * (size_t)r + d] - mu[3 * (size_t)r + d]);
+        for (int32_t v = 0; v < n; v++)
+            for (int d = 0; d < 3; d++) buf[(size_t)d * n + b->perm[v]] = rhs[3 * (size_t)v + d];
+        if (nb && LAPACKE_dpbtrs(LAPACK_COL_MAJOR, 'L', nb, kd, 3, b->ab, ld, buf, n) != 0) break;
+        if (nd) { /* the border: z = S^-1 (g - E^T y), then y -= Y z */
+            for (int d = 0; d < 3; d++)
+                for (int32_t i = 0; i < nd; i++) {
+                    double acc = buf[(size_t)d * n + nb + i];
+                    for (int32_t l = 0; l < nb; l++) acc -= b->E[(size_t)i * nb + l] * buf[(size_t)d * n + l];
+                    buf[(size_t)d * n + nb + i] = acc;
+                }
+            if (LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', nd, 3, S, nd, buf + nb, n) != 0) break;
+            for (int d = 0; d < 3; d++)
+                for (int32_t l = 0; l < nb; l++) {
+                    double acc = 0;
+                    for (int32_t i = 0; i < nd; i++) acc += Y[(size_t)i * nb + l] * buf[(size_t)d * n + nb + i];
+                    buf[(size_t)d * n + l] -= acc;
+                }
+        }
+        double worst = 0;
+        for (int32_t r = 0; r < m; r++)
+            for (int d = 0; d < 3; d++) {
+                double acc = -R[3 * (size_t)r + d];
+                for (int32_t t = 0; t < C[r].n; t++) acc += C[r].c[t] * buf[(size_t)d * n + b->perm[C[r].v[t]]];
+                res[3 * (size_t)r + d] = acc;
+                if (!(fabs(acc) <= worst)) worst = fabs(acc);
+            }
+        if (worst < best) {
+            stall = worst < 0.9 * best ? 0 : stall + 1;
+            best = worst;
+            for (int32_t v = 0; v < n; v++)
+                for (int d = 0; d < 3; d++) del[3 * (size_t)v + d] = buf[(size_t)d * n + b->perm[v]];
+            rc = 1;
+        } else {
+            stall++;
+        }
+        for (int32_t q = 0; q < 3 * m; q++) mu[q] += rho * res[q];
+    }
+done:
+    free(Y); free(S); free(mu); free(rhs); free(buf); free(res);
+    return rc;
+}
+
 int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const uint8_t *sharp,
                  const uint8_t *filled, double (*q)[NQ][NQ][3], double *dev, double *energy) {
-    if (nfan < 1 || nsp > CCN_FILL_G1_MAX_SPOKES) return 0;
+    if (nfan < 1) return 0;
     double E[NQ][5], A[3][NQ][NQ];
     if (raise_matrix(E)) return 0;
     gram(A);
@@ -402,7 +595,9 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
     double (*x)[NQ][NQ][3] = malloc(sizeof *x * (size_t)nfan); /* raised, then the fairest G1 */
     int32_t (*idx)[NQ][NQ] = malloc(sizeof *idx * (size_t)nfan), nsm = 0;
     uint8_t *smooth = calloc((size_t)nsp + 1, 1);
-    double *W = NULL, *C = NULL, *R = NULL, *H = NULL, *del = NULL;
+    double *W = NULL, *Cd = NULL, *R = NULL, *H = NULL, *del = NULL;
+    g1_row *C = NULL;
+    band bd = {0};
     if (!x || !idx || !smooth) goto done;
     raise_fills(E, cs, filled, nfan, x);
     int32_t n = number_unknowns(nfan, nsp, sharp, filled, smooth, idx, &nsm), m = 2 * NCOL * nsm;
@@ -410,16 +605,28 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
     rc = 0;
     if (!nsm) goto done;
     rc = -1;
-    W = calloc((size_t)n * n, sizeof(double));
-    C = calloc((size_t)m * n, sizeof(double));
+    C = calloc((size_t)m, sizeof *C);
     R = calloc((size_t)m * 3, sizeof(double));
     H = calloc((size_t)n * 3, sizeof(double));
     del = calloc((size_t)n * 3, sizeof(double));
-    if (!W || !C || !R || !H || !del) goto done;
+    if (!C || !R || !H || !del) goto done;
     rc = 0;
-    if (!g1_rows(x, idx, nfan, nsp, smooth, n, C, R)) goto done;
-    thin_plate(A, x, idx, filled, nfan, n, W, H);
-    rc = least_energy(m, n, C, R, W, H, del);
+    if (!g1_rows(x, idx, nfan, nsp, smooth, C, R)) goto done;
+    if (nsp <= CCN_FILL_G1_DENSE_SPOKES) { /* dense: the SVD's exact null space */
+        rc = -1;
+        W = calloc((size_t)n * n, sizeof(double));
+        Cd = calloc((size_t)m * n, sizeof(double));
+        if (!W || !Cd) goto done;
+        for (int32_t r = 0; r < m; r++)
+            for (int32_t t = 0; t < C[r].n; t++) Cd[(size_t)r * n + C[r].v[t]] += C[r].c[t];
+        thin_plate(A, x, idx, filled, nfan, n, W, NULL, H);
+        rc = least_energy(m, n, Cd, R, W, H, del);
+    } else {
+        rc = band_setup(&bd, idx, nfan, n, C, m);
+        if (rc < 0) goto done;
+        thin_plate(A, x, idx, filled, nfan, n, NULL, &bd, H);
+        rc = least_energy_banded(m, n, C, R, &bd, H, del);
+    }
     if (rc <= 0) goto done;
     for (int32_t k = 0; k < nfan; k++) /* a shared spoke pole is one unknown: both sectors get it */
         for (int i = 0; i < NQ; i++)
@@ -442,10 +649,12 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
     *energy = en;
     memcpy(q, x, sizeof *x * (size_t)nfan);
 done:
+    band_free(&bd);
     free(x);
     free(idx);
     free(smooth);
     free(W);
+    free(Cd);
     free(C);
     free(R);
     free(H);

@@ -22,10 +22,11 @@
  * poles (the tangent plane), the sharp spokes and the outer two layers (the C1 join) are the
  * bicubic fill's, degree-raised. bnd: w on the boundary (nsp = nfan + 1 spokes, else nsp =
  * nfan). Returns 1 with q, *dev (the largest normal angle across the smooth spokes, 16
- * points each) and *energy (q's thin-plate energy, to compare fills of different spoke data), 0 when the relations have no solution (no common tangent plane or a folded
- * corner, more than CCN_FILL_G1_MAX_SPOKES spokes: the cost grows with their cube, 2 s at 32;
- * q untouched), -1 out of memory. */
-#define CCN_FILL_G1_MAX_SPOKES 32
+ * points each) and *energy (q's thin-plate energy, to compare fills of different spoke data),
+ * 0 when the relations have no solution (no common tangent plane or a folded corner; q
+ * untouched), -1 out of memory. Up to CCN_FILL_G1_DENSE_SPOKES spokes the solve is dense (its
+ * cost grows with the cube of the spokes, 2 s at 32), beyond it banded (linear in them). */
+#define CCN_FILL_G1_DENSE_SPOKES 32
 /* Bicubic fills that deviate less than this (rad) across their spokes are kept as they are
  * (smooth valence-2 corners: 1e-21). */
 #define CCN_FILL_G1_EXACT 1e-10

@@ -943,7 +943,14 @@ static double fill_spoke_angle(const char *name, int *pairs) {
     ccn_export_info info;
     *pairs = 0;
     if (export_of(name, &F, &info) != CCN_OK) return INFINITY;
-    double worst = 0;
+    double worst = 0, (*mid)[4][3] = malloc(sizeof *mid * (size_t)(F.n ? F.n : 1));
+    for (int a = 0; a < F.n; a++) /* each side's midpoint: only sides meeting there are compared */
+        for (int sa = 0; sa < 4 && F.f[a].kind == CCN_EXPORT_FACE_FILL; sa++) {
+            const face *A = &F.f[a];
+            double ua[2] = {A->t[0][A->deg[0]], A->t[0][A->np[0]]}, va[2] = {A->t[1][A->deg[1]], A->t[1][A->np[1]]};
+            double u = sa < 2 ? 0.5 * (ua[0] + ua[1]) : ua[sa - 2], v = sa < 2 ? va[sa] : 0.5 * (va[0] + va[1]), Su[3], Sv[3];
+            feval_d(A, u, v, mid[a][sa], Su, Sv);
+        }
     for (int a = 0; a < F.n; a++)
         for (int b = a + 1; b < F.n; b++) {
             const face *A = &F.f[a], *B = &F.f[b];
@@ -953,6 +960,9 @@ static double fill_spoke_angle(const char *name, int *pairs) {
             for (int sa = 0; sa < 4; sa++)
                 for (int sb = 0; sb < 4; sb++)
                     for (int rev = 0; rev < 2; rev++) {
+                        double gap = 0;
+                        for (int k = 0; k < 3; k++) gap = fmax(gap, fabs(mid[a][sa][k] - mid[b][sb][k]));
+                        if (!(gap <= 1e-6)) continue;
                         double pa[7][3], pb[7][3], na[7][3], nb[7][3], d = 0, size = 0;
                         for (int q = 0; q < 7; q++) {
                             double x = (q + 1) / 8.0, y = rev ? 1 - x : x, P[3], Su[3], Sv[3];
@@ -981,12 +991,14 @@ static double fill_spoke_angle(const char *name, int *pairs) {
                         }
                     }
         }
+    free(mid);
     faces_free(&F);
     return worst;
 }
 
 static void test_fills_g1(void) {
-    static const char *cages[] = {"lshape", "bfan5", "mixed_boundary", "fig16_v6", "fig17_v7", "continuity_cube"};
+    static const char *cages[] = {"lshape",   "bfan5",           "mixed_boundary", "fig16_v6",
+                                  "fig17_v7", "continuity_cube", "fan64",          "fvar_cylinder64"};
     for (int i = 0; i < (int)(sizeof cages / sizeof *cages); i++) {
         int pairs;
         double ang = fill_spoke_angle(cages[i], &pairs);

@@ -122,6 +122,7 @@ check star5_nu tests/data/star5_nu.obj 3
 check tearbox "$T/tearbox.obj" 3
 check ngon_prism tests/data/ngon_prism.obj 3
 check lshape tests/data/lshape.obj 3
+check fan64 tests/data/fan64.obj 3
 fill_g1=""
 check mixed_boundary tests/data/mixed_boundary.obj 3
 check carlike_2.5k "$T/carlike.obj" 1
