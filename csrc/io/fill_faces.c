@@ -410,6 +410,20 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
                 for (int d = 0; d < 3; d++) c[1][d] = P[d] + X[d] - t * Ns[k][d];
             }
         }
+        if (nsp == 2 && nfan == 2 && !bnd && !sharp[0] && !sharp[1] && filled[0] && filled[1]) {
+            /* an interior valence-2 vertex: its sectors are half-planes, so its two spokes must
+             * leave it along one line (a patch's corner cannot open wider than pi: with the
+             * limit's tangents, 170-190 degrees apart, one sector folds over the other, and no
+             * G1 relation with beta > 0 holds at the vertex); the line bisects them, in the
+             * tangent plane */
+            double t0[3], t1[3], e[3], l0, l1, le;
+            for (int d = 0; d < 3; d++) t0[d] = sp[0][1][d] - P[d], t1[d] = sp[1][1][d] - P[d];
+            l0 = sqrt(dot3(t0, t0)), l1 = sqrt(dot3(t1, t1));
+            for (int d = 0; d < 3; d++) e[d] = t0[d] / l0 - t1[d] / l1;
+            le = sqrt(dot3(e, e));
+            if (l0 > 0 && l1 > 0 && le > 0)
+                for (int d = 0; d < 3; d++) sp[0][1][d] = P[d] + l0 * e[d] / le, sp[1][1][d] = P[d] - l1 * e[d] / le;
+        }
         for (int32_t k = 0; k < nfan; k++) {
             double (*c)[5][3] = cs[k], S[5][3], L[5][3];
             memset(c, 0, sizeof cs[k]);

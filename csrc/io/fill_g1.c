@@ -144,6 +144,14 @@ static int weights(const double *Da, const double *Db, const double *T, double *
     return 1;
 }
 
+/* Is a on the line of t (within 1e-7 rad)? */
+static int along(const double *a, const double *t) {
+    double c[3] = {a[1] * t[2] - a[2] * t[1], a[2] * t[0] - a[0] * t[2], a[0] * t[1] - a[1] * t[0]};
+    double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2], aa = 0, tt = 0;
+    for (int d = 0; d < 3; d++) aa += a[d] * a[d], tt += t[d] * t[d];
+    return aa > 0 && tt > 0 && cc <= 1e-14 * aa * tt;
+}
+
 static double angle_between(const double *a, const double *b) {
     double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
     return atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
@@ -270,7 +278,14 @@ static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan,
             Da2[d] = x[a][8][1][d] - x[a][8][0][d], Db2[d] = x[b][1][8][d] - x[b][0][8][d];
             T2[d] = x[a][8][0][d] - x[a][7][0][d];
         }
-        if (!weights(Da0, Db0, T0, &be0, &ga0) || !weights(Da2, Db2, T2, &be2, &ga2)) return 0;
+        if (!weights(Da2, Db2, T2, &be2, &ga2)) return 0;
+        if (!weights(Da0, Db0, T0, &be0, &ga0)) { /* a valence-2 vertex: the three on one line */
+            if (!along(Da0, T0) || !along(Db0, T0)) return 0;
+            double dt = 0, tt = 0;
+            be0 = be2; /* any beta holds there: the far end's */
+            for (int d = 0; d < 3; d++) dt += (Da0[d] + be0 * Db0[d]) * T0[d], tt += T0[d] * T0[d];
+            ga0 = dt / tt;
+        }
         for (int span = 0; span < 2; span++)
             for (int c = 0; c < NCOL; c++, row++) {
                 double u = span + 0.5 * (GL[c] + 1), N[NQ], dN[NQ];

@@ -938,11 +938,37 @@ static void test_bad_input(void) {
  * mixed_boundary here, 1.8e-9 with another LAPACK). Two fill faces share a spoke when
  * 7 points along a side of each coincide (either direction); the angle between their normals is
  * taken as it is (a fold would show as pi). */
+/* The export of an OBJ text (plan levels 3, defaults). */
+static ccn_status export_text(const char *text, faces *F, ccn_export_info *info) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_options o = {0};
+    ccn_error err;
+    ccn_plan *p = NULL;
+    o.levels = 3;
+    memset(F, 0, sizeof *F);
+    if (ccn_obj_parse(text, strlen(text), &obj, &err)) return CCN_ERR_ARGUMENT;
+    ccn_status st = ccn_obj_get_cage(obj, &cage);
+    if (!st) st = ccn_plan_create(&cage, &o, &p, &err);
+    if (!st) {
+        ccn_export_options eo;
+        memset(&eo, 0, sizeof eo);
+        sink s = {NULL, 0, 0, -1};
+        st = run(p, &eo, F, &s, info, &err);
+        free(s.d);
+        ccn_plan_destroy(p);
+    }
+    ccn_obj_destroy(obj);
+    return st;
+}
+
+/* The largest normal angle across the fill faces' shared sides (7 points each); *pairs counts
+ * the sides. name: a cage of tests/data, or an OBJ text when it starts with "v ". */
 static double fill_spoke_angle(const char *name, int *pairs) {
     faces F;
     ccn_export_info info;
     *pairs = 0;
-    if (export_of(name, &F, &info) != CCN_OK) return INFINITY;
+    if ((strncmp(name, "v ", 2) ? export_of(name, &F, &info) : export_text(name, &F, &info)) != CCN_OK) return INFINITY;
     double worst = 0, (*mid)[4][3] = malloc(sizeof *mid * (size_t)(F.n ? F.n : 1));
     for (int a = 0; a < F.n; a++) /* each side's midpoint: only sides meeting there are compared */
         for (int sa = 0; sa < 4 && F.f[a].kind == CCN_EXPORT_FACE_FILL; sa++) {
@@ -1005,6 +1031,13 @@ static void test_fills_g1(void) {
         CHECK(pairs > 0 && ang <= 1e-8, "%s: %d fill spokes, normals across them up to %g rad", cages[i], pairs, ang);
         printf("# %s: %d fill spokes, normals across them <= %.2e rad\n", cages[i], pairs, ang);
     }
+    /* an interior valence-2 vertex: two quads sharing two edges, spokes 180 degrees apart and
+     * the vertex lifted; its half-plane sectors must not fold over each other (pi rad) */
+    static const char val2[] = "v 0 0 0.3\nv 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nf 1 2 4 3\nf 1 3 5 2\n";
+    int pairs;
+    double ang = fill_spoke_angle(val2, &pairs);
+    CHECK(pairs == 2 && ang <= 1e-8, "valence 2: %d fill spokes, normals across them up to %g rad", pairs, ang);
+    printf("# interior valence 2: %d fill spokes, normals across them <= %.2e rad\n", pairs, ang);
 }
 
 int main(void) {
