@@ -90,14 +90,31 @@ void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi)
     *hi = flat_knot(f, dir, f->num_poles[dir]);
 }
 
+/* The span of t -- the largest flat index s in [p, n - 1] with t_s <= t, p when there is none
+ * -- and its 2p flat knots t_{s-p+1} .. t_{s+p} into U, in two walks over the distinct knots
+ * (flat_knot per index would cost the knot count each: packed faces have hundreds). */
+static int32_t span_knots(const ccn__cad_surface *f, int dir, double t, double *U) {
+    int32_t p = f->degree[dir], n = f->num_poles[dir], nk = f->num_knots[dir], last = -1;
+    const double *kv = f->knots[dir];
+    const int32_t *mu = f->mults[dir];
+    for (int32_t k = 0; k < nk && kv[k] <= t; k++) last += mu[k];
+    int32_t span = last < n - 1 ? last : n - 1;
+    if (span < p) span = p;
+    int32_t i = span - p + 1, k = 0, before = 0; /* flat index i lies in distinct knot k */
+    while (k + 1 < nk && i >= before + mu[k]) before += mu[k++];
+    for (int32_t q = 0; q < 2 * p; q++, i++) {
+        while (k + 1 < nk && i >= before + mu[k]) before += mu[k++];
+        U[q] = kv[k];
+    }
+    return span;
+}
+
 /* Nonzero basis functions N[span-p .. span] at t (span: t[span] <= t < t[span+1], the last
  * non-empty span inside the domain at its upper end). Returns span. */
 static int32_t basis(const ccn__cad_surface *f, int dir, double t, double *N) {
-    int32_t p = f->degree[dir], n = f->num_poles[dir], span = p;
-    while (span + 1 < n && flat_knot(f, dir, span + 1) <= t) span++;
     double U[2 * CCN_CAD_MAX_DEGREE];
-    for (int32_t k = 0; k < 2 * p; k++) U[k] = flat_knot(f, dir, span - p + 1 + k);
-    ccn__bspline_basis(p, U, t, N);
+    int32_t span = span_knots(f, dir, t, U);
+    ccn__bspline_basis(f->degree[dir], U, t, N);
     return span;
 }
 
@@ -114,14 +131,15 @@ void ccn__cad_eval(const ccn__cad_surface *f, double u, double v, double out[3])
 
 /* basis() with first derivatives dN (Piegl & Tiller A2.3, first order). */
 static int32_t basis_d(const ccn__cad_surface *f, int dir, double t, double *N, double *dN) {
-    int32_t p = f->degree[dir], n = f->num_poles[dir], span = p;
-    while (span + 1 < n && flat_knot(f, dir, span + 1) <= t) span++;
+    int32_t p = f->degree[dir];
+    double U[2 * CCN_CAD_MAX_DEGREE];
+    int32_t span = span_knots(f, dir, t, U);
     double left[CCN_CAD_MAX_DEGREE + 1], right[CCN_CAD_MAX_DEGREE + 1];
     double ndu[CCN_CAD_MAX_DEGREE + 1][CCN_CAD_MAX_DEGREE + 1]; /* ndu[j][r]: basis, ndu[r][j]: knot differences */
     ndu[0][0] = 1;
     for (int32_t j = 1; j <= p; j++) {
-        left[j] = t - flat_knot(f, dir, span + 1 - j);
-        right[j] = flat_knot(f, dir, span + j) - t;
+        left[j] = t - U[p - j];      /* t_{span+1-j} */
+        right[j] = U[p - 1 + j] - t; /* t_{span+j} */
         double saved = 0;
         for (int32_t r = 0; r < j; r++) {
             ndu[j][r] = right[r + 1] + left[j - r];
