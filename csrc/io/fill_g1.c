@@ -456,19 +456,22 @@ static int band_setup(band *b, int32_t (*idx)[NQ][NQ], int32_t nfan, int32_t n, 
     int32_t *key = malloc(sizeof(int32_t) * (size_t)n), *cnt = calloc(2 * (size_t)nfan + 3, sizeof(int32_t));
     b->perm = malloc(sizeof(int32_t) * (size_t)n);
     if (!key || !cnt || !b->perm) { free(key); free(cnt); return -1; }
+    const int32_t border = 2 * nfan + 1; /* keys: spoke k 2k, sector k 2k + 1, then the border */
     for (int32_t v = 0; v < n; v++) key[v] = -1;
     for (int32_t k = 0; k < nfan; k++)
         for (int i = 0; i < NQ; i++)
             for (int j = 0; j < NQ; j++) {
-                int32_t v = idx[k][i][j], sk = j == 0 ? k : i == 0 ? (k + 1) % nfan : -1;
+                int32_t v = idx[k][i][j], sk = j == 0 ? k : i == 0 ? (k + 1) % nfan : -1; /* spoke or -1 */
                 if (v < 0) continue;
-                key[v] = sk >= 2 ? 2 * sk : sk >= 0 || k == 0 ? 2 * nfan + 1 : 2 * k + 1;
+                key[v] = sk >= 2 ? 2 * sk : sk >= 0 || k == 0 ? border : 2 * k + 1;
             }
-    for (int32_t v = n - 1; v >= 0; v--) /* a sector's poles left fixed along a sharp spoke: with it */
-        if (key[v] < 0) key[v] = v + 1 < n && key[v + 1] >= 0 ? key[v + 1] : 2 * nfan + 1;
+    /* numbers no pole takes (a sector's cross-derivative row along a sharp spoke stays fixed,
+     * number_unknowns skips it): next to the following number */
+    for (int32_t v = n - 1; v >= 0; v--)
+        if (key[v] < 0) key[v] = v + 1 < n && key[v + 1] >= 0 ? key[v + 1] : border;
     for (int32_t v = 0; v < n; v++) cnt[key[v] + 1]++;
-    for (int32_t q = 1; q < 2 * nfan + 3; q++) cnt[q] += cnt[q - 1];
-    b->n = n, b->nb = cnt[2 * nfan + 1], b->nd = n - b->nb;
+    for (int32_t q = 1; q < border + 2; q++) cnt[q] += cnt[q - 1];
+    b->n = n, b->nb = cnt[border], b->nd = n - b->nb;
     for (int32_t v = 0; v < n; v++) b->perm[v] = cnt[key[v]]++;
     int32_t kd = 0;
     for (int32_t k = 0; k < nfan; k++) {

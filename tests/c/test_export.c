@@ -1038,6 +1038,19 @@ static void test_fills_g1(void) {
     double ang = fill_spoke_angle(val2, &pairs);
     CHECK(pairs == 2 && ang <= 1e-8, "valence 2: %d fill spokes, normals across them up to %g rad", pairs, ang);
     printf("# interior valence 2: %d fill spokes, normals across them <= %.2e rad\n", pairs, ang);
+    /* a boundary vertex of 40 faces (beyond the dense solve's 32 spokes: the banded one, with
+     * its two sharp spokes), lifted and the rim waved */
+    char bfan[8192];
+    size_t at = (size_t)snprintf(bfan, sizeof bfan, "v 0 0 0.3\n");
+    for (int k = 0; k <= 80; k++) { /* even k: spoke ends, odd k: the quads' far corners */
+        double a = 3.14159265358979 * k / 80, r = k % 2 ? 1.3 : 1.0;
+        at += (size_t)snprintf(bfan + at, sizeof bfan - at, "v %.6f %.6f %.6f\n", r * cos(a), r * sin(a), 0.1 * sin(3 * a));
+    }
+    for (int k = 0; k < 40; k++)
+        at += (size_t)snprintf(bfan + at, sizeof bfan - at, "f 1 %d %d %d\n", 2 + 2 * k, 3 + 2 * k, 4 + 2 * k);
+    ang = fill_spoke_angle(bfan, &pairs);
+    CHECK(pairs >= 39 && ang <= 1e-8, "boundary valence 41: %d fill spokes, normals across them up to %g rad", pairs, ang);
+    printf("# boundary vertex of 40 faces: %d fill spokes, normals across them <= %.2e rad\n", pairs, ang);
 }
 
 int main(void) {
