@@ -310,6 +310,11 @@ static int g1_rows(double (*x)[NQ][NQ][3], int32_t (*idx)[NQ][NQ], int32_t nfan,
     return 1;
 }
 
+/* The thin-plate functional's entry for poles (i, j) and (i2, j2) of one sector (A: gram). */
+static double plate(double A[3][NQ][NQ], int i, int j, int i2, int j2) {
+    return A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
+}
+
 /* The system of the banded solve (many spokes): the unknowns permuted (perm) along the fan, so
  * that all but the border -- the poles that close the cycle -- lie in a band of half-width kd (lower band storage, column-major, for dpbtrf); E (nb x nd, column-major) the
  * band's coupling to the border, D (nd x nd) the border's own block. */
@@ -345,7 +350,7 @@ static void thin_plate(double A[3][NQ][NQ], double (*x)[NQ][NQ][3], int32_t (*id
                 if (v < 0) continue; /* also every pole of a sector without unknowns */
                 for (int i2 = 0; i2 < NQ; i2++)
                     for (int j2 = 0; j2 < NQ; j2++) {
-                        double e = A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
+                        double e = plate(A, i, j, i2, j2);
                         int32_t v2 = idx[k][i2][j2];
                         if (v2 >= 0) {
                             if (W) W[(size_t)v * n + v2] += e;
@@ -661,7 +666,7 @@ int ccn__fill_g1(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, const u
             for (int j = 0; j < NQ; j++)
                 for (int i2 = 0; i2 < NQ; i2++)
                     for (int j2 = 0; j2 < NQ; j2++) {
-                        double e = A[2][i][i2] * A[0][j][j2] + 2 * A[1][i][i2] * A[1][j][j2] + A[0][i][i2] * A[2][j][j2];
+                        double e = plate(A, i, j, i2, j2);
                         for (int d = 0; d < 3; d++) en += e * x[k][i][j][d] * x[k][i2][j2][d];
                     }
     *energy = en;

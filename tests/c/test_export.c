@@ -128,11 +128,12 @@ static int sink_fn(void *user, const char *data, size_t len) {
     return 0;
 }
 
+/* name: a cage of tests/data, or an OBJ text when it starts with "v ". */
 static ccn_plan *load(const char *name, ccn_obj **obj, ccn_cage *cage, const ccn_options *o) {
     char path[256];
     snprintf(path, sizeof path, "tests/data/%s.obj", name);
-    size_t len;
-    char *text = tl_slurp(path, &len);
+    size_t len = strlen(name);
+    char *text = strncmp(name, "v ", 2) ? tl_slurp(path, &len) : strdup(name);
     if (!text) return NULL;
     ccn_error err;
     ccn_plan *p = NULL;
@@ -938,37 +939,13 @@ static void test_bad_input(void) {
  * mixed_boundary here, 1.8e-9 with another LAPACK). Two fill faces share a spoke when
  * 7 points along a side of each coincide (either direction); the angle between their normals is
  * taken as it is (a fold would show as pi). */
-/* The export of an OBJ text (plan levels 3, defaults). */
-static ccn_status export_text(const char *text, faces *F, ccn_export_info *info) {
-    ccn_obj *obj;
-    ccn_cage cage;
-    ccn_options o = {0};
-    ccn_error err;
-    ccn_plan *p = NULL;
-    o.levels = 3;
-    memset(F, 0, sizeof *F);
-    if (ccn_obj_parse(text, strlen(text), &obj, &err)) return CCN_ERR_ARGUMENT;
-    ccn_status st = ccn_obj_get_cage(obj, &cage);
-    if (!st) st = ccn_plan_create(&cage, &o, &p, &err);
-    if (!st) {
-        ccn_export_options eo;
-        memset(&eo, 0, sizeof eo);
-        sink s = {NULL, 0, 0, -1};
-        st = run(p, &eo, F, &s, info, &err);
-        free(s.d);
-        ccn_plan_destroy(p);
-    }
-    ccn_obj_destroy(obj);
-    return st;
-}
-
 /* The largest normal angle across the fill faces' shared sides (7 points each); *pairs counts
  * the sides. name: a cage of tests/data, or an OBJ text when it starts with "v ". */
 static double fill_spoke_angle(const char *name, int *pairs) {
     faces F;
     ccn_export_info info;
     *pairs = 0;
-    if ((strncmp(name, "v ", 2) ? export_of(name, &F, &info) : export_text(name, &F, &info)) != CCN_OK) return INFINITY;
+    if (export_of(name, &F, &info) != CCN_OK) return INFINITY;
     double worst = 0, (*mid)[4][3] = malloc(sizeof *mid * (size_t)(F.n ? F.n : 1));
     for (int a = 0; a < F.n; a++) /* each side's midpoint: only sides meeting there are compared */
         for (int sa = 0; sa < 4 && F.f[a].kind == CCN_EXPORT_FACE_FILL; sa++) {
