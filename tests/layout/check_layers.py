@@ -31,7 +31,7 @@ if len(sys.argv) == 3 and sys.argv[1] == "--root":  # another tree (the self-tes
     ROOT = os.path.abspath(sys.argv[2])
 CSRC = os.path.join(ROOT, "csrc")
 ADDON = os.path.join(ROOT, "addon")
-LAYERS = ["base", "topology", "rules", "refine", "bi5", "surface", "io", "tools"]
+LAYERS = ["base", "topology", "rules", "refine", "bi5", "fill", "surface", "io", "tools"]
 PUBLIC = "include/ccnurbs"
 MAX_LINES = 800
 CC = os.environ.get("CC", "cc")
