@@ -23,7 +23,7 @@ c_double_p = ctypes.POINTER(ctypes.c_double)
 
 # ccn_scheme, ccn_cap, ccn_corners (C enums: int)
 SCHEMES = {"EIGEN": 0, "NURSS": 1, "CATMULL_CLARK": 2}
-CAPS = {"GUIDED_BI5": 0, "REFINE": 1}
+CAPS = {"GUIDED_BI5": 0, "REFINE": 1, "G1_FILL": 2}
 CORNERS = {"ALL": 0, "PRESERVE_CORNERS": 1}
 CREASE_METHODS = {"UNIFORM": 0, "CHAIKIN": 1}
 # ccn_fvar_linear from Blender's UV Smooth (Subdivision Surface's names): OpenSubdiv's modes
@@ -427,11 +427,11 @@ class Plan:
             self._last = {k: out[k] for k in ("positions", "normals", "corner_normals") if k in out}
         return out
 
-    EV_SURFACES = ("capped", "blended", "refined")  # ccn_ev_surface
+    EV_SURFACES = ("capped", "blended", "refined", "filled")  # ccn_ev_surface
 
     def evs(self):
         """The output's extraordinary points: (output vertex indices (K,) int32, how each is
-        made (K,) int32: 0 capped, 1 cap blended with the refined limit, 2 refined limit)."""
+        made (K,) int32: 0 capped, 1 cap blended, 2 refined limit, 3 G1 fill cap)."""
         if self._handle is None:
             raise CCNError("CCN_ERR_ARGUMENT", "plan was destroyed")
         n = ctypes.c_int32(0)

@@ -17,6 +17,9 @@ CAP_ITEMS = (
     ('GUIDED_BI5', "Guided Bi-5", "Fill extraordinary points with guided bi-5 rings and a G1 "
      "cap (Karciauskas & Peters 2018): a finite, smooth surface"),
     ('REFINE', "Refine", "Evaluate the limit of refinement at extraordinary points"),
+    ('G1_FILL', "G1 Fill", "Guided bi-5 caps where the knot intervals allow them, elsewhere a "
+     "G1 fill: a finite surface, exactly G1 at every extraordinary point of valence 5 or more, "
+     "as the CAD export writes it; less fair than the other modes at uneven intervals"),
 )
 BOUNDARY_ITEMS = (
     ('ALL', "All", "Smooth the boundary and its corners (like Subdivision Surface 'All')"),

@@ -260,18 +260,19 @@ def sync_object(obj, kind, cage, force=False, defer_normals=False, defer_analysi
     return st
 
 
-EV_COLORS = np.array([(0.1, 0.85, 0.2, 1.0), (1.0, 0.85, 0.1, 1.0), (1.0, 0.1, 0.1, 1.0)],
-                     np.float32)  # capped, cap blended, refined (native.Plan.EV_SURFACES)
+EV_COLORS = np.array([(0.1, 0.85, 0.2, 1.0), (1.0, 0.85, 0.1, 1.0), (1.0, 0.1, 0.1, 1.0),
+                      (0.1, 0.7, 1.0, 1.0)],
+                     np.float32)  # capped, cap blended, refined, G1 fill (native.Plan.EV_SURFACES)
 
 
 def ev_marks(plan, me):
     """Analysis > Cap Status: positions (the proxy's, local) and colours of the extraordinary
-    points, and how many are capped, blended, refined."""
+    points, and how many are capped, blended, refined, filled."""
     idx, kind = plan.evs()
     co = np.empty(3 * len(me.vertices), np.float32)
     me.vertices.foreach_get("co", co)
     return {"coords": co.reshape(-1, 3)[idx], "colors": EV_COLORS[kind],
-            "counts": tuple(int((kind == k).sum()) for k in range(3)), "batch": None}
+            "counts": tuple(int((kind == k).sum()) for k in range(len(EV_COLORS))), "batch": None}
 
 
 def missing_tap(obj, kind):

@@ -246,9 +246,10 @@ def cap_status_line(obj):
     st = state.peek(obj)
     if not obj.ccnurbs.cap_status or st is None or st.ev_marks is None:
         return None
-    c, b, r = st.ev_marks["counts"]
-    return "Extraordinary points: %d capped (green), %d blended (yellow), %d refined (red: " \
+    c, b, r, f = st.ev_marks["counts"]
+    line = "Extraordinary points: %d capped (green), %d blended (yellow), %d refined (red: " \
            "unbounded curvature)" % (c, b, r)
+    return line + (", %d G1 fill (blue)" % f if f else "")
 
 
 def edge_menu(self, context):

@@ -131,6 +131,11 @@ done:
     return rc;
 }
 
+int ccn__fill_g1_vertex_weights(const double a[3], const double b[3], const double t[3], double *beta,
+                                double *gamma) {
+    return ccn__g1_weights_of(a, b, t, beta, gamma);
+}
+
 /* ---- the operator ------------------------------------------------------------------- */
 
 struct ccn__g1_operator {

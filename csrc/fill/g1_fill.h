@@ -31,6 +31,12 @@ int ccn__fill_g1_solve(const double (*cs)[5][5][3], int32_t nfan, int32_t nsp, c
                        const uint8_t *filled, const ccn__g1_weights *wt, double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3],
                        uint8_t *smooth, double *energy);
 
+/* The weights at the vertex where the spoke vectors are known in a plane (a characteristic
+ * map's): a + beta b = gamma t with a, b the neighbouring spokes' vectors, t spoke k's; 0 when
+ * b and t are parallel or a and b lie on one side of t (a folded map). */
+int ccn__fill_g1_vertex_weights(const double a[3], const double b[3], const double t[3], double *beta,
+                                double *gamma);
+
 /* The same fill as a linear map, for an interior vertex of n smooth spokes with every sector
  * filled and fixed weights wt (n entries): q = raise(cs) + L cs on the free poles, the same
  * result as ccn__fill_g1_solve(cs, n, n, no sharp spoke, all filled, wt) to rounding. Made

@@ -28,7 +28,13 @@ typedef enum {
 } ccn_status;
 
 typedef enum { CCN_SCHEME_EIGEN = 0, CCN_SCHEME_NURSS, CCN_SCHEME_CATMULL_CLARK } ccn_scheme;
-typedef enum { CCN_CAP_GUIDED_BI5 = 0, CCN_CAP_REFINE } ccn_cap;
+/* How extraordinary points are closed: GUIDED_BI5, the guided bi-5 cap where the spoke knot
+ * ratios allow it (within 1.05 of each other), the refined limit elsewhere; REFINE, the refined
+ * limit everywhere; G1_FILL, the guided bi-5 cap where it is whole and the G1 fill cap beyond it
+ * (valence >= 5: a finite surface exactly G1 at every EV whatever the intervals, which the CAD
+ * export writes as it is; measured less fair than the refined limit at spoke ratios of 2 and
+ * more, docs/caps.md). */
+typedef enum { CCN_CAP_GUIDED_BI5 = 0, CCN_CAP_REFINE, CCN_CAP_G1_FILL } ccn_cap;
 /* Valence-2 boundary corners: smooth (OpenSubdiv EDGE_ONLY, Blender "All") or pinned
  * (OpenSubdiv EDGE_AND_CORNER, Blender "Keep Corners"). */
 typedef enum { CCN_CORNERS_SMOOTH = 0, CCN_CORNERS_PINNED } ccn_corners;
@@ -260,8 +266,8 @@ typedef struct {
     int32_t levels;           /* effective output level (>= 1 when the cage has non-quads) */
     int32_t refine_levels;    /* internal refinement depth */
     int32_t num_extraordinary;/* interior EVs of the cage after the first split */
-    int32_t num_caps;         /* EVs filled by the guided bi-5 cap */
-    int32_t num_cap_fallbacks;/* EVs that use the refined limit instead of the cap */
+    int32_t num_caps;         /* EVs closed by a finite cap (guided bi-5, G1 fill or their blend) */
+    int32_t num_cap_fallbacks;/* EVs that use the refined limit instead of a cap */
     int32_t num_caps_deferred;/* cap EVs (bi-5) with no cap built because the output level is not
                                  above the cap level (they would change no output sample); the
                                  finite patch set (ccn_plan_patches, ccn_plan_export) needs them:
@@ -335,13 +341,15 @@ ccn_status ccn_plan_get_stats(const ccn_plan *plan, ccn_plan_stats *stats);
 
 /* The extraordinary points of the output surface (interior smooth vertices of valence != 4 of
  * the output level) and how each is made: CCN_EV_CAPPED, the guided bi-5 cap (G1, bounded
- * curvature); CCN_EV_CAP_BLENDED, a cap blended with the refined limit at the end of the cap's
- * range of knot ratios; CCN_EV_REFINED, the refined limit (no cap: knot intervals beyond the cap's
- * range, cap = REFINE, a cap that would fold, or an output level not above the cap level): its
+ * curvature); CCN_EV_FILLED, the G1 fill cap (G1, bounded curvature: spoke knot ratios beyond
+ * the bi-5 cap's range, valence 5 and more); CCN_EV_CAP_BLENDED, the bi-5 cap blended with the
+ * fill cap (or, at valence 3, with the refined limit) at the end of the bi-5 cap's range of knot
+ * ratios; CCN_EV_REFINED, the refined limit (no cap: valence 3 beyond the bi-5 cap's range,
+ * cap = REFINE, a cap that would fold, or an output level not above the cap level): its
  * curvature is unbounded there. Call with NULL arrays for *num, then with arrays of *num
  * entries: output vertex indices and ccn_ev_surface values (either may be NULL). CCN_OK, or
  * CCN_ERR_ARGUMENT (no plan or num), CCN_ERR_MEMORY. */
-typedef enum { CCN_EV_CAPPED = 0, CCN_EV_CAP_BLENDED, CCN_EV_REFINED } ccn_ev_surface;
+typedef enum { CCN_EV_CAPPED = 0, CCN_EV_CAP_BLENDED, CCN_EV_REFINED, CCN_EV_FILLED } ccn_ev_surface;
 ccn_status ccn_plan_get_evs(const ccn_plan *plan, int32_t *num, int32_t *out_vertex,
                             int32_t *surface);
 /* positions: 3 * num_cage_verts, or NULL for the cage's own positions. Topology outputs

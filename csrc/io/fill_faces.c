@@ -37,6 +37,7 @@
 #include "base/error.h"
 #include "refine/level.h"
 #include "rules/bspline.h"
+#include "surface/fill_border.h"
 #include "surface/limit.h"
 #include "surface/patches.h"
 
@@ -98,84 +99,11 @@ static void to_caller(const ccn__plan_view *v, double *p, int32_t n) {
         for (int k = 0; k < 3; k++) p[3 * i + k] = v->centre[k] + v->scale * p[3 * i + k];
 }
 
-/* The Bezier grid b (4x4x3, b[i][j] i along the face's first half-edge) re-framed to start at
- * corner r (r quarter turns: (u,v) -> (1 - v', u') each). */
-static void rotate(double b[4][4][3], int32_t r) {
-    double t[4][4][3];
-    for (; r > 0; r--) {
-        for (int i = 0; i < 4; i++)
-            for (int j = 0; j < 4; j++) memcpy(t[i][j], b[3 - j][i], sizeof t[i][j]);
-        memcpy(b, t, sizeof t);
-    }
-}
-
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static int32_t fan_end(const ccn_mesh *m, int32_t w, int32_t k) {
     int32_t e = ccn__fan_edge(m, w, k);
     return m->everts[2 * e] == w ? m->everts[2 * e + 1] : m->everts[2 * e];
-}
-
-/* Aligned cells (packs.c's convention): a base half-edge b of face hface[b] runs along +u. */
-static int32_t step_u(const ccn_mesh *m, int32_t b) {
-    if (b < 0) return -1;
-    int32_t x = ccn__next(m, b), t = m->htwin[x];
-    return t < 0 || ccn__edge_sharp(m, m->hedge[x]) ? -1 : ccn__next(m, t); /* not across a crease */
-}
-static int32_t step_v(const ccn_mesh *m, int32_t b) {
-    if (b < 0) return -1;
-    int32_t x = ccn__next(m, ccn__next(m, b));
-    return ccn__edge_sharp(m, m->hedge[x]) ? -1 : m->htwin[x];
-}
-
-/* The bicubic patch of the aligned cell b (strict or not) in the cell's frame; 0 if none. */
-static int cell_patch(const ccn_mesh *m, int32_t b, int pinned, double out[4][4][3]) {
-    if (b < 0) return 0;
-    int32_t f = m->hface[b];
-    if (!ccn__bicubic_patch(m, f, pinned, 0, out)) return 0;
-    rotate(out, b - m->fstart[f]);
-    return 1;
-}
-
-/* Poles Q0..Q4 of the 2-span uniform clamped cubic (knots 0000 1 2222) equal to the C2 pair of
- * Bezier pieces a0..a3, a3..a6 (a[k] at stride 3 doubles). */
-static void two_span(const double a[7][3], double Q[5][3]) {
-    for (int d = 0; d < 3; d++) {
-        Q[0][d] = a[0][d];
-        Q[1][d] = a[1][d];
-        Q[2][d] = 0.5 * ((2 * a[2][d] - a[1][d]) + (2 * a[4][d] - a[5][d]));
-        Q[3][d] = a[5][d];
-        Q[4][d] = a[6][d];
-    }
-}
-
-/* One sector's block around w: the aligned cells of the 2x2 faces [0,2]^2 and of the strict
- * faces along its far sides: N1, N2 across u = 2 (v in [0,1], [1,2]), M1, M2 across v = 2. */
-typedef struct { int32_t g, A, B, D, N1, N2, M1, M2; } block;
-
-static void sector_block(const ccn_mesh *m, int32_t h, block *k) {
-    k->g = h;
-    k->A = step_u(m, h);
-    k->B = step_v(m, h);
-    k->D = step_v(m, k->A);
-    k->N1 = step_u(m, k->A);
-    k->N2 = step_u(m, k->D);
-    k->M1 = step_v(m, k->B);
-    k->M2 = step_v(m, k->D);
-}
-
-/* The 2-span poles of the side (layer 0) or of its C1 continuation (layer 1) of the cells
- * P (first span) and Q (second span) across their u = 0 side (v = 0 side if along_u). */
-static void side_poles(const double P[4][4][3], const double Q[4][4][3], int along_u, int layer,
-                       double out[5][3]) {
-    double a[7][3];
-    for (int k = 0; k < 7; k++) {
-        const double (*c)[4][3] = k < 3 ? P : Q;
-        int q = k < 3 ? k : k - 3;
-        const double *s = along_u ? c[q][0] : c[0][q], *t = along_u ? c[q][1] : c[1][q];
-        for (int d = 0; d < 3; d++) a[k][d] = layer ? 2 * s[d] - t[d] : s[d];
-    }
-    two_span((const double(*)[3])a, out);
 }
 
 static void unit3(double *a) {
@@ -326,7 +254,7 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
     ccn_status st = CCN_OK;
     double (*sp)[5][3] = malloc(sizeof *sp * (size_t)(nsp + 1)); /* spoke curves from w */
     double (*nb)[6][4][4][3] = malloc(sizeof *nb * (size_t)(nfan ? nfan : 1)); /* N1 N2 M1 M2 A B */
-    block *bk = malloc(sizeof *bk * (size_t)(nfan ? nfan : 1));
+    ccn__fill_block *bk = malloc(sizeof *bk * (size_t)(nfan ? nfan : 1));
     double (*N)[3] = malloc(sizeof *N * (size_t)(nfan ? nfan : 1)); /* per fan face: its sector's */
     double (*Ns)[3] = malloc(sizeof *Ns * (size_t)(nsp + 1));      /* per spoke */
     uint8_t *sharp = malloc((size_t)nsp + 1);                         /* C0 spokes */
@@ -347,10 +275,10 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
     for (int32_t k = 0; k < nfan; k++) filled[k] = !ccn__sector_regular(m, w, k, v->pinned);
     for (int32_t k = 0; k < nfan; k++) {
         if (!filled[k]) continue;
-        sector_block(m, m->vfan[m->vfan_start[w] + k], &bk[k]);
+        ccn__fill_sector_block(m, m->vfan[m->vfan_start[w] + k], &bk[k]);
         const int32_t cells[6] = {bk[k].N1, bk[k].N2, bk[k].M1, bk[k].M2, bk[k].A, bk[k].B};
         int ok = ccn__fsize(m, m->hface[bk[k].g]) == 4 && bk[k].D >= 0;
-        for (int q = 0; q < 6 && ok; q++) ok = cell_patch(m, cells[q], v->pinned, nb[k][q]);
+        for (int q = 0; q < 6 && ok; q++) ok = ccn__fill_cell_patch(m, cells[q], v->pinned, nb[k][q]);
         if (!ok) {
             st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_VERTEX, w,
                            "the faces around a hole's vertex are not regular enough to fill");
@@ -376,11 +304,11 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
             int own = k < nfan && filled[k]; /* else from sector k-1's v-side */
             if (!own && (km < 0 || !filled[km])) continue; /* no fill on either side */
             if (own) { /* from sector k's cells N1 (and N2) across u = 2 */
-                side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 0, S);
-                side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 1, L);
+                ccn__fill_side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 0, S);
+                ccn__fill_side_poles((const double(*)[4][3])nb[k][0], (const double(*)[4][3])nb[k][1], 0, 1, L);
             } else { /* sector k-1's cells M1, M2 across v = 2 */
-                side_poles((const double(*)[4][3])nb[km][2], (const double(*)[4][3])nb[km][3], 1, 0, S);
-                side_poles((const double(*)[4][3])nb[km][2], (const double(*)[4][3])nb[km][3], 1, 1, L);
+                ccn__fill_side_poles((const double(*)[4][3])nb[km][2], (const double(*)[4][3])nb[km][3], 1, 0, S);
+                ccn__fill_side_poles((const double(*)[4][3])nb[km][2], (const double(*)[4][3])nb[km][3], 1, 1, L);
             }
             memcpy(c[4], S[0], sizeof c[4]);
             memcpy(c[3], L[0], sizeof c[3]);
@@ -425,35 +353,10 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
                 for (int d = 0; d < 3; d++) sp[0][1][d] = P[d] + l0 * e[d] / le, sp[1][1][d] = P[d] - l1 * e[d] / le;
         }
         for (int32_t k = 0; k < nfan; k++) {
-            double (*c)[5][3] = cs[k], S[5][3], L[5][3];
+            double (*c)[5][3] = cs[k];
             memset(c, 0, sizeof cs[k]);
             if (!filled[k]) continue;
-            int cnt[5][5];
-            memset(cnt, 0, sizeof cnt);
-            for (int pass = 0; pass < 2; pass++) { /* u-side from N1, N2; v-side from M1, M2 */
-                const double (*a)[4][3] = (const double(*)[4][3])nb[k][pass ? 2 : 0];
-                const double (*b)[4][3] = (const double(*)[4][3])nb[k][pass ? 3 : 1];
-                side_poles(a, b, pass, 0, S);
-                side_poles(a, b, pass, 1, L);
-                for (int q = 0; q < 5; q++)
-                    for (int lay = 0; lay < 2; lay++) {
-                        int i = pass ? q : 4 - lay, j = pass ? 4 - lay : q;
-                        for (int d = 0; d < 3; d++) c[i][j][d] += lay ? L[q][d] : S[q][d];
-                        cnt[i][j]++;
-                    }
-            }
-            for (int i = 0; i < 5; i++) /* the far corner comes from both sides: their mean */
-                for (int j = 0; j < 5; j++)
-                    for (int d = 0; d < 3 && cnt[i][j] > 1; d++) c[i][j][d] /= cnt[i][j];
-            for (int j = 1; j < 3; j++) /* inner layers: linear continuations of the outer two */
-                for (int d = 0; d < 3; d++) {
-                    c[2][j][d] = 2 * c[3][j][d] - c[4][j][d];
-                    c[j][2][d] = 2 * c[j][3][d] - c[j][4][d];
-                }
-            for (int d = 0; d < 3; d++) {
-                c[2][2][d] = 0.5 * ((2 * c[3][2][d] - c[4][2][d]) + (2 * c[2][3][d] - c[2][4][d]));
-                c[1][1][d] = 0.5 * ((2 * c[2][1][d] - c[3][1][d]) + (2 * c[1][2][d] - c[1][3][d]));
-            }
+            ccn__fill_sector_border((const double(*)[4][4][3])nb[k], c);
             for (int q = 0; q < 5; q++) { /* spokes exactly (shared with the next sector) */
                 memcpy(c[q][0], sp[k][q], sizeof c[q][0]);
                 memcpy(c[0][q], sp[(k + 1) % nsp][q], sizeof c[0][q]);

@@ -3,6 +3,7 @@
  * the exact level-(K+1) surround for arbitrary non-uniform intervals (surface/surround.c), the
  * fallbacks, and their evaluation (caps and the bicubic ring faces around them). */
 #include "surface/caps.h"
+#include "surface/fill_cap.h"
 
 #include "base/error.h"
 #include "base/parallel.h"
@@ -31,6 +32,13 @@
  * largest |log kappa_s| goes from log(CCN_CAP_KAPPA_FULL) to log(CCN_CAP_KAPPA_RANGE), so the
  * surface does not jump where an EV's spokes leave the range. */
 #define CCN_CAP_KAPPA_FULL 1.04
+/* With options.cap = G1_FILL the bi-5 cap is blended with the G1 fill cap instead, over a wider
+ * band (the two differ more than the bi-5 cap and the refined limit do: over 1.04 .. 1.05 a
+ * sweep of one interval moved the surface 20x faster in the band than outside it, over
+ * 1.01 .. 1.05 within 10x, tests/c/test_fill_cap.c). */
+#ifndef CCN_FILL_CAP_KAPPA_FULL
+#define CCN_FILL_CAP_KAPPA_FULL 1.01
+#endif
 /* Equal spoke intervals take the uniform operator on the level-K net; a research build may take
  * the exact surround there too (tests/experiments/RESULTS.md: the same fairness). */
 #ifndef CCN_CAP_EXACT_SURROUND_ALWAYS
@@ -49,6 +57,7 @@ static int cap_ev(const ccn_mesh *m, int32_t v) {
 }
 
 void ccn__cap_free(ccn__cap *c) {
+    ccn__fill_cap_destroy(c->fill);
     free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
     free(c->taus);
     memset(c, 0, sizeof *c);
@@ -169,6 +178,7 @@ typedef struct {
     int32_t ev;
     int ok, uni;       /* ok: so far; uni: equal spoke intervals */
     int need_taus;     /* non-uniform spokes whose taus are still to be solved (pass 2) */
+    int need_fill;     /* a G1 fill cap whose operator is still to be solved (pass 2) */
 } cap_todo;
 
 /* Pass 1 (serial): the cap of EV ev at level K in slot c: its net, ring, spoke intervals,
@@ -209,10 +219,18 @@ static void cap_begin(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn__ca
             lk = fmax(lk, fabs(log(kap)));
             if (kap > krange * (1 + 1e-12) || kap * krange < 1 - 1e-12) ok = 0; /* measured range */
         }
-        double x = (log(krange) - lk) / (log(krange) - log(CCN_CAP_KAPPA_FULL));
-        c->w = x >= 1 ? 1.0 : x * x * (3 - 2 * x);
+        double kfull = p->opts.cap == CCN_CAP_G1_FILL ? CCN_FILL_CAP_KAPPA_FULL : CCN_CAP_KAPPA_FULL;
+        double x = (log(krange) - lk) / (log(krange) - log(kfull));
+        c->w = x >= 1 ? 1.0 : x <= 0 ? 0.0 : x * x * (3 - 2 * x);
         if (!(c->w > 0)) ok = 0; /* at the range's end the refined limit alone */
         t->uni = uni;
+        /* beyond the bi-5 cap's whole range: the G1 fill cap (its operator in pass 2), blended
+         * with the bi-5 cap while that has weight */
+        if (p->opts.cap == CCN_CAP_G1_FILL && c->w < 1 && n >= CCN_FILL_CAP_MIN_VALENCE &&
+            (p->R >= p->K + 1 || ccn__plan_build_levels(p, p->K + 1, &e2) == CCN_OK)) {
+            int r = ccn__fill_cap_create(p, ev, n, c->knots, &c->fill);
+            t->need_fill = r > 0;
+        }
         if (ok && nu) {
             c->taus = malloc(sizeof(double complex) * 36 * (size_t)n);
             const ccn__cap *h = c->taus ? same_spokes_cap(p, hint_caps, ev, c) : NULL;
@@ -236,7 +254,11 @@ static void taus_range(void *ctx, int32_t begin, int32_t end) {
         cap_todo *t = &j->todo[i];
         ccn__cap *c = &j->caps[i];
         ccn_error e2;
-        t->ok = ccn__bi5_nu_taus(c->op, c->knots, 0, c->taus, &e2) == CCN_OK;
+        if (t->ok && t->need_taus) t->ok = ccn__bi5_nu_taus(c->op, c->knots, 0, c->taus, &e2) == CCN_OK;
+        if (t->need_fill && ccn__fill_cap_solve(c->fill) <= 0) {
+            ccn__fill_cap_destroy(c->fill);
+            c->fill = NULL;
+        }
     }
 }
 
@@ -257,6 +279,13 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
         else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
         free(zero);
     }
+    if (!ok && c->fill) { /* the fill alone */
+        free(c->taus); free(c->pieces); free(c->patches);
+        c->taus = NULL, c->pieces = NULL, c->patches = NULL;
+        c->w = 0;
+        c->exact_surround = 1; /* its surround is the limit itself */
+        return 1;
+    }
     if (!ok) ccn__cap_free(c);
     return ok;
 }
@@ -267,7 +296,7 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
  * 4e-16 in position and 4e-12 rad in normal on the shipped cages). */
 ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     p->K = -1;
-    if (p->opts.cap != CCN_CAP_GUIDED_BI5) return CCN_OK;
+    if (p->opts.cap != CCN_CAP_GUIDED_BI5 && p->opts.cap != CCN_CAP_G1_FILL) return CCN_OK;
     ccn_status st0 = ccn__plan_build_levels(p, 1, err);
     if (st0) return st0;
     if (count_evs(p->lev[1]) == 0) return CCN_OK;
@@ -314,9 +343,12 @@ ccn_status ccn__caps_setup(ccn_plan *p, ccn_error *err) {
     int32_t nsolve = 0; /* pass 2: the tau solves (each a few ms), spread over the threads */
     int32_t *solve = malloc(sizeof(int32_t) * (size_t)(ncand ? ncand : 1));
     for (int32_t i = 0; solve && i < ncand; i++)
-        if (todo[i].ok && todo[i].need_taus) solve[nsolve++] = i;
+        if ((todo[i].ok && todo[i].need_taus) || todo[i].need_fill) solve[nsolve++] = i;
     if (!solve) /* out of memory: those caps fall back */
-        for (int32_t i = 0; i < ncand; i++) todo[i].ok &= !todo[i].need_taus;
+        for (int32_t i = 0; i < ncand; i++) {
+            todo[i].ok &= !todo[i].need_taus;
+            if (todo[i].need_fill) ccn__fill_cap_destroy(p->caps[i].fill), p->caps[i].fill = NULL;
+        }
     taus_job tj = {p->caps, todo, solve};
     ccn__parallel_for(p->threads, nsolve, taus_range, &tj);
     free(solve);
@@ -469,6 +501,9 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
     const double *P = p->lev[p->K]->pos;
     for (int32_t c = 0; c < p->ncap; c++) {
         ccn__cap *cp = &p->caps[c];
+        if (cp->fill && !ccn__fill_cap_update(p, cp->fill))
+            return ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_VERTEX, cp->cnet[0], "fill cap border lost");
+        if (!(cp->w > 0)) continue; /* the fill alone */
         int32_t n = cp->n, nc = 6 * n + 1;
         double *net = p->cap_net, ctr[3] = {0, 0, 0}, org[3], nrm[3]; /* ctr: at the origin */
         for (int32_t j = 0; j < nc; j++) memcpy(net + 3 * j, P + 3 * (size_t)cp->cnet[j], sizeof(double) * 3);
@@ -492,21 +527,27 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
     }
     for (int32_t i = 0; i < p->nhv; i++) {
         const ccn__cap *cp = &p->caps[p->hv_cap[i]];
-        double x[3], du[3], dv[3], w = cp->w;
-        ccn__bi5_eval(cp->op, cp->patches, p->hv_sector[i], p->hv_uv[2 * i], p->hv_uv[2 * i + 1], x, du, dv);
-        int32_t o = p->hv_out[i];
+        double x[3], du[3], dv[3], w = cp->w, u = p->hv_uv[2 * i], v = p->hv_uv[2 * i + 1];
+        int32_t o = p->hv_out[i], k = p->hv_sector[i];
         if (written) written[o] = 1;
         double *po = out->positions + 3 * (size_t)o, *no = out->normals ? out->normals + 3 * (size_t)o : NULL;
-        if (w < 1) { /* near the end of the cap's range: blended with the refined limit (there) */
+        if (cp->fill) { /* the G1 fill cap: alone, or what the bi-5 cap is blended with */
+            ccn__fill_cap_eval(cp->fill, k, u, v, po, du, dv, NULL);
+            if (no) ccn__unit_normal(du, dv, no);
+            if (!(w > 0)) continue;
+        }
+        ccn__bi5_eval(cp->op, cp->patches, k, u, v, x, du, dv);
+        if (w < 1) { /* near the end of the cap's range: blended with the fill cap, or with the
+                      * refined limit (there) */
             double nc[3], nb[3];
-            for (int k = 0; k < 3; k++) po[k] = w * x[k] + (1 - w) * po[k];
+            for (int q = 0; q < 3; q++) po[q] = w * x[q] + (1 - w) * po[q];
             if (no) {
                 ccn__unit_normal(du, dv, nc);
                 if (nc[0] * no[0] + nc[1] * no[1] + nc[2] * no[2] < 0)
-                    for (int k = 0; k < 3; k++) nc[k] = -nc[k];
-                for (int k = 0; k < 3; k++) nb[k] = w * nc[k] + (1 - w) * no[k];
+                    for (int q = 0; q < 3; q++) nc[q] = -nc[q];
+                for (int q = 0; q < 3; q++) nb[q] = w * nc[q] + (1 - w) * no[q];
                 double l = sqrt(nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2]);
-                for (int k = 0; k < 3; k++) no[k] = nb[k] / l;
+                for (int q = 0; q < 3; q++) no[q] = nb[q] / l;
             }
             continue;
         }
@@ -529,7 +570,7 @@ ccn_status ccn_plan_get_evs(const ccn_plan *p, int32_t *num, int32_t *out_vertex
     for (int32_t c = 0; c < p->ncap; c++) {
         int32_t v = p->caps[c].cnet[0];
         for (int32_t l = p->K; l < p->L; l++) v += p->lev[l]->nf + p->lev[l]->ne;
-        capped[v] = p->caps[c].w >= 1 ? 1 : 2;
+        capped[v] = p->caps[c].w >= 1 ? 1 : p->caps[c].w > 0 ? 2 : 3;
     }
     int32_t n = 0;
     for (int32_t o = 0; o < p->nout_v; o++) {
@@ -538,7 +579,7 @@ ccn_status ccn_plan_get_evs(const ccn_plan *p, int32_t *num, int32_t *out_vertex
         if (out_vertex) out_vertex[n] = o;
         if (surface)
             surface[n] = !capped || !capped[v] ? CCN_EV_REFINED
-                         : capped[v] == 1 ? CCN_EV_CAPPED : CCN_EV_CAP_BLENDED;
+                         : capped[v] == 1 ? CCN_EV_CAPPED : capped[v] == 2 ? CCN_EV_CAP_BLENDED : CCN_EV_FILLED;
         n++;
     }
     free(capped);

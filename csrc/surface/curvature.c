@@ -35,6 +35,7 @@
 #include "base/error.h"
 #include "bi5/bi5.h"
 #include "base/parallel.h"
+#include "surface/fill_cap.h"
 #include "surface/limit.h"
 
 #include <math.h>
@@ -295,7 +296,14 @@ void ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out) {
         if (i < p->nhv) {
             const ccn__cap *cp = &p->caps[p->hv_cap[i]];
             o = p->hv_out[i];
-            if (cp->w < 1) { /* blended with the refined limit: not computed */
+            if (cp->fill && !(cp->w > 0)) { /* the G1 fill cap alone */
+                double x[3]; /* d: S_u, S_v, S_uu, S_uv, S_vv (bezier_d2's) */
+                ccn__fill_cap_eval(cp->fill, p->hv_sector[i], p->hv_uv[2 * i], p->hv_uv[2 * i + 1], x, d[0], d[1],
+                                   (double(*)[3])d[2]);
+                ccn__curvature_at(p, (const double(*)[3])d, out, o);
+                continue;
+            }
+            if (cp->w < 1) { /* blended: not computed */
                 ccn__curvature_flag(out, o);
                 continue;
             }

@@ -5,6 +5,7 @@
 #include "surface/plan_types.h"
 
 #include "bi5/bi5.h"
+#include "surface/fill_cap.h"
 #include "surface/patches.h"
 
 #include <math.h>
@@ -107,10 +108,35 @@ void ccn__cap_patch_rect(const struct ccn__bi5 *op, int32_t n, int32_t i, int32_
             rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
 }
 
+/* The G1 fill cap of cap c: per sector four quintic Bezier patches, each a quarter of the
+ * sector's level-K face. */
+static void export_fill(walk *w, int32_t c) {
+    const ccn_plan *p = w->p;
+    const ccn__cap *cp = &p->caps[c];
+    const ccn_mesh *mK = p->lev[p->K];
+    for (int32_t s = 0; s < cp->n; s++) {
+        int32_t h = mK->vfan[mK->vfan_start[cp->cnet[0]] + s], f = mK->hface[h], j0 = h - mK->fstart[f];
+        double b[4][6][6][3];
+        ccn__fill_cap_bezier(cp->fill, s, b);
+        const double *o = UNIT[j0], *eu = UNIT[(j0 + 1) % 4], *ev = UNIT[(j0 + 3) % 4];
+        for (int q = 0; q < 4; q++) {
+            double a = 0.5 * (q / 2), cc = 0.5 * (q % 2), hole[3][2] = {{a, cc}, {a + 0.5, cc}, {a, cc + 0.5}}, rect[3][2];
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 2; d++)
+                    rect[k][d] = o[d] + hole[k][0] * (eu[d] - o[d]) + hole[k][1] * (ev[d] - o[d]);
+            emit(w, CCN__PATCH_CAP, 5, &b[q][0][0][0], p->K, f, (const double(*)[2])rect, c, s, -1, -1);
+        }
+    }
+}
+
 /* The bi-5 patches of cap c, each placed in its sector's level-K face (ccn__cap_patch_rect). */
 static void export_cap(walk *w, int32_t c) {
     const ccn_plan *p = w->p;
     const ccn__cap *cp = &p->caps[c];
+    if (!(cp->w > 0)) {
+        export_fill(w, c);
+        return;
+    }
     const ccn_mesh *mK = p->lev[p->K];
     int32_t n = cp->n, nsig = cp->op->nsig, np = ccn__bi5_num_patches(cp->op);
     for (int32_t i = 0; i < np; i++) {
@@ -147,7 +173,7 @@ void ccn__plan_view_get(const ccn_plan *p, ccn__plan_view *v) {
     v->crease_method = p->opts.crease_method;
     v->ev_polyhedron = p->opts.ev_polyhedron;
     v->ev_cache = p->ev_cache;
-    v->guided_caps = p->opts.cap == CCN_CAP_GUIDED_BI5;
+    v->guided_caps = p->opts.cap != CCN_CAP_REFINE;
     v->output_level = p->L;
 }
 

@@ -58,7 +58,7 @@ void ccn_plan_destroy(ccn_plan *p) {
 static ccn_status check_options(const ccn_options *o, ccn_error *err) {
     if (o->scheme < CCN_SCHEME_EIGEN || o->scheme > CCN_SCHEME_CATMULL_CLARK)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown scheme %d", (int)o->scheme);
-    if (o->cap < CCN_CAP_GUIDED_BI5 || o->cap > CCN_CAP_REFINE)
+    if (o->cap < CCN_CAP_GUIDED_BI5 || o->cap > CCN_CAP_G1_FILL)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown cap %d", (int)o->cap);
     if (o->boundary_corners < CCN_CORNERS_SMOOTH || o->boundary_corners > CCN_CORNERS_PINNED)
         return ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1, "unknown boundary_corners %d",

@@ -23,8 +23,11 @@ typedef struct {
     double *pieces;     /* exact_surround: n*4 bi-5 pieces, 36*3 doubles each (evaluate fills) */
     void *taus;         /* non-uniform (some kappa != 1): the n cap taus (double complex[36] each,
                            bi5.h [R11]), computed once at create; NULL otherwise */
-    double w;           /* the cap's weight against the refined limit in its hole: 1, falling
-                           smoothly to 0 as the spoke ratios reach the cap's range (caps.c) */
+    double w;           /* the bi-5 cap's weight in its hole: 1, falling smoothly to 0 as the
+                           spoke ratios reach its range (caps.c); against the G1 fill cap where
+                           there is one, else against the refined limit. 0: the fill alone (no
+                           bi-5 patches) */
+    struct ccn__fill_cap *fill; /* the G1 fill cap (surface/fill_cap.h) where w < 1, or NULL */
 } ccn__cap;
 
 struct ccn_plan {

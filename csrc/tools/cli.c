@@ -246,6 +246,7 @@ int ccn_cli_parse(int argc, char **argv, unsigned allowed, int max_levels, ccn_o
         } else if ((allowed & CCN_CLI_CAP) && strcmp(a, "--cap") == 0 && val) {
             if (strcmp(val, "bi5") == 0) o->cap = CCN_CAP_GUIDED_BI5;
             else if (strcmp(val, "refine") == 0) o->cap = CCN_CAP_REFINE;
+            else if (strcmp(val, "fill") == 0) o->cap = CCN_CAP_G1_FILL;
             else { fprintf(stderr, "ccnurbs: bad --cap '%s'\n", val); return 2; }
             i++;
         } else if (strcmp(a, "--corners") == 0 && val) {

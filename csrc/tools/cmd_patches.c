@@ -21,7 +21,7 @@ static void put_patch(void *user, int32_t degree, const double *pts, int32_t cag
 int ccn_cmd_patches(int argc, char **argv) {
     ccn_options o = {0};
     const char *in = NULL, *out = NULL;
-    int rc0 = ccn_cli_parse(argc, argv, 0, 0, &o, NULL, &in, &out);
+    int rc0 = ccn_cli_parse(argc, argv, CCN_CLI_CAP, 0, &o, NULL, &in, &out);
     if (rc0) return rc0;
     ccn_plan *plan = NULL;
     int rc = ccn_cli_load_plan_caps(in, &o, &plan);

@@ -30,10 +30,10 @@ static int usage(void) {
     fprintf(stderr,
             "usage:\n"
             "  ccnurbs refine --scheme eigen|nurss|cc --levels K [--corners smooth|pinned] [--crease-method uniform|chaikin] [--polyhedron P] [--fvar-linear M] in.obj out.obj\n"
-            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--curvature] [--polyhedron P] [--fvar-linear M] in.obj out.obj|out.ply\n"
-            "  ccnurbs patches [--scheme ...] [--corners ...] in.obj out.bv\n"
+            "  ccnurbs limit --levels L [--scheme eigen|nurss|cc] [--cap bi5|refine|fill] [--corners smooth|pinned] [--crease-method uniform|chaikin] [--corner-normals] [--curvature] [--polyhedron P] [--fvar-linear M] in.obj out.obj|out.ply\n"
+            "  ccnurbs patches [--scheme ...] [--cap bi5|refine|fill] [--corners ...] in.obj out.bv\n"
             "  ccnurbs export --format step|iges [--unpacked] [--fill-levels N] [--name NAME] [--face-map F]\n"
-            "                 [--scheme ...] [--cap bi5|refine] [--corners ...] in.obj out.step\n"
+            "                 [--scheme ...] [--cap bi5|refine|fill] [--corners ...] in.obj out.step\n"
             "  ccnurbs matrix --valence N [--knots d0,d1,...] [--scheme eigen|nurss|cc]\n"
             "  ccnurbs experiment maxima|charmap --cases N --seed S [...] (experiment --help)\n"
             "  --fvar-linear none|corners-only|corners-plus1|corners-plus2|boundaries|all: the UV map's (vt)\n"

@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 CLI_SCHEME = {"EIGEN": "eigen", "NURSS": "nurss", "CATMULL_CLARK": "cc"}
-CLI_CAP = {"GUIDED_BI5": "bi5", "REFINE": "refine"}
+CLI_CAP = {"GUIDED_BI5": "bi5", "REFINE": "refine", "G1_FILL": "fill"}
 CLI_CORNERS = {"ALL": "smooth", "PRESERVE_CORNERS": "pinned"}
 
 

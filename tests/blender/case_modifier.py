@@ -462,7 +462,8 @@ class TestModifier(AddonTestCase):
     def test_cap_status(self):
         """Analysis > Cap Status marks each extraordinary point: a cube's 8 corners capped
         (uniform intervals), refined with Cap = Refine; the valence-7 point of Fig. 17 (spoke
-        ratio 8) refined; the marks sit on the surface's vertices; off, none."""
+        ratio 8) refined, with Cap = G1 Fill closed by the fill cap (the surface the CLI's
+        --cap fill gives); the marks sit on the surface's vertices; off, none."""
         ob = add_modifier(cube("CapCube"), levels=3)
         ob.ccnurbs.cap_status = True
         update()
@@ -478,6 +479,10 @@ class TestModifier(AddonTestCase):
         fig.ccnurbs.cap_status = True
         update()
         self.assertIn("0 capped (green), 0 blended (yellow), 1 refined", ccn.ui.cap_status_line(fig))
+        fig.ccnurbs.cap = 'G1_FILL'
+        update()
+        self.assertIn("0 refined (red: unbounded curvature), 1 G1 fill (blue)", ccn.ui.cap_status_line(fig))
+        self.assertMatchesCLI(fig)
         fig.ccnurbs.cap_status = False
         update()
         self.assertIsNone(ccn.ui.cap_status_line(fig))

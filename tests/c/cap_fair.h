@@ -29,6 +29,7 @@
 
 #include "bi5/bi5.h"
 #include "ccnurbs.h"
+#include "surface/fill_cap.h"
 #include "surface/plan_types.h"
 #include "bi5_props.h"
 
@@ -124,7 +125,7 @@ static void ring_curvature(const double *x, const double *n, const int32_t *nbs,
 
 /* ---- one cage at one level ------------------------------------------------------------------ */
 
-typedef struct { ccn_plan *p; int32_t nv, nf; double *x, *n; int32_t *fv; } fplan;
+typedef struct { ccn_plan *p; int32_t nv, nf; double *x, *n, *k; int32_t *fv; } fplan;
 
 static int fplan_run(const ccn_cage *cage, ccn_options o, fplan *f) {
     ccn_error err;
@@ -136,14 +137,15 @@ static int fplan_run(const ccn_cage *cage, ccn_options o, fplan *f) {
     f->x = malloc(sizeof(double) * 3 * (size_t)f->nv);
     f->n = malloc(sizeof(double) * 3 * (size_t)f->nv);
     f->fv = malloc(sizeof(int32_t) * 4 * (size_t)f->nf);
-    ccn_limit_mesh lm = {.positions = f->x, .normals = f->n, .face_verts = f->fv};
+    f->k = malloc(sizeof(double) * 2 * (size_t)f->nv);
+    ccn_limit_mesh lm = {.positions = f->x, .normals = f->n, .face_verts = f->fv, .curvatures = f->k};
     if (ccn_plan_evaluate(f->p, NULL, &lm, &err)) { fprintf(stderr, "evaluate: %s\n", err.message); return -1; }
     return 0;
 }
 
 static void fplan_free(fplan *f) {
     ccn_plan_destroy(f->p);
-    free(f->x); free(f->n); free(f->fv);
+    free(f->x); free(f->n); free(f->fv); free(f->k);
 }
 
 /* Vertex neighbours (sharing an edge) from the quads, CSR. */
@@ -317,17 +319,147 @@ static void measure_cap(const ccn_plan *plan, const ccn__cap *cp, const fplan *p
     F->holes_checked++;
 }
 
+/* ---- the G1 fill cap ------------------------------------------------------------------------ */
+
+/* Degree-5 Bernstein basis with first and second derivatives at t. */
+static void bern5(double t, double B[6], double D[6], double DD[6]) {
+    static const double C5[6] = {1, 5, 10, 10, 5, 1}, C4[5] = {1, 4, 6, 4, 1}, C3[4] = {1, 3, 3, 1};
+    double b4[5], b3[4];
+    for (int i = 0; i < 6; i++) B[i] = C5[i] * pow(t, i) * pow(1 - t, 5 - i);
+    for (int i = 0; i < 5; i++) b4[i] = C4[i] * pow(t, i) * pow(1 - t, 4 - i);
+    for (int i = 0; i < 4; i++) b3[i] = C3[i] * pow(t, i) * pow(1 - t, 3 - i);
+    for (int i = 0; i < 6; i++) {
+        D[i] = 5 * ((i > 0 ? b4[i - 1] : 0) - (i < 5 ? b4[i] : 0));
+        DD[i] = 20 * ((i > 1 ? b3[i - 2] : 0) - 2 * (i > 0 && i < 5 ? b3[i - 1] : 0) + (i < 4 ? b3[i] : 0));
+    }
+}
+
+/* Quintic Bezier patch b at (s, t): value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2. */
+static void bez5_jet(const double b[6][6][3], double s, double t, double jet[6][3]) {
+    double Bs[6], Ds[6], DDs[6], Bt[6], Dt[6], DDt[6];
+    bern5(s, Bs, Ds, DDs);
+    bern5(t, Bt, Dt, DDt);
+    memset(jet, 0, sizeof(double) * 18);
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) {
+            double w[6] = {Bs[i] * Bt[j], Ds[i] * Bt[j], Bs[i] * Dt[j], DDs[i] * Bt[j], Ds[i] * Dt[j], Bs[i] * DDt[j]};
+            for (int q = 0; q < 6; q++)
+                for (int k = 0; k < 3; k++) jet[q][k] += w[q] * b[i][j][k];
+        }
+}
+
+/* Sector s of a fill cap at face coordinates (u, v) in [0,1]^2 (its four patches b). */
+static void fill_jet(double (*b)[4][6][6][3], int s, double u, double v, double jet[6][3]) {
+    int a = u < 0.5 ? 0 : 1, c = v < 0.5 ? 0 : 1;
+    bez5_jet((const double(*)[6][3])b[s][2 * a + c], 2 * u - a, 2 * v - c, jet);
+}
+
+/* The refined limit around cap cap_id: its K, H range and max |K| in the hole, max |K| on the
+ * ring of output vertices around it. */
+static void hole_reference(const fplan *pr, const uint8_t *in_hole_of, int32_t cap_id, const int32_t *nbs,
+                           const int32_t *nb, double r[6]) {
+    double kmin = 1e300, kmax = -1e300, hmin = 1e300, hmax = -1e300, kref = 0, kout = 0;
+    for (int32_t v = 0; v < pr->nv; v++) {
+        double K, H;
+        if (in_hole_of[v] == cap_id + 1) {
+            ring_curvature(pr->x, pr->n, nbs, nb, v, &K, &H);
+            kmin = fmin(kmin, K), kmax = fmax(kmax, K), hmin = fmin(hmin, H), hmax = fmax(hmax, H);
+            kref = fmax(kref, fabs(K));
+            continue;
+        }
+        if (in_hole_of[v]) continue;
+        int next = 0;
+        for (int32_t q = nbs[v]; q < nbs[v + 1] && !next; q++) next = in_hole_of[nb[q]] == cap_id + 1;
+        if (!next) continue;
+        ring_curvature(pr->x, pr->n, nbs, nb, v, &K, &H);
+        kout = fmax(kout, fabs(K));
+    }
+    r[0] = kmin, r[1] = kmax, r[2] = hmin, r[3] = hmax, r[4] = kref, r[5] = kout;
+}
+
+/* The fill cap's measures (the same as measure_cap's): samples of its patches; joins across
+ * its spokes (both sectors' normals and K) and along its border (K against the refined plan's
+ * exact curvature at the border's output vertices). */
+static void measure_fill(const ccn_plan *plan, const ccn__cap *cp, const fplan *pr, const uint8_t *in_hole_of,
+                         int32_t cap_id, const int32_t *nbs, const int32_t *nb, int32_t ev_out, fair *F) {
+    int n = cp->n;
+    double (*b)[4][6][6][3] = malloc(sizeof *b * (size_t)n), ref[6];
+    if (!b) return;
+    for (int s = 0; s < n; s++) {
+        ccn__fill_cap_bezier(cp->fill, s, b[s]);
+        for (int q = 0; q < 4; q++)
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 6; j++)
+                    for (int k = 0; k < 3; k++) b[s][q][i][j][k] = plan->centre[k] + plan->scale * b[s][q][i][j][k];
+    }
+    hole_reference(pr, in_hole_of, cap_id, nbs, nb, ref);
+    const double *nev = pr->n + 3 * ev_out;
+    double kc = 0, cmin = 1e300, cmaxk = -1e300, chmin = 1e300, chmax = -1e300, jmax = 0, jmin = 1e300;
+    for (int s = 0; s < n; s++)
+        for (int a = 0; a <= 20; a++)
+            for (int c = 0; c <= 20; c++) {
+                double jet[6][3], K, H, N[3], x[3];
+                fill_jet(b, s, a / 20.0, c / 20.0, jet);
+                cross(jet[1], jet[2], x);
+                double jn = norm3(x);
+                if (a && c) jmax = fmax(jmax, jn), jmin = fmin(jmin, jn); /* not on the spokes */
+                if (!(jn > 0)) continue;
+                jet_curv(jet, &K, &H, N);
+                if (dot3(N, nev) < 0) H = -H;
+                kc = fmax(kc, fabs(K));
+                cmin = fmin(cmin, K), cmaxk = fmax(cmaxk, K), chmin = fmin(chmin, H), chmax = fmax(chmax, H);
+            }
+    F->jac = fmin(F->jac, jmin / jmax);
+    if ((ref[0] > 0 && cmin <= 0) || (ref[1] < 0 && cmaxk >= 0)) F->ksign++;
+    if ((ref[2] > 0 && chmin <= 0) || (ref[3] < 0 && chmax >= 0)) F->hsign++;
+    if (ref[4] > 0) F->kratio = fmax(F->kratio, kc / ref[4]);
+    if (ref[5] > 0) F->kring = fmax(F->kring, kc / ref[5]);
+    double jump = 0;
+    for (int s = 0; s < n; s++) { /* spoke s + 1: sector s's v-axis, sector s + 1's u-axis */
+        int s1 = (s + 1) % n;
+        for (int q = 1; q <= 40; q++) {
+            double t = q / 41.0, j1[6][3], j2[6][3], K1, K2, H1, H2, N1[3], N2[3];
+            fill_jet(b, s, 0, t, j1);
+            fill_jet(b, s1, t, 0, j2);
+            jet_curv(j1, &K1, &H1, N1), jet_curv(j2, &K2, &H2, N2);
+            jump = fmax(jump, fabs(K1 - K2));
+            F->g1 = fmax(F->g1, plane_angle(N1, N2));
+        }
+    }
+    for (int32_t i = 0; i < plan->nhv; i++) { /* the border against the exact curvature there */
+        double u = plan->hv_uv[2 * i], v = plan->hv_uv[2 * i + 1];
+        if (plan->hv_cap[i] != cap_id || (u < 1 - 1e-12 && v < 1 - 1e-12)) continue;
+        double j1[6][3], K, H, N[3];
+        fill_jet(b, plan->hv_sector[i], u, v, j1);
+        jet_curv(j1, &K, &H, N);
+        const double *k = pr->k + 2 * (size_t)plan->hv_out[i];
+        if (isfinite(k[0]) && isfinite(k[1])) jump = fmax(jump, fabs(K - k[0] * k[1]));
+    }
+    if (kc > 0) F->kjump = fmax(F->kjump, jump / kc);
+    for (int s = 0; s < n; s++) { /* the centre */
+        double j1[6][3], K, H, N[3];
+        fill_jet(b, s, 0, 0, j1);
+        jet_curv(j1, &K, &H, N);
+        if (dot3(N, nev) < 0)
+            for (int k = 0; k < 3; k++) N[k] = -N[k];
+        F->centre = fmax(F->centre, angle(N, nev));
+    }
+    free(b);
+    F->holes_checked++;
+}
+
 static inline void fair_init(fair *F) {
     memset(F, 0, sizeof *F);
     F->jac = 1;
 }
 
-/* Both plans of one cage at level L; returns -1 if a plan failed. */
+/* Both plans of one cage at level L (the cap plan with base.cap G1_FILL, else GUIDED_BI5);
+ * returns -1 if a plan failed. */
 static inline int fair_measure(const ccn_cage *cage, int L, ccn_options base, fair *F) {
     fplan pb, pr;
     ccn_options ob = base, orf = base;
     ob.levels = orf.levels = L;
-    ob.cap = CCN_CAP_GUIDED_BI5;
+    ob.cap = base.cap == CCN_CAP_G1_FILL ? CCN_CAP_G1_FILL : CCN_CAP_GUIDED_BI5;
     orf.cap = CCN_CAP_REFINE;
     if (fplan_run(cage, ob, &pb) || fplan_run(cage, orf, &pr)) { fplan_free(&pb); fplan_free(&pr); return -1; }
     ccn_sizes sz;
@@ -358,7 +490,10 @@ static inline int fair_measure(const ccn_cage *cage, int L, ccn_options base, fa
     int32_t *nbs, *nb;
     neighbours(&pr, &nbs, &nb);
     for (int32_t c = 0; c < pb.p->ncap; c++)
-        if (evout[c] >= 0) measure_cap(pb.p, &pb.p->caps[c], &pr, hole, c, nbs, nb, evout[c], F);
+        if (evout[c] >= 0 && !(pb.p->caps[c].w > 0))
+            measure_fill(pb.p, &pb.p->caps[c], &pr, hole, c, nbs, nb, evout[c], F);
+        else if (evout[c] >= 0)
+            measure_cap(pb.p, &pb.p->caps[c], &pr, hole, c, nbs, nb, evout[c], F);
     free(nbs); free(nb); free(hole); free(evout);
     fplan_free(&pb);
     fplan_free(&pr);

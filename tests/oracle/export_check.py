@@ -254,7 +254,8 @@ def main():
     kind = {f["index"]: f["kind"] for f in faces}
     pats = read_bv(a.patches) if a.patches else []
     G = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]
-    preq = [(f["index"], u, v, f["patch"]) for f in faces if f["patch"] >= 0 for u in G for v in G]
+    preq = [(f["index"], u, v, f["patch"]) for f in faces if f["patch"] >= 0 and f["patch"] < len(pats)
+            for u in G for v in G]
     sampled = {r[0] for r in req}
     print("limit_level: %d\nlimit_vertices: %d\nunmatched_vertices: %d\nsize: %.9g" % (
         level, len(V), len(V) - len(matched), size))

@@ -48,9 +48,12 @@ check() { # name obj limit-level [options]
   awk '$1 == "F" && $3 == 4 { print $2 }' "$T/$name.map" > "$T/$name.fb"
   closed=$(val closed "$T/$name.info.step") bnd=$(val boundary_edges "$T/$name.info.step")
   cap="" pat="--patches $T/$name.bv"
-  case " $* " in *" --cap refine "*) cap="--cap refine" pat="" ;; esac # `ccnurbs patches` has no --cap
+  case " $* " in
+    *" --cap refine "*) cap="--cap refine" pat="" ;; # no patches at the EVs
+    *" --cap fill "*) cap="--cap fill" ;;
+  esac
   build/ccnurbs limit --levels "$L" $cap "$obj" "$T/$name.lim.obj" 2> /dev/null &&
-    { [ -z "$pat" ] || build/ccnurbs patches "$obj" "$T/$name.bv" 2> /dev/null; } &&
+    { [ -z "$pat" ] || build/ccnurbs patches $cap "$obj" "$T/$name.bv" 2> /dev/null; } &&
     python3 tests/oracle/export_check.py --cage "$obj" --limit "$T/$name.lim.obj" --map "$T/$name.map" \
       $pat --fallback "$T/$name.fb" --occt build/occt_read "$T/$name.step" "$T/$name.igs" > "$T/$name.chk" 2>&1 ||
     { fail=$((fail+1)); echo "FAIL $name: limit check: $(tail -n 3 "$T/$name.chk" 2> /dev/null)"; return; }
@@ -123,6 +126,14 @@ check tearbox "$T/tearbox.obj" 3
 check ngon_prism tests/data/ngon_prism.obj 3
 check lshape tests/data/lshape.obj 3
 check fan64 tests/data/fan64.obj 3
+# the G1 fill caps (--cap fill): the holes of the non-uniform EVs are the plan's own fill patches
+# (one merged face per sector, counted as bi-5), no hole left there
+expect="bi5=8 fill_faces=8"
+check fig18_fill tests/data/fig18_v8.obj 3 --cap fill
+expect="bi5=5 fill_faces=5"
+check star5_fill tests/data/star5_nu.obj 3 --cap fill
+expect=""
+check tearbox_fill "$T/tearbox.obj" 3 --cap fill
 fill_g1=""
 check mixed_boundary tests/data/mixed_boundary.obj 3
 check carlike_2.5k "$T/carlike.obj" 1
