@@ -13,12 +13,17 @@
 typedef struct { int32_t width, num_values; const double *values; const int32_t *face_values; } uv_out;
 
 /* vn lines: one per vertex, or (corner normals) one per face corner, 4 per face in order. */
+/* evs: the output's extraordinary points by ccn_ev_surface (capped, blended, refined, G1 fill). */
 static int write_limit(FILE *f, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm,
-                       const uv_out *uv) {
+                       const uv_out *uv, const int32_t evs[4]) {
     fprintf(f, "# ccnurbs limit level %d: %d vertices, %d faces, %d caps, %d cap fallbacks, "
                "%d EV fallbacks, %d ring conflicts\n", (int)ps->levels, (int)s->num_verts,
             (int)s->num_faces, (int)ps->num_caps, (int)ps->num_cap_fallbacks,
             (int)ps->num_ev_fallbacks, (int)ps->num_ring_conflicts);
+    if (evs[0] + evs[1] + evs[2] + evs[3])
+        fprintf(f, "# extraordinary points: %d guided bi-5 cap, %d blended, %d G1 fill cap, %d refined limit\n",
+                (int)evs[CCN_EV_CAPPED], (int)evs[CCN_EV_CAP_BLENDED], (int)evs[CCN_EV_FILLED],
+                (int)evs[CCN_EV_REFINED]);
     for (int32_t v = 0; v < s->num_verts; v++)
         fprintf(f, "v %.17g %.17g %.17g\n", lm->positions[3 * v], lm->positions[3 * v + 1],
                 lm->positions[3 * v + 2]);
@@ -80,13 +85,13 @@ static int write_ply(FILE *f, const ccn_sizes *s, const ccn_plan_stats *ps, cons
 }
 
 static int write_atomic(const char *path, const ccn_sizes *s, const ccn_plan_stats *ps, const ccn_limit_mesh *lm,
-                        const uv_out *uv) {
+                        const uv_out *uv, const int32_t evs[4]) {
     size_t n = strlen(path);
     char *tmp = malloc(n + 32);
     if (!tmp) return 2;
     snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
-    int rc = !f ? -1 : ends_with(path, ".ply") ? write_ply(f, s, ps, lm) : write_limit(f, s, ps, lm, uv);
+    int rc = !f ? -1 : ends_with(path, ".ply") ? write_ply(f, s, ps, lm) : write_limit(f, s, ps, lm, uv, evs);
     if (f && fclose(f) != 0) rc = -1;
     if (rc == 0 && rename(tmp, path) != 0) rc = -1;
     if (rc) { remove(tmp); fprintf(stderr, "ccnurbs: cannot write %s\n", path); }
@@ -160,7 +165,13 @@ int ccn_cmd_limit(int argc, char **argv) {
                (ch >= 0 && ccn_plan_evaluate_fvar(plan, ch, NULL, uv_values, uv_faces, &err))) {
         rc = ccn_cli_error(in, &err);
     } else {
-        rc = write_atomic(out, &s, &ps, &lm, ch >= 0 ? &uv : NULL);
+        int32_t evs[4] = {0, 0, 0, 0}, nev = 0, *kind = NULL;
+        if (ccn_plan_get_evs(plan, &nev, NULL, NULL) == CCN_OK && nev > 0 && (kind = malloc(sizeof(int32_t) * (size_t)nev)) &&
+            ccn_plan_get_evs(plan, &nev, NULL, kind) == CCN_OK)
+            for (int32_t i = 0; i < nev; i++)
+                if (kind[i] >= 0 && kind[i] < 4) evs[kind[i]]++;
+        free(kind);
+        rc = write_atomic(out, &s, &ps, &lm, ch >= 0 ? &uv : NULL, evs);
     }
     free(lm.positions); free(lm.normals); free(lm.face_verts); free(lm.corner_normals);
     free(lm.curvatures);

@@ -207,13 +207,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
     ccn_options o = {0};
     o.scheme = (ccn_scheme)(next(&r) % 4);     /* 3: invalid */
-    o.cap = (ccn_cap)(next(&r) % 3);           /* 2: invalid */
+    o.cap = (ccn_cap)(next(&r) % 4);           /* 3: invalid */
     uint8_t lb = next(&r);
     o.levels = lb == 255 ? 1000 : lb == 254 ? INT32_MIN : (int32_t)(lb % 5) - 1; /* -1..3 */
     o.boundary_corners = next(&r) % 3;         /* 2: invalid */
     o.threads = next(&r) % 3;
     o.crease_method = next(&r) % 2;
-    int opts_bad = o.scheme > CCN_SCHEME_CATMULL_CLARK || o.cap > CCN_CAP_REFINE ||
+    int opts_bad = o.scheme > CCN_SCHEME_CATMULL_CLARK || o.cap > CCN_CAP_G1_FILL ||
                    o.levels < 0 || o.boundary_corners > CCN_CORNERS_PINNED;
     int levels_huge = o.levels == 1000; /* must be refused: CCN_ERR_ARGUMENT or _MEMORY */
 
