@@ -40,7 +40,16 @@
 #define CCN_FILL_CAP_KAPPA_FULL 1.01
 #endif
 /* Equal spoke intervals take the uniform operator on the level-K net; a research build may take
- * the exact surround there too (tests/experiments/RESULTS.md: the same fairness). */
+ * the exact surround there too (tests/experiments/RESULTS.md: the same fairness, at 2 - 3.6x the
+ * evaluation time where caps are built). The two constructions differ (the exact surround's
+ * first ring has speed 1/2): by 1.2e-4 - 4.7e-4 of a star's size at level 4, valence 3 - 10,
+ * when one interval leaves equality by 1e-9. So while the intervals' spread log(max d / min d)
+ * is below CCN_CAP_UNIFORM_BAND the uniform operator's cap and its bicubic ring faces are
+ * blended with the exact-surround cap and the exact limit there (the uniform twin's weight
+ * falling smoothly from 1 at equality to 0 at the band's end), and the surface moves
+ * continuously as an interval leaves equality; within the band the ring faces are the exact
+ * limit only up to that blend (as the ring faces of equal intervals' caps are). */
+#define CCN_CAP_UNIFORM_BAND 0.01
 #ifndef CCN_CAP_EXACT_SURROUND_ALWAYS
 #define CCN_CAP_EXACT_SURROUND_ALWAYS 0
 #endif
@@ -58,6 +67,7 @@ static int cap_ev(const ccn_mesh *m, int32_t v) {
 
 void ccn__cap_free(ccn__cap *c) {
     ccn__fill_cap_destroy(c->fill);
+    free(c->upatches);
     free(c->cnet); free(c->ring); free(c->l0); free(c->knots); free(c->patches); free(c->pieces);
     free(c->taus);
     memset(c, 0, sizeof *c);
@@ -210,12 +220,14 @@ static void cap_begin(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn__ca
         for (int32_t j = 0; ok && j < 2 * n + 1; j++)
             c->l0[j] = s->wp[j], c->l0[2 * n + 1 + j] = s->wu[j], c->l0[4 * n + 2 + j] = s->wv[j];
         int nu = 0, uni = 1; /* some kappa_s = d_{s+1}/d_{s-1} != 1: taus, once (no positions) */
+        double dmin = c->knots[0], dmax = c->knots[0];
         const double krange = CCN_CAP_KAPPA_RANGE;
         double lk = 0;
         for (int32_t k = 0; k < n; k++) {
             double kap = c->knots[(k + 1) % n] / c->knots[(k + n - 1) % n];
             nu |= fabs(kap - 1.0) > 1e-12;
             uni &= fabs(c->knots[k] / c->knots[0] - 1.0) <= 1e-12;
+            dmin = fmin(dmin, c->knots[k]), dmax = fmax(dmax, c->knots[k]);
             lk = fmax(lk, fabs(log(kap)));
             if (kap > krange * (1 + 1e-12) || kap * krange < 1 - 1e-12) ok = 0; /* measured range */
         }
@@ -224,6 +236,8 @@ static void cap_begin(ccn_plan *p, int32_t ev, const int32_t *hint_caps, ccn__ca
         c->w = x >= 1 ? 1.0 : x <= 0 ? 0.0 : x * x * (3 - 2 * x);
         if (!(c->w > 0)) ok = 0; /* at the range's end the refined limit alone */
         t->uni = uni;
+        double spread = log(dmax / dmin) / CCN_CAP_UNIFORM_BAND; /* the uniform twin's weight */
+        c->wu = uni || !(spread < 1) || CCN_CAP_EXACT_SURROUND_ALWAYS ? 0.0 : 1 - spread * spread * (3 - 2 * spread);
         /* beyond the bi-5 cap's whole range: the G1 fill cap (its operator in pass 2), blended
          * with the bi-5 cap while that has weight */
         if (p->opts.cap == CCN_CAP_G1_FILL && c->w < 1 && n >= CCN_FILL_CAP_MIN_VALENCE &&
@@ -276,13 +290,17 @@ static int cap_finish(ccn_plan *p, ccn__cap *c, const cap_todo *t) {
          * level-(K+1) surround and the exact centre normal (bi5.h [R13], [R14]). */
         if (ok && t->uni && !CCN_CAP_EXACT_SURROUND_ALWAYS)
             ok = ccn__bi5_apply_cached(c->op, zero, c->knots, c->taus, zero, c->patches, &e2) == CCN_OK;
-        else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
+        else if (ok && c->wu > 0) { /* the uniform twin: the operator the cap has so far */
+            c->uop = c->op;
+            c->upatches = malloc(sizeof(double) * 108 * (size_t)ccn__bi5_num_patches(c->uop));
+            ok = c->upatches && cap_use_surround(p, c, t->ev, zero, &e2);
+        } else if (ok) ok = cap_use_surround(p, c, t->ev, zero, &e2);
         free(zero);
     }
     if (!ok && c->fill) { /* the fill alone */
-        free(c->taus); free(c->pieces); free(c->patches);
-        c->taus = NULL, c->pieces = NULL, c->patches = NULL;
-        c->w = 0;
+        free(c->taus); free(c->pieces); free(c->patches); free(c->upatches);
+        c->taus = NULL, c->pieces = NULL, c->patches = NULL, c->upatches = NULL;
+        c->w = 0, c->wu = 0;
         c->exact_surround = 1; /* its surround is the limit itself */
         return 1;
     }
@@ -477,7 +495,16 @@ done:
     return r;
 }
 
-/* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h). */
+/* a = the unit normal of w b + (1 - w) a (a, b unit). */
+static void blend_normal(double a[3], const double b[3], double w) {
+    double m[3];
+    for (int k = 0; k < 3; k++) m[k] = w * b[k] + (1 - w) * a[k];
+    double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    for (int k = 0; k < 3; k++) a[k] = m[k] / l;
+}
+
+/* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h);
+ * around a cap with a uniform twin (wu > 0) blended with the exact limit already there. */
 static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) {
     const ccn_mesh *mK = p->lev[p->K];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
@@ -491,8 +518,17 @@ static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) 
         ccn__bezier_eval(b, 3, p->bv_uv[2 * i], p->bv_uv[2 * i + 1], x, du, dv);
         int32_t o = p->bv_out[i];
         if (written) written[o] = 1;
-        memcpy(out->positions + 3 * (size_t)o, x, sizeof x);
-        if (out->normals) ccn__unit_normal(du, dv, out->normals + 3 * (size_t)o);
+        const ccn__cap *cp = &p->caps[p->rf_cap[p->bv_rf[i]]];
+        double wr = cp->exact_surround ? cp->wu : 1, *po = out->positions + 3 * (size_t)o;
+        double *no = out->normals ? out->normals + 3 * (size_t)o : NULL, nn[3];
+        if (wr < 1)
+            for (int k = 0; k < 3; k++) po[k] = wr * x[k] + (1 - wr) * po[k];
+        else
+            memcpy(po, x, sizeof x);
+        if (!no) continue;
+        ccn__unit_normal(du, dv, nn);
+        if (wr < 1) blend_normal(no, nn, wr);
+        else memcpy(no, nn, sizeof nn);
     }
 }
 
@@ -522,8 +558,12 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
         } else {
             st = ccn__bi5_apply_cached(cp->op, net, cp->knots, cp->taus, ctr, cp->patches, err);
         }
+        if (!st && cp->wu > 0) /* the uniform twin on the level-K net */
+            st = isfinite(nrm[0]) ? ccn__bi5_apply_normal(cp->uop, net, NULL, NULL, ctr, nrm, cp->upatches, err)
+                                  : ccn__bi5_apply_cached(cp->uop, net, NULL, NULL, ctr, cp->upatches, err);
         if (st) return st;
         translate(cp->patches, 36 * (size_t)ccn__bi5_num_patches(cp->op), org, 1);
+        if (cp->wu > 0) translate(cp->upatches, 36 * (size_t)ccn__bi5_num_patches(cp->uop), org, 1);
     }
     for (int32_t i = 0; i < p->nhv; i++) {
         const ccn__cap *cp = &p->caps[p->hv_cap[i]];
@@ -536,23 +576,28 @@ ccn_status ccn__caps_evaluate(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written
             if (no) ccn__unit_normal(du, dv, no);
             if (!(w > 0)) continue;
         }
+        double nn[3];
         ccn__bi5_eval(cp->op, cp->patches, k, u, v, x, du, dv);
+        ccn__unit_normal(du, dv, nn);
+        if (cp->wu > 0) { /* near-equal intervals: with the uniform operator's cap */
+            double xu[3], duu[3], dvu[3], n2[3];
+            ccn__bi5_eval(cp->uop, cp->upatches, k, u, v, xu, duu, dvu);
+            ccn__unit_normal(duu, dvu, n2);
+            for (int q = 0; q < 3; q++) x[q] = cp->wu * xu[q] + (1 - cp->wu) * x[q];
+            blend_normal(nn, n2, cp->wu);
+        }
         if (w < 1) { /* near the end of the cap's range: blended with the fill cap, or with the
                       * refined limit (there) */
-            double nc[3], nb[3];
             for (int q = 0; q < 3; q++) po[q] = w * x[q] + (1 - w) * po[q];
             if (no) {
-                ccn__unit_normal(du, dv, nc);
-                if (nc[0] * no[0] + nc[1] * no[1] + nc[2] * no[2] < 0)
-                    for (int q = 0; q < 3; q++) nc[q] = -nc[q];
-                for (int q = 0; q < 3; q++) nb[q] = w * nc[q] + (1 - w) * no[q];
-                double l = sqrt(nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2]);
-                for (int q = 0; q < 3; q++) no[q] = nb[q] / l;
+                if (nn[0] * no[0] + nn[1] * no[1] + nn[2] * no[2] < 0)
+                    for (int q = 0; q < 3; q++) nn[q] = -nn[q];
+                blend_normal(no, nn, w);
             }
             continue;
         }
         memcpy(po, x, sizeof x);
-        if (no) ccn__unit_normal(du, dv, no);
+        if (no) memcpy(no, nn, sizeof nn);
     }
     eval_ring_faces(p, out, written);
     return CCN_OK;

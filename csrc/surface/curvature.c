@@ -303,7 +303,7 @@ void ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out) {
                 ccn__curvature_at(p, (const double(*)[3])d, out, o);
                 continue;
             }
-            if (cp->w < 1) { /* blended: not computed */
+            if (cp->w < 1 || cp->wu > 0) { /* blended: not computed */
                 ccn__curvature_flag(out, o);
                 continue;
             }
@@ -316,6 +316,10 @@ void ccn__curvature_evaluate(ccn_plan *p, ccn_limit_mesh *out) {
             const double *B = p->rf_bez + 48 * (size_t)p->bv_rf[b];
             if (isnan(B[0])) continue;
             o = p->bv_out[b];
+            if (p->caps[p->rf_cap[p->bv_rf[b]]].exact_surround) { /* blended with the limit */
+                ccn__curvature_flag(out, o);
+                continue;
+            }
             bezier_d2(B, 3, p->bv_uv[2 * b], p->bv_uv[2 * b + 1], d);
         }
         ccn__curvature_at(p, (const double(*)[3])d, out, o);

@@ -61,7 +61,8 @@ static int export_bicubic(walk *w, int32_t lvl) {
         for (int32_t k = p->lev[p->K]->vfan_start[p->caps[c].cnet[0]];
              k < p->lev[p->K]->vfan_start[p->caps[c].cnet[0] + 1]; k++)
             kind[p->lev[p->K]->hface[p->lev[p->K]->vfan[k]]] = 1;
-    for (int32_t i = 0; i < p->nrf; i++) kind[p->rf_face[i]] = 2;
+    for (int32_t i = 0; i < p->nrf; i++) /* ring faces (of an exact-surround cap: its uniform twin's) */
+        if (!p->caps[p->rf_cap[i]].exact_surround) kind[p->rf_face[i]] = 2;
     for (int32_t c = 0; c < p->ncap; c++) { /* exact surround: faces around the hole, 3 */
         const ccn__cap *cp = &p->caps[c];
         if (!cp->exact_surround || lvl != p->K) continue;

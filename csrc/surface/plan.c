@@ -47,7 +47,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->curv_wuu); free(p->curv_wuv); free(p->curv_wvv); free(p->curv_other);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
-    free(p->rf_face); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
+    free(p->rf_face); free(p->rf_cap); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
     for (int32_t c = 0; c < p->nfv; c++) ccn__fvchan_free(p->fv[c]);
     free(p->fv); free(p->vd_buf);
     ccn__ev_cache_destroy(p->ev_cache);
@@ -444,17 +444,21 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         memset(written, 0, (size_t)p->nout_v);
         for (int32_t i = 0; i < r->nrows; i++) written[r->rows[i]] = 1;
         eval_stencils(p, out, r->rows, r->nrows);
-        /* a cap blended with the refined limit (caps.c) reads the limit in its whole hole */
+        /* a cap blended with the refined limit (caps.c) reads the limit in its whole hole, the
+         * ring faces of a cap with a uniform twin read it on them */
         int32_t nb = 0, *blend = NULL;
-        for (int32_t i = 0; i < p->nhv; i++)
-            if (p->caps[p->hv_cap[i]].w < 1 && !written[p->hv_out[i]]) {
-                if (!blend && !(blend = malloc(sizeof(int32_t) * (size_t)p->nhv))) {
+        for (int32_t i = 0; i < p->nhv + p->nbv; i++) {
+            const ccn__cap *cp = &p->caps[i < p->nhv ? p->hv_cap[i] : p->rf_cap[p->bv_rf[i - p->nhv]]];
+            int32_t o = i < p->nhv ? p->hv_out[i] : p->bv_out[i - p->nhv];
+            if ((i < p->nhv ? cp->w < 1 : cp->exact_surround) && !written[o]) {
+                if (!blend && !(blend = malloc(sizeof(int32_t) * (size_t)(p->nhv + p->nbv)))) {
                     ccn__edit_region_free(r);
                     return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
                 }
-                written[p->hv_out[i]] = 1;
-                blend[nb++] = p->hv_out[i];
+                written[o] = 1;
+                blend[nb++] = o;
             }
+        }
         if (nb) eval_stencils(p, out, blend, nb);
         free(blend);
     } else {

@@ -28,6 +28,12 @@ typedef struct {
                            there is one, else against the refined limit. 0: the fill alone (no
                            bi-5 patches) */
     struct ccn__fill_cap *fill; /* the G1 fill cap (surface/fill_cap.h) where w < 1, or NULL */
+    double wu;          /* spoke intervals within CCN_CAP_UNIFORM_BAND of equal (not equal): the
+                           weight, falling from 1 to 0 across the band, of the uniform operator's
+                           cap (uop, upatches on the level-K net, with its bicubic ring faces)
+                           blended with this exact-surround one; 0 otherwise (caps.c) */
+    const struct ccn__bi5 *uop;
+    double *upatches;
 } ccn__cap;
 
 struct ccn_plan {
@@ -100,6 +106,7 @@ struct ccn_plan {
      * of their level-K net (the spline the cap joins C2), not as the subdivision limit;
      * not for exact_surround caps, whose surround is the limit itself */
     int32_t nrf, *rf_face;  /* distinct faces */
+    int32_t *rf_cap;        /* the cap of each (the weight of its bicubic patch: 1, or the cap's wu) */
     double *rf_bez;         /* 48 doubles per face, filled by evaluate */
     int32_t nbv;            /* output vertices on those faces */
     int32_t *bv_out, *bv_rf;

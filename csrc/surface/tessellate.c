@@ -675,7 +675,7 @@ static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
     ccn_plan *p = w->p;
     const ccn_mesh *mK = p->lev[p->K];
     const ccn__cap *cp = &p->caps[c];
-    if (cp->exact_surround) return 0; /* its surround is the limit itself (bi5.h [R13]) */
+    if (cp->exact_surround && !(cp->wu > 0)) return 0; /* its surround is the limit itself (bi5.h [R13]) */
     w->mode = 1;
     for (int32_t j = 0; j < 2 * cp->n; j++) {
         int32_t v = cp->ring[j];
@@ -684,8 +684,9 @@ static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
             for (int32_t h = mK->fstart[f]; h < mK->fstart[f + 1]; h++) touches |= mK->hvert[h] == cp->cnet[0];
             if (touches || face_done[f]) continue;
             face_done[f] = 1;
-            if (grow_i32(&p->rf_face, p->nrf + 1)) return -1;
+            if (grow_i32(&p->rf_face, p->nrf + 1) || grow_i32(&p->rf_cap, p->nrf + 1)) return -1;
             p->rf_face[p->nrf] = f;
+            p->rf_cap[p->nrf] = c;
             w->rf = p->nrf++;
             double cc[4][2];
             memcpy(cc, UNIT, sizeof cc);

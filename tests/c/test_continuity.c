@@ -16,7 +16,9 @@
  *   - measured and printed: the largest step of the sweep over its median (a Lipschitz bound
  *     measured on the sweep; steep blends between polyhedra show here).
  * Plus the reduced cages of the regressions (tests/data/continuity_*.obj): their surface moves
- * by <= 1e-7 of their size when their interval changes in the 9th digit.
+ * by <= 1e-7 of their size when their interval changes in the 9th digit; the cap's range (a
+ * spoke swept through the end of the guided cap's kappa range) and equal intervals left by one
+ * spoke (the uniform operator's cap against the exact-surround one), at level 4.
  *
  * CCN_CONT_CAGES and CCN_CONT_STEPS (environment) set the number of random cages and steps per
  * sweep (make test: 12 x 400). */
@@ -391,7 +393,45 @@ static void test_cap_range(void) {
     }
 }
 
+/* Equal intervals take the uniform operator's cap, any others the exact-surround cap: an
+ * interval leaving equality by 1e-9 must not move the surface (level 4: caps are built; they
+ * differed by 1.2e-4 - 4.7e-4 of the size before the two were blended near equality), and a
+ * sweep starting at equality moves it without a jump. */
+static void test_leaving_equal_intervals(void) {
+    int small = getenv("CCN_TEST_SMALL") != NULL;
+    static const int32_t ns[3] = {3, 5, 8};
+    for (int q = 0; q < (small ? 1 : 3); q++) {
+        int32_t n = ns[q];
+        star c;
+        star_make(&c, n, 3, 1);
+        for (int32_t i = 0; i < c.nrings; i++) c.ring_d[i] = 1.0;
+        sweep_levels = 4;
+        double *a = NULL, *b = NULL;
+        int32_t nv = 0, nv2 = 0;
+        ccn_cage g = star_cage(&c);
+        int ok = limit_of(&g, NULL, &a, &nv) == 0;
+        c.ring_d[0] = 1 + 1e-9;
+        g = star_cage(&c);
+        ok = ok && limit_of(&g, NULL, &b, &nv2) == 0 && nv == nv2;
+        double moved = ok ? max_diff(a, b, nv) / cage_size(a, nv) : INFINITY;
+        CHECK(moved <= 1e-7, "valence %d: one interval 1 -> 1 + 1e-9 moves the surface %.3g of its size", (int)n,
+              moved);
+        free(a);
+        free(b);
+        c.ring_d[0] = sqrt(1.04); /* the sweep 1 .. 1.04: its first step leaves equality */
+        sweep_span = 1.04;
+        double pert = 0, at = 0, fine = 0, r = sweep(&c, 0, small ? 20 : 40, &pert, &at, &fine);
+        sweep_span = 4.0, sweep_levels = 2;
+        CHECK(fine <= 10, "valence %d: spoke 0 swept from equality (1 .. 1.04): largest step %.3g x the median "
+              "(at %.6g; cut 4096-fold %.3g x)", (int)n, r, at, fine);
+        printf("# valence %d, spoke 0 from equal intervals: 1e-9 moves %.2g of the size; swept 1 .. 1.04, "
+               "level 4: largest step %.3g x the median, cut 4096-fold %.3g x\n", (int)n, moved, r, fine);
+        star_free(&c);
+    }
+}
+
 int main(void) {
+    RUN(test_leaving_equal_intervals);
     RUN(test_regressions);
     RUN(test_cap_range);
     RUN(test_random_sweeps);
