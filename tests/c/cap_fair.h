@@ -41,7 +41,10 @@
 
 typedef struct {
     double turn, turn_ref, kratio, kring, kjump, centre, outside, g1, jac;
-    int ksign, hsign, caps, fallbacks, holes_checked;
+    double twin_out, twin_g1; /* the hole border and ring faces of caps blended with their uniform
+                                 twin (intervals within 1 % of equal): position over the size and
+                                 normal angle against the exact limit there */
+    int ksign, hsign, caps, fallbacks, holes_checked, twins;
 } fair;
 
 typedef struct {
@@ -478,12 +481,22 @@ static inline int fair_measure(const ccn_cage *cage, int L, ccn_options base, fa
         if (u < 1 - 1e-12 && v < 1 - 1e-12) hole[pb.p->hv_out[i]] = (uint8_t)(pb.p->hv_cap[i] + 1);
         if (u == 0 && v == 0) evout[pb.p->hv_cap[i]] = pb.p->hv_out[i];
     }
+    uint8_t *twin = calloc((size_t)pr.nv, 1);
+    for (int32_t i = 0; i < pb.p->nhv; i++) twin[pb.p->hv_out[i]] = pb.p->caps[pb.p->hv_cap[i]].wu > 0;
+    for (int32_t i = 0; i < pb.p->nbv; i++) twin[pb.p->bv_out[i]] |= pb.p->caps[pb.p->rf_cap[pb.p->bv_rf[i]]].exact_surround;
+    for (int32_t c = 0; c < pb.p->ncap; c++) F->twins += pb.p->caps[c].wu > 0;
     for (int32_t v = 0; v < pr.nv; v++) {
         if (hole[v]) continue;
         double d[3] = {pb.x[3 * v] - pr.x[3 * v], pb.x[3 * v + 1] - pr.x[3 * v + 1], pb.x[3 * v + 2] - pr.x[3 * v + 2]};
+        if (twin[v]) {
+            F->twin_out = fmax(F->twin_out, norm3(d) / size);
+            F->twin_g1 = fmax(F->twin_g1, angle(pb.n + 3 * v, pr.n + 3 * v));
+            continue;
+        }
         F->outside = fmax(F->outside, norm3(d) / size);
         F->g1 = fmax(F->g1, angle(pb.n + 3 * v, pr.n + 3 * v)); /* the hole's border and beyond */
     }
+    free(twin);
     double rmax, excess = turn_excess(&pr, &pb, &rmax);
     F->turn = fmax(F->turn, excess / rmax);
     F->turn_ref = fmax(F->turn_ref, rmax);

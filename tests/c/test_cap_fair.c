@@ -7,7 +7,9 @@
  * normal-turn excess <= 0.25 of the refined limit's largest rate, no curvature sign change
  * where the refined limit keeps its sign, max |K| <= 3x the refined limit's, K jump across
  * cap-ring and cap-cap joins <= 10 % of max |K|, cap-centre normal = exact limit normal to
- * 1e-9 rad, outside the holes = exact limit to 1e-12, G1 at every join to 1e-9 rad. Vertices
+ * 1e-9 rad, outside the holes = exact limit to 1e-12, G1 at every join to 1e-9 rad (spoke
+ * intervals within 1 % of equal: the hole border and ring faces, where the uniform operator's
+ * cap is blended in, within 1e-4 of the size and 1e-4 rad of the exact limit). Vertices
  * whose spoke ratios kappa_s = d_{s+1}/d_{s-1} leave [1/1.05, 1.05] (or whose cap folds) fall
  * back and are counted; the count is checked against that rule. */
 #include "testlib.h"
@@ -40,11 +42,15 @@ static void check_case(const char *what, fcage *c, int L, int expect_caps, int e
     CHECK(F.centre <= 1e-9, "%s: centre normal %.2g rad", name, F.centre);
     CHECK(F.outside <= 1e-12, "%s: outside the holes %.2g", name, F.outside);
     CHECK(F.g1 <= 1e-9, "%s: G1 %.2g rad", name, F.g1);
+    /* intervals within 1 % of equal: the uniform operator's cap and its ring faces blended in */
+    CHECK(F.twin_out <= 1e-4 && F.twin_g1 <= 1e-4, "%s: uniform twin's border and ring faces %.2g of the size, "
+          "%.2g rad from the exact limit", name, F.twin_out, F.twin_g1);
     if (expect_caps >= 0) CHECK(F.caps == expect_caps, "%s: %d caps, want %d", name, F.caps, expect_caps);
     if (expect_fb >= 0) CHECK(F.fallbacks == expect_fb, "%s: %d fallbacks, want %d", name, F.fallbacks, expect_fb);
     fair *a = &t->all;
     a->turn = fmax(a->turn, F.turn), a->kratio = fmax(a->kratio, F.kratio), a->kjump = fmax(a->kjump, F.kjump);
     a->centre = fmax(a->centre, F.centre), a->outside = fmax(a->outside, F.outside), a->g1 = fmax(a->g1, F.g1);
+    a->twin_out = fmax(a->twin_out, F.twin_out), a->twin_g1 = fmax(a->twin_g1, F.twin_g1), a->twins += F.twins;
     a->jac = fmin(a->jac, F.jac);
     a->ksign += F.ksign, a->hsign += F.hsign, a->caps += F.caps, a->fallbacks += F.fallbacks;
     t->cases++;
@@ -98,7 +104,9 @@ static void test_acceptance(void) {
         }
     }
     fair_print("all cases", &t.all);
-    printf("# %d cases (levels 4-6): %d caps measured, %d fell back\n", t.cases, t.all.caps, t.all.fallbacks);
+    printf("# %d cases (levels 4-6): %d caps measured, %d fell back; %d caps with a uniform twin (intervals within 1 %% "
+           "of equal): border and ring faces %.2g of the size, %.2g rad from the exact limit\n", t.cases, t.all.caps,
+           t.all.fallbacks, t.all.twins, t.all.twin_out, t.all.twin_g1);
     CHECK(t.all.caps >= (small ? 5 : 50), "caps measured: %d", t.all.caps);
 }
 
