@@ -14,10 +14,10 @@
  *   - Spoke k's first pole: P + s D_k, D_k = row E_k of the subdominant spectral projector
  *     R (L R)^-1 L of the EV's matrix M applied to its 1-ring (the characteristic map's spoke
  *     vector in the limit tangent plane; L, R the left and right eigenvectors of the two
- *     subdominant eigenvalues), s = CCN__FILL_CAP_TANGENT (measured on 42 random stars, valence
- *     3-12, spoke ratios up to 10, tests/experiments/RESULTS.md: 0.33 keeps the largest |K| in
- *     the hole within twice the surround's and without a K sign change on 34 of 36 stars of
- *     valence 5-12; longer tangents bulge, shorter ones pinch).
+ *     subdominant eigenvalues), s = CCN__FILL_CAP_TANGENT (tests/experiments/RESULTS.md: at
+ *     the export's fill level 0.33 kept the fill's largest |K| within twice the exact pieces'
+ *     around it on 34 of 36 random stars of valence 5-12; in the plan's harness 0.4-0.5 lower
+ *     it somewhat, 0.2 and 0.7 raise it: shorter tangents pinch, longer ones bulge).
  *   - At u = 0 the relation D_{k+1} + beta D_{k-1} = gamma D_k holds among the characteristic
  *     map's planar spoke vectors c(k) = R_{E_k} (L R)^-1, so beta(0), gamma(0) solve it in the
  *     plane, for every position of the ring.
@@ -27,7 +27,9 @@
  *     intervals d (the far sides are halves of the level-K edges opposite spokes k+1 and k-1),
  *     so beta(2) = d_{k+1} / d_{k-1}, gamma(2) = 0.
  * The operator depends on the weights only (fill/g1_fill.c); the fill is built around the EV's
- * limit point (translated there and back) so that its rounding is that of the hole's size. */
+ * limit point (translated there and back) so that its rounding is that of the hole's size.
+ * Measured not fair enough to be the default cap (docs/caps.md): exactly G1 and finite, but its
+ * curvature jumps across the spokes and peaks at the vertex. */
 #include "surface/fill_cap.h"
 
 #include "base/error.h"
