@@ -152,8 +152,6 @@ void ccn__g1_operator_destroy(ccn__g1_operator *op) {
     free(op);
 }
 
-int32_t ccn__g1_operator_valence(const ccn__g1_operator *op) { return op->n; }
-
 int ccn__g1_operator_create(int32_t n, const ccn__g1_weights *wt, ccn__g1_operator **out) {
     *out = NULL;
     if (n < 2 || n > CCN_FILL_G1_DENSE_SPOKES) return 0;

@@ -47,7 +47,6 @@ typedef struct ccn__g1_operator ccn__g1_operator;
 int ccn__g1_operator_create(int32_t n, const ccn__g1_weights *wt, ccn__g1_operator **out);
 void ccn__g1_operator_apply(const ccn__g1_operator *op, const double (*cs)[5][5][3],
                             double (*q)[CCN_FILL_G1_POLES][CCN_FILL_G1_POLES][3]);
-int32_t ccn__g1_operator_valence(const ccn__g1_operator *op);
 void ccn__g1_operator_destroy(ccn__g1_operator *op);
 
 /* A fill sector q at (u, v) in [0, 2]^2: the point x, its first derivatives du, dv and (d2 not

@@ -16,7 +16,6 @@ static void rotate(double b[4][4][3], int32_t r) {
     }
 }
 
-
 /* Aligned cells (packs.c's convention): a base half-edge b of face hface[b] runs along +u. */
 static int32_t step_u(const ccn_mesh *m, int32_t b) {
     if (b < 0) return -1;

@@ -142,8 +142,6 @@ static void test_continuity(void) {
     CHECK(r2 <= 10, "sweep: step %.2f x median", r2);
 }
 
-typedef struct { double worst; int32_t n; const fplan *p; const uint8_t *hole; double size; } on_patch;
-
 static void test_patches_are_the_surface(void) {
     fcage c;
     fill_star(8, 4, 1, &c);
