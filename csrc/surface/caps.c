@@ -48,7 +48,7 @@
  * blended with the exact-surround cap and the exact limit there (the uniform twin's weight
  * falling smoothly from 1 at equality to 0 at the band's end), and the surface moves
  * continuously as an interval leaves equality; within the band the ring faces are the exact
- * limit only up to that blend (as the ring faces of equal intervals' caps are). */
+ * limit only up to that blend, which fades out across them (twin_ring_weight). */
 #define CCN_CAP_UNIFORM_BAND 0.01
 #ifndef CCN_CAP_EXACT_SURROUND_ALWAYS
 #define CCN_CAP_EXACT_SURROUND_ALWAYS 0
@@ -503,8 +503,25 @@ static void blend_normal(double a[3], const double b[3], double w) {
     for (int k = 0; k < 3; k++) a[k] = m[k] / l;
 }
 
+/* The weight of a uniform twin's ring face f at its (u, v) (face frame, corner j at UNIT[j]):
+ * wu at the corners on the cap's 1-ring (the hole's border), 0 at the others, in between the
+ * tensor product of smoothsteps, so that the weight and its slope across the face's edges are
+ * continuous and vanish on the ring's outer edge: there the surface is the exact limit, C1. */
+static double twin_ring_weight(const ccn_plan *p, const ccn__cap *cp, int32_t f, double u, double v) {
+    const ccn_mesh *mK = p->lev[p->K];
+    double su = u * u * (3 - 2 * u), sv = v * v * (3 - 2 * v), t = 0;
+    const double h[4] = {(1 - su) * (1 - sv), su * (1 - sv), su * sv, (1 - su) * sv};
+    for (int32_t j = 0; j < 4 && j < ccn__fsize(mK, f); j++) {
+        int32_t w = mK->hvert[mK->fstart[f] + j], on = 0;
+        for (int32_t r = 0; r < 2 * cp->n && !on; r++) on = cp->ring[r] == w;
+        t += on ? h[j] : 0;
+    }
+    return cp->wu * t;
+}
+
 /* The faces around each hole: bicubic patches of the level-K net (see surface/plan_types.h);
- * around a cap with a uniform twin (wu > 0) blended with the exact limit already there. */
+ * around a cap with a uniform twin (wu > 0) blended with the exact limit already there
+ * (twin_ring_weight). */
 static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) {
     const ccn_mesh *mK = p->lev[p->K];
     int pinned = p->opts.boundary_corners == CCN_CORNERS_PINNED;
@@ -519,7 +536,8 @@ static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) 
         int32_t o = p->bv_out[i];
         if (written) written[o] = 1;
         const ccn__cap *cp = &p->caps[p->rf_cap[p->bv_rf[i]]];
-        double wr = cp->exact_surround ? cp->wu : 1, *po = out->positions + 3 * (size_t)o;
+        double wr = cp->exact_surround ? twin_ring_weight(p, cp, p->rf_face[p->bv_rf[i]], p->bv_uv[2 * i], p->bv_uv[2 * i + 1]) : 1;
+        double *po = out->positions + 3 * (size_t)o;
         double *no = out->normals ? out->normals + 3 * (size_t)o : NULL, nn[3];
         if (wr < 1)
             for (int k = 0; k < 3; k++) po[k] = wr * x[k] + (1 - wr) * po[k];
