@@ -444,13 +444,14 @@ static ccn_status evaluate(ccn_plan *p, const double *positions, ccn_limit_mesh 
         memset(written, 0, (size_t)p->nout_v);
         for (int32_t i = 0; i < r->nrows; i++) written[r->rows[i]] = 1;
         eval_stencils(p, out, r->rows, r->nrows);
-        /* a cap blended with the refined limit (caps.c) reads the limit in its whole hole, the
-         * ring faces of a cap with a uniform twin read it on them */
+        /* a cap blended with the refined limit (caps.c) reads the limit in its whole hole (not
+         * one with a fill cap: that is what it is blended with), the ring faces of a cap with a
+         * uniform twin read it on them */
         int32_t nb = 0, *blend = NULL;
         for (int32_t i = 0; i < p->nhv + p->nbv; i++) {
             const ccn__cap *cp = &p->caps[i < p->nhv ? p->hv_cap[i] : p->rf_cap[p->bv_rf[i - p->nhv]]];
             int32_t o = i < p->nhv ? p->hv_out[i] : p->bv_out[i - p->nhv];
-            if ((i < p->nhv ? cp->w < 1 : cp->exact_surround) && !written[o]) {
+            if ((i < p->nhv ? cp->w < 1 && !cp->fill : cp->exact_surround) && !written[o]) {
                 if (!blend && !(blend = malloc(sizeof(int32_t) * (size_t)(p->nhv + p->nbv)))) {
                     ccn__edit_region_free(r);
                     return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
