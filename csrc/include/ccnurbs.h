@@ -529,7 +529,8 @@ typedef struct {
  * plan's bicubic patches and bi-5 rings and caps around extraordinary points, and where the
  * plan has no patch (cap fallbacks, smooth boundary corners, boundary EVs) the exact pieces
  * of a deeper local refinement closed by fill faces, whose G1 deviation is measured. Faces
- * share their edges (one shell; closed cages: a solid). opts NULL = defaults; info may be
+ * share their edges, one shell per connected part of the cage, in the file part by part (closed
+ * cages: a solid per part). opts NULL = defaults; info may be
  * NULL. Nothing is written if the status is not CCN_OK before output starts. A bi-5 plan
  * whose caps were not built (ccn_plan_stats.num_caps_deferred > 0: output level not above the cap
  * level) is CCN_ERR_ARGUMENT: create it with more levels. */

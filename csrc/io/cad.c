@@ -296,7 +296,7 @@ static void uf_union(int32_t *parent, int32_t a, int32_t b) {
 void ccn__cad_topo_free(ccn__cad_topo *t) {
     free(t->face_seg); free(t->seg_face); free(t->seg_side); free(t->seg_lo); free(t->seg_hi);
     free(t->seg_vert); free(t->vert_pos); free(t->seg_edge); free(t->seg_sense);
-    free(t->edge_seg); free(t->edge_vert);
+    free(t->edge_seg); free(t->edge_vert); free(t->face_shell); free(t->shell_closed);
     memset(t, 0, sizeof *t);
 }
 
@@ -504,6 +504,33 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
             t->seg_sense[b] = (uint8_t)!fwd;
         }
     }
+    /* shells: faces joined through shared segments, numbered in the order of their first face
+     * (a cage of several parts is several shells, each a solid when closed) */
+    int32_t nf = m->num_faces;
+    t->face_shell = malloc(sizeof(int32_t) * (size_t)nf);
+    int32_t *fp = malloc(sizeof(int32_t) * (size_t)nf);
+    if (!t->face_shell || !fp) {
+        free(fp);
+        ccn__cad_topo_free(t);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    }
+    for (int32_t f = 0; f < nf; f++) fp[f] = f, t->face_shell[f] = -1;
+    for (int32_t a = 0; a < t->num_segs; a++)
+        if (m->adjacency[a] >= 0) uf_union(fp, t->seg_face[a], t->seg_face[m->adjacency[a]]);
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t r = uf_find(fp, f);
+        if (t->face_shell[r] < 0) t->face_shell[r] = t->num_shells++;
+        t->face_shell[f] = t->face_shell[r];
+    }
+    free(fp);
+    t->shell_closed = malloc((size_t)t->num_shells);
+    if (!t->shell_closed) {
+        ccn__cad_topo_free(t);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
+    }
+    memset(t->shell_closed, 1, (size_t)t->num_shells);
+    for (int32_t a = 0; a < t->num_segs; a++)
+        if (m->adjacency[a] < 0) t->shell_closed[t->face_shell[t->seg_face[a]]] = 0;
     return CCN_OK;
 }
 

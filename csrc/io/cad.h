@@ -62,13 +62,15 @@ typedef struct {
 /* Output sink: returns 0 on success, non-zero to stop (the writer returns CCN_ERR_IO). */
 typedef int (*ccn__cad_write_fn)(void *user, const char *data, size_t len);
 
-/* STEP AP214 (ISO 10303-21), lengths in millimetres. A closed shell (every side shared) is a
- * CLOSED_SHELL in a MANIFOLD_SOLID_BREP (ADVANCED_BREP_SHAPE_REPRESENTATION), otherwise an
- * OPEN_SHELL in a SHELL_BASED_SURFACE_MODEL (MANIFOLD_SURFACE_SHAPE_REPRESENTATION). */
+/* STEP AP214 (ISO 10303-21), lengths in millimetres. One shell per connected component of
+ * faces: when every side is shared, each is a CLOSED_SHELL in its own MANIFOLD_SOLID_BREP
+ * (ADVANCED_BREP_SHAPE_REPRESENTATION), otherwise all are in one SHELL_BASED_SURFACE_MODEL
+ * (MANIFOLD_SURFACE_SHAPE_REPRESENTATION), OPEN_SHELL or CLOSED_SHELL each. */
 ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
                            ccn_error *err);
 /* IGES 5.3, millimetres: 128 surfaces in the B-rep entities 502 vertex list, 504 edge list,
- * 508 loop, 510 face, 514 shell (form 1 closed, 2 open) and, when closed, 186 manifold solid. */
+ * 508 loop, 510 face, one 514 shell per connected component (form 1 closed, 2 open) and, when
+ * every side is shared, a 186 manifold solid per shell. */
 ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *user,
                            ccn_error *err);
 
@@ -95,6 +97,9 @@ typedef struct {
     uint8_t *seg_sense;       /* num_segs */
     int32_t *edge_seg;        /* num_edges */
     int32_t *edge_vert;       /* 2 * num_edges */
+    int32_t num_shells;       /* connected components of faces (through shared segments) */
+    int32_t *face_shell;      /* num_faces: shells numbered in the order of their first face */
+    uint8_t *shell_closed;    /* num_shells: every segment of the shell's faces shared */
 } ccn__cad_topo;
 
 /* Validates the model (every error names the face or side) and builds its topology. */

@@ -187,6 +187,51 @@ static int32_t uf_find(int32_t *p, int32_t x) {
     return x;
 }
 
+/* The faces grouped by connected component (stably, components in the order of their first
+ * face): the writers put each component in a shell of its own, and a reader meets the faces
+ * shell by shell, so this makes the file's face order (face_fn's) the order a reader sees. */
+static ccn_status order_by_shell(ccn__xmodel *xm, const ccn_mesh *cage, ccn_error *err) {
+    int32_t *bs = NULL, *adj = NULL;
+    double *br = NULL;
+    uint8_t *crease = NULL;
+    ccn_status st = ccn__xtopo_build(xm, cage, &bs, &br, &adj, &crease, err);
+    if (st) return st;
+    int32_t nf = xm->num_faces;
+    int32_t *uf = malloc(sizeof(int32_t) * (size_t)nf), *segf = malloc(sizeof(int32_t) * (size_t)(4 * nf + bs[4 * nf]));
+    int32_t *comp = malloc(sizeof(int32_t) * (size_t)nf), *count = calloc((size_t)nf + 1, sizeof(int32_t));
+    ccn__xface *sorted = malloc(sizeof(ccn__xface) * (size_t)nf);
+    if (!uf || !segf || !comp || !count || !sorted) {
+        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export shells)");
+        goto done;
+    }
+    for (int32_t f = 0; f < nf; f++) {
+        uf[f] = f, comp[f] = -1;
+        for (int32_t j = 4 * f + bs[4 * f]; j < 4 * (f + 1) + bs[4 * (f + 1)]; j++) segf[j] = f;
+    }
+    for (int32_t j = 0; j < 4 * nf + bs[4 * nf]; j++) {
+        if (adj[j] < 0) continue;
+        int32_t a = uf_find(uf, segf[j]), b = uf_find(uf, segf[adj[j]]);
+        if (a != b) uf[a < b ? b : a] = a < b ? a : b;
+    }
+    int32_t nc = 0, sorted_already = 1;
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t r = uf_find(uf, f);
+        if (comp[r] < 0) comp[r] = nc++;
+        comp[f] = comp[r];
+        sorted_already &= f == 0 || comp[f] >= comp[f - 1];
+    }
+    if (!sorted_already) {
+        for (int32_t f = 0; f < nf; f++) count[comp[f] + 1]++;
+        for (int32_t c = 0; c < nc; c++) count[c + 1] += count[c];
+        for (int32_t f = 0; f < nf; f++) sorted[count[comp[f]]++] = xm->faces[f];
+        memcpy(xm->faces, sorted, sizeof(ccn__xface) * (size_t)nf);
+    }
+done:
+    free(uf); free(segf); free(comp); free(count); free(sorted);
+    free(bs); free(br); free(adj); free(crease);
+    return st;
+}
+
 /* ---- output ------------------------------------------------------------------------ */
 
 typedef struct {
@@ -417,6 +462,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_NONE, -1, "the cage has no surface to export");
         goto done;
     }
+    if ((st = order_by_shell(&xm, v.lev[0], err))) goto done;
     if (o.face_fn) face_map(&o, &xm);
     if ((st = ccn__xtopo_build(&xm, v.lev[0], &bs, &br, &adj, &crease, err))) goto done;
     progress(&o, 0.6);

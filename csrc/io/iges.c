@@ -5,14 +5,16 @@
  * IGES reader does not sew by default). The 5.3 B-rep class shares topology by index: one
  * 502 vertex list, one 504 edge list whose entries are 126 curves between two listed
  * vertices, and per face a 508 loop of (edge list, index, orientation) uses, a 510 face on an
- * untrimmed 128 surface, all in one 514 shell (form 1 closed, form 2 open) and, when closed,
- * a 186 manifold solid. OpenCASCADE reads that into one shell whose faces share their edges.
+ * untrimmed 128 surface, a 514 shell per connected component (form 1 closed, form 2 open) and,
+ * when every side is shared, a 186 manifold solid per shell. OpenCASCADE reads each shell with
+ * its faces sharing their edges.
  *
  * Layout: directory entry k (1-based) is on lines 2k-1, 2k; entity order: the vertex list,
  * the edge curves (cut to their segment when a side is split), the edge list, per face
- * (128, 508 with one edge use per side segment, 510), the shell, the solid. Every
- * entity except the top one is physically dependent (status 00010000), so the top entity
- * is the only root a reader transfers. The parameter section is built in memory first (the
+ * (128, 508 with one edge use per side segment, 510), the shells (one per connected component),
+ * the solids (one per shell, when every side is shared). Every
+ * entity except the top ones (the solids, else the shells) is physically dependent (status
+ * 00010000), so those are the only roots a reader transfers. The parameter section is built in memory first (the
  * directory needs each entity's first parameter line and line count).
  */
 #include "io/cad.h"
@@ -231,21 +233,30 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         pd_int(p, DEP(ks + 1));
         pd_finish(p, de, ks + 2);
     }
-    pd_begin(p, de, k_shell, 514, t->closed ? 1 : 2);
-    pd_int(p, F);
-    for (int32_t f = 0; f < F; f++) {
-        pd_int(p, DEP(2 + E + 3 * f + 2));
-        pd_int(p, 1); /* the face normal is the surface normal Su x Sv */
+    /* one 514 per connected component, then (every side shared) a 186 solid per shell; the
+     * shells, or the solids, are the file's roots */
+    int32_t S = t->num_shells;
+    for (int32_t sh = 0; sh < S; sh++) {
+        int32_t k = k_shell + sh, nsf = 0;
+        for (int32_t f = 0; f < F; f++) nsf += t->face_shell[f] == sh;
+        pd_begin(p, de, k, 514, t->shell_closed[sh] ? 1 : 2);
+        pd_int(p, nsf);
+        for (int32_t f = 0; f < F; f++) {
+            if (t->face_shell[f] != sh) continue;
+            pd_int(p, DEP(2 + E + 3 * f + 2));
+            pd_int(p, 1); /* the face normal is the surface normal Su x Sv */
+        }
+        pd_finish(p, de, k);
+        de[k].top = !t->closed;
     }
-    pd_finish(p, de, k_shell);
-    de[k_shell].top = !t->closed;
-    if (t->closed) {
-        pd_begin(p, de, k_shell + 1, 186, 0);
-        pd_int(p, DEP(k_shell));
+    for (int32_t sh = 0; t->closed && sh < S; sh++) {
+        int32_t k = k_shell + S + sh;
+        pd_begin(p, de, k, 186, 0);
+        pd_int(p, DEP(k_shell + sh));
         pd_int(p, 1); /* the shell's face normals point out of the solid */
         pd_int(p, 0); /* no void shells */
-        pd_finish(p, de, k_shell + 1);
-        de[k_shell + 1].top = 1;
+        pd_finish(p, de, k);
+        de[k].top = 1;
     }
 #undef DEP
     return p->oom ? CCN_ERR_MEMORY : p->too_long ? CCN_ERR_ARGUMENT : CCN_OK;
@@ -266,7 +277,7 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         for (size_t i = 0; i < 3 * (size_t)s->num_poles[0] * (size_t)s->num_poles[1]; i++)
             maxc = s->poles[i] > maxc ? s->poles[i] : -s->poles[i] > maxc ? -s->poles[i] : maxc;
     }
-    int32_t nde = 4 + t.num_edges + 3 * m->num_faces;
+    int32_t nde = 2 + t.num_edges + 3 * m->num_faces + (t.closed ? 2 : 1) * t.num_shells;
     iges_de *de = calloc((size_t)nde, sizeof *de);
     double *pts = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
     ccn__cad_curve c = {0, 0, pts + 3 * (size_t)maxp, pts, 0}; /* poles, then knots */
@@ -286,7 +297,6 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }
-    if (!t.closed) nde--; /* no solid */
     ccn__cad_out_init(o, fn, user);
     int32_t ns = 0, ng = 0;
     const char *name = m->name ? m->name : "ccnurbs";

@@ -194,7 +194,7 @@ static void header(step_w *w, const char *name, const char *stamp) {
 }
 
 /* Context, units, representation and the product structure around the shape item. */
-static void trailer(step_w *w, const char *name, int closed, int32_t item, double tol) {
+static void trailer(step_w *w, const char *name, int closed, const int32_t *items, int32_t nitems, double tol) {
     char r[32];
     ccn__cad_out *o = &w->o;
     int32_t mm = ent(w);
@@ -219,9 +219,11 @@ static void trailer(step_w *w, const char *name, int closed, int32_t item, doubl
     int32_t ax = ent(w);
     ccn__cad_printf(o, "AXIS2_PLACEMENT_3D('',#%d,#%d,#%d);\n", (int)p0, (int)dz, (int)dx);
     int32_t rep = ent(w);
-    ccn__cad_printf(o, "%s('%s',(#%d,#%d),#%d);\n",
+    ccn__cad_printf(o, "%s('%s',(#%d",
                     closed ? "ADVANCED_BREP_SHAPE_REPRESENTATION" : "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
-                    name, (int)ax, (int)item, (int)ctx);
+                    name, (int)ax);
+    for (int32_t k = 0; k < nitems; k++) ccn__cad_printf(o, ",%s#%d", k % 8 == 7 ? "\n" : "", (int)items[k]);
+    ccn__cad_printf(o, "),#%d);\n", (int)ctx);
     int32_t app = ent(w);
     ccn__cad_puts(o, "APPLICATION_CONTEXT('automotive design');\n");
     ent(w);
@@ -263,13 +265,15 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         maxids = ns > maxids ? ns : maxids;
     }
     maxids = (size_t)maxp > maxids ? (size_t)maxp : maxids;
+    maxids = (size_t)t.num_shells > maxids ? (size_t)t.num_shells : maxids; /* the solids */
     int32_t *vert_id = malloc(sizeof(int32_t) * (size_t)t.num_verts);
     int32_t *edge_id = malloc(sizeof(int32_t) * (size_t)t.num_edges);
     int32_t *face_id = malloc(sizeof(int32_t) * (size_t)m->num_faces);
+    int32_t *shell_id = malloc(sizeof(int32_t) * (size_t)t.num_shells);
     double *scratch = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
     int32_t *ids = malloc(sizeof(int32_t) * maxids);
     step_w *w = calloc(1, sizeof *w);
-    if (!vert_id || !edge_id || !face_id || !scratch || !ids || !w) {
+    if (!vert_id || !edge_id || !face_id || !shell_id || !scratch || !ids || !w) {
         st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
         goto done;
     }
@@ -285,20 +289,38 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     ccn__cad_curve c = {0, 0, scratch + 3 * (size_t)maxp, scratch, 0}; /* poles, then knots */
     for (int32_t e = 0; e < t.num_edges; e++) edge_id[e] = edge_curve(w, m, &t, vert_id, e, &c, ids);
     for (int32_t f = 0; f < m->num_faces; f++) face_id[f] = face(w, m, &t, edge_id, f, ids);
-    int32_t shell = ent(w);
-    ccn__cad_printf(&w->o, "%s('',(", t.closed ? "CLOSED_SHELL" : "OPEN_SHELL");
-    for (int32_t f = 0; f < m->num_faces; f++)
-        ccn__cad_printf(&w->o, "%s#%d", f ? (f % 8 ? "," : ",\n") : "", (int)face_id[f]);
-    ccn__cad_puts(&w->o, "));\n");
-    int32_t item = ent(w);
-    if (t.closed) ccn__cad_printf(&w->o, "MANIFOLD_SOLID_BREP('%s',#%d);\n", name, (int)shell);
-    else ccn__cad_printf(&w->o, "SHELL_BASED_SURFACE_MODEL('%s',(#%d));\n", name, (int)shell);
-    trailer(w, name, t.closed, item, t.tolerance);
+    /* one shell per connected component; closed: a solid each, else one surface model */
+    for (int32_t sh = 0; sh < t.num_shells; sh++) {
+        shell_id[sh] = ent(w);
+        ccn__cad_printf(&w->o, "%s('',(", t.shell_closed[sh] ? "CLOSED_SHELL" : "OPEN_SHELL");
+        int32_t k = 0;
+        for (int32_t f = 0; f < m->num_faces; f++)
+            if (t.face_shell[f] == sh) {
+                ccn__cad_printf(&w->o, "%s#%d", k ? (k % 8 ? "," : ",\n") : "", (int)face_id[f]);
+                k++;
+            }
+        ccn__cad_puts(&w->o, "));\n");
+    }
+    int32_t nitems = 0;
+    if (t.closed)
+        for (int32_t sh = 0; sh < t.num_shells; sh++) {
+            ids[nitems++] = ent(w);
+            if (t.num_shells == 1) ccn__cad_printf(&w->o, "MANIFOLD_SOLID_BREP('%s',#%d);\n", name, (int)shell_id[sh]);
+            else ccn__cad_printf(&w->o, "MANIFOLD_SOLID_BREP('%s %d',#%d);\n", name, (int)sh + 1, (int)shell_id[sh]);
+        }
+    else {
+        ids[nitems++] = ent(w);
+        ccn__cad_printf(&w->o, "SHELL_BASED_SURFACE_MODEL('%s',(", name);
+        for (int32_t sh = 0; sh < t.num_shells; sh++)
+            ccn__cad_printf(&w->o, "%s#%d", sh ? (sh % 8 ? "," : ",\n") : "", (int)shell_id[sh]);
+        ccn__cad_puts(&w->o, "));\n");
+    }
+    trailer(w, name, t.closed, ids, nitems, t.tolerance);
     if (ccn__cad_flush(&w->o))
         st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
 done:
     if (w) free(w->pts);
-    free(vert_id); free(edge_id); free(face_id); free(scratch); free(ids); free(w);
+    free(vert_id); free(edge_id); free(face_id); free(shell_id); free(scratch); free(ids); free(w);
     ccn__cad_topo_free(&t);
     return st;
 }

@@ -1030,6 +1030,70 @@ static void test_fills_g1(void) {
     printf("# boundary vertex of 40 faces: %d fill spokes, normals across them <= %.2e rad\n", pairs, ang);
 }
 
+/* A cage of two parts (two cubes, their faces interleaved in the file): one shell per part,
+ * each a solid (STEP: CLOSED_SHELL in its MANIFOLD_SOLID_BREP; IGES: a 514 shell and an
+ * independent 186 solid each), and the faces reach the file -- and the face callback -- part
+ * by part, the order in which a reader meets them. */
+static void test_parts(void) {
+    static const int Q[6][4] = {{1, 4, 3, 2}, {5, 6, 7, 8}, {1, 2, 6, 5}, {3, 4, 8, 7}, {1, 5, 8, 4}, {2, 3, 7, 6}};
+    char text[2048];
+    size_t at = 0;
+    for (int part = 0; part < 2; part++)
+        for (int k = 0; k < 8; k++)
+            at += (size_t)snprintf(text + at, sizeof text - at, "v %d %d %d\n", ((k & 1) ^ ((k >> 1) & 1)) + 3 * part,
+                                   (k >> 1) & 1, (k >> 2) & 1);
+    for (int f = 0; f < 6; f++) /* face f of the first cube, then face f of the second */
+        for (int part = 0; part < 2; part++)
+            at += (size_t)snprintf(text + at, sizeof text - at, "f %d %d %d %d\n", Q[f][0] + 8 * part,
+                                   Q[f][1] + 8 * part, Q[f][2] + 8 * part, Q[f][3] + 8 * part);
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load(text, &obj, &cage, NULL);
+    CHECK(p != NULL, "plan of two cubes");
+    if (!p) return;
+    for (int fmt = 0; fmt < 2; fmt++) {
+        ccn_export_options eo;
+        memset(&eo, 0, sizeof eo);
+        eo.format = fmt ? CCN_EXPORT_IGES : CCN_EXPORT_STEP;
+        faces F;
+        sink s = {NULL, 0, 0, -1};
+        ccn_export_info info;
+        ccn_error err;
+        CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "export: %s", err.message);
+        sink_fn(&s, "", 1); /* a C string */
+        CHECK(info.num_shells == 2 && info.closed == 1, "%d shells, closed %d", (int)info.num_shells, (int)info.closed);
+        int part = 0, order_ok = F.n > 0, seen[2] = {0, 0};
+        for (int i = 0; i < F.n; i++) {
+            int c = F.f[i].cells[0].cage_face % 2; /* odd cage faces: the second cube */
+            for (int j = 1; j < F.f[i].ncells; j++) order_ok &= F.f[i].cells[j].cage_face % 2 == c;
+            order_ok &= c >= part;
+            part = c;
+            seen[c] = 1;
+        }
+        CHECK(order_ok && seen[0] && seen[1], "%s: faces part by part", fmt ? "IGES" : "STEP");
+        if (!fmt) {
+            int shells = 0, solids = 0;
+            for (const char *q = s.d; (q = strstr(q, "CLOSED_SHELL(")) && q < s.d + s.n; q++) shells++;
+            for (const char *q = s.d; (q = strstr(q, "MANIFOLD_SOLID_BREP(")) && q < s.d + s.n; q++) solids++;
+            CHECK(shells == 2 && solids == 2 && !strstr(s.d, "OPEN_SHELL"), "STEP: %d closed shells, %d solids",
+                  shells, solids);
+        } else {
+            int shells = 0, solids = 0, roots = 0;
+            for (const char *q = s.d, *e; q && *q; q = (e = strchr(q, '\n')) ? e + 1 : NULL) { /* directory lines */
+                if (strlen(q) < 74 || q[72] != 'D') continue;
+                if (!strncmp(q, "     514", 8)) shells++;
+                if (!strncmp(q, "     186", 8)) solids++, roots += !strncmp(q + 64, "00000000", 8);
+            }
+            CHECK(shells == 4 && solids == 4 && roots == 2, "IGES: %d shells, %d solids (%d independent)", shells / 2,
+                  solids / 2, roots);
+        }
+        faces_free(&F);
+        free(s.d);
+    }
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
 int main(void) {
     RUN(test_bad_input);
     RUN(test_torus_pack);
@@ -1042,5 +1106,6 @@ int main(void) {
     RUN(test_fills_g1);
     RUN(test_far_from_origin);
     RUN(test_knot_removal);
+    RUN(test_parts);
     return TEST_SUMMARY();
 }

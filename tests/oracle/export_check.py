@@ -9,7 +9,7 @@ corners of the cage faces in order), the patches' values from a Bernstein evalua
                   [--fallback FACES] --occt build/occt_read FILE.step|FILE.igs ...
 
 occt_read runs once per file, with --eval and (--fallback FACES) its full report, which is
-written to FILE.rep for the caller's checks.
+written to FILE.rep for the caller's checks (its warnings to FILE.rep.warn).
 
 For every limit vertex, every place (cage face, sub-quad, s, t) it has; the face map's cells
 containing it give the face and its (u, v); OpenCASCADE evaluates those (occt_read --eval)
@@ -272,8 +272,8 @@ def main():
             ed = os.path.join(T, "edges")
             cmd = [a.occt] + (["--fallback", a.fallback] if a.fallback else []) + ["--eval", rq, "--out", rs,
                                                                                     "--edges", ed, path]
-            with open(path + ".rep", "w") as rep:
-                p = subprocess.run(cmd, stdout=rep, stderr=subprocess.DEVNULL)
+            with open(path + ".rep", "w") as rep, open(path + ".rep.warn", "w") as warn:
+                p = subprocess.run(cmd, stdout=rep, stderr=warn)
             tag = "iges" if path.endswith((".igs", ".iges")) else "step"
             if p.returncode != 0:
                 print("%s_eval: failed" % tag)
