@@ -470,7 +470,19 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     if (!faces) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)"); goto done; }
     for (int32_t f = 0; f < xm.num_faces; f++) faces[f] = xm.faces[f].s;
     ccn__cad_model m = {xm.num_faces, faces, bs, br, adj, o.name, o.timestamp, o.tolerance};
-    if ((st = ccn__cad_topo_build(&m, &topo, err))) { free(faces); goto done; }
+    if ((st = ccn__cad_topo_build(&m, &topo, err))) {
+        /* the writer's check names its own faces; the user needs the cage's */
+        if (st == CCN_ERR_TOPOLOGY && err && err->element_kind == CCN_ELEM_FACE && err->element >= 0 &&
+            err->element < xm.num_faces) {
+            int32_t cf = xm.cells[xm.faces[err->element].cell0].pl.cage_face;
+            ccn__fail(err, st, CCN_ELEM_FACE, cf,
+                      "the surface over cage face %d does not close into a B-rep: two of its pieces do not "
+                      "meet along one curve, as where the surface folds onto itself (two faces back to "
+                      "back); nothing written", (int)cf);
+        }
+        free(faces);
+        goto done;
+    }
     int32_t ns = topo.num_segs;
     so = malloc(sizeof *so * (size_t)ns);
     uf = malloc(sizeof(int32_t) * (size_t)xm.num_faces);

@@ -1094,6 +1094,28 @@ static void test_parts(void) {
     ccn_obj_destroy(obj);
 }
 
+/* A sheet folded onto itself (a quad and its reverse, back to back: every vertex an interior
+ * valence-2 vertex) has no B-rep: the export refuses with a topology error naming a cage face. */
+static void test_folded(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load("v 0.1 0 0.1\nv 0.9 0 0.1\nv 0.9 0 0.9\nv 0.1 0 0.9\nf 1 2 3 4\nf 4 3 2 1\n", &obj, &cage, NULL);
+    CHECK(p != NULL, "plan of the folded sheet");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    sink s = {NULL, 0, 0, -1};
+    ccn_error err;
+    ccn_status st = ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err);
+    CHECK(st == CCN_ERR_TOPOLOGY && err.element_kind == CCN_ELEM_FACE && err.element >= 0 &&
+              err.element < cage.num_faces && strstr(err.message, "cage face") && s.n == 0,
+          "status %d, element %d/%d: %s (%zu bytes)", (int)st, (int)err.element_kind, (int)err.element,
+          err.message, s.n);
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
 int main(void) {
     RUN(test_bad_input);
     RUN(test_torus_pack);
@@ -1107,5 +1129,6 @@ int main(void) {
     RUN(test_far_from_origin);
     RUN(test_knot_removal);
     RUN(test_parts);
+    RUN(test_folded);
     return TEST_SUMMARY();
 }
