@@ -297,6 +297,7 @@ void ccn__cad_topo_free(ccn__cad_topo *t) {
     free(t->face_seg); free(t->seg_face); free(t->seg_side); free(t->seg_lo); free(t->seg_hi);
     free(t->seg_vert); free(t->vert_pos); free(t->seg_edge); free(t->seg_sense);
     free(t->edge_seg); free(t->edge_vert); free(t->face_shell); free(t->shell_closed);
+    free(t->shell_start); free(t->shell_face);
     memset(t, 0, sizeof *t);
 }
 
@@ -524,13 +525,20 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
     }
     free(fp);
     t->shell_closed = malloc((size_t)t->num_shells);
-    if (!t->shell_closed) {
+    t->shell_start = calloc((size_t)t->num_shells + 1, sizeof(int32_t));
+    t->shell_face = malloc(sizeof(int32_t) * (size_t)nf);
+    if (!t->shell_closed || !t->shell_start || !t->shell_face) {
         ccn__cad_topo_free(t);
         return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     }
     memset(t->shell_closed, 1, (size_t)t->num_shells);
     for (int32_t a = 0; a < t->num_segs; a++)
         if (m->adjacency[a] < 0) t->shell_closed[t->face_shell[t->seg_face[a]]] = 0;
+    for (int32_t f = 0; f < nf; f++) t->shell_start[t->face_shell[f] + 1]++;
+    for (int32_t sh = 0; sh < t->num_shells; sh++) t->shell_start[sh + 1] += t->shell_start[sh];
+    for (int32_t f = 0; f < nf; f++) t->shell_face[t->shell_start[t->face_shell[f]]++] = f;
+    for (int32_t sh = t->num_shells; sh > 0; sh--) t->shell_start[sh] = t->shell_start[sh - 1];
+    t->shell_start[0] = 0;
     return CCN_OK;
 }
 

@@ -100,6 +100,8 @@ typedef struct {
     int32_t num_shells;       /* connected components of faces (through shared segments) */
     int32_t *face_shell;      /* num_faces: shells numbered in the order of their first face */
     uint8_t *shell_closed;    /* num_shells: every segment of the shell's faces shared */
+    int32_t *shell_start;     /* num_shells + 1: shell s has faces shell_face[shell_start[s]..] */
+    int32_t *shell_face;      /* num_faces: the faces shell by shell, each shell's in face order */
 } ccn__cad_topo;
 
 /* Validates the model (every error names the face or side) and builds its topology. */

@@ -11,10 +11,10 @@
  *
  * Layout: directory entry k (1-based) is on lines 2k-1, 2k; entity order: the vertex list,
  * the edge curves (cut to their segment when a side is split), the edge list, per face
- * (128, 508 with one edge use per side segment, 510), the shells (one per connected component),
- * the solids (one per shell, when every side is shared). Every
- * entity except the top ones (the solids, else the shells) is physically dependent (status
- * 00010000), so those are the only roots a reader transfers. The parameter section is built in memory first (the
+ * (128, 508 with one edge use per side segment, 510), the shells (one per connected
+ * component), the solids (one per shell, when every side is shared). Every entity except the
+ * top ones (the solids, else the shells) is physically dependent (status 00010000), so those
+ * are the only roots a reader transfers. The parameter section is built in memory first (the
  * directory needs each entity's first parameter line and line count).
  */
 #include "io/cad.h"
@@ -237,13 +237,11 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
      * shells, or the solids, are the file's roots */
     int32_t S = t->num_shells;
     for (int32_t sh = 0; sh < S; sh++) {
-        int32_t k = k_shell + sh, nsf = 0;
-        for (int32_t f = 0; f < F; f++) nsf += t->face_shell[f] == sh;
+        int32_t k = k_shell + sh;
         pd_begin(p, de, k, 514, t->shell_closed[sh] ? 1 : 2);
-        pd_int(p, nsf);
-        for (int32_t f = 0; f < F; f++) {
-            if (t->face_shell[f] != sh) continue;
-            pd_int(p, DEP(2 + E + 3 * f + 2));
+        pd_int(p, t->shell_start[sh + 1] - t->shell_start[sh]);
+        for (int32_t q = t->shell_start[sh]; q < t->shell_start[sh + 1]; q++) {
+            pd_int(p, DEP(2 + E + 3 * t->shell_face[q] + 2));
             pd_int(p, 1); /* the face normal is the surface normal Su x Sv */
         }
         pd_finish(p, de, k);

@@ -293,12 +293,10 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     for (int32_t sh = 0; sh < t.num_shells; sh++) {
         shell_id[sh] = ent(w);
         ccn__cad_printf(&w->o, "%s('',(", t.shell_closed[sh] ? "CLOSED_SHELL" : "OPEN_SHELL");
-        int32_t k = 0;
-        for (int32_t f = 0; f < m->num_faces; f++)
-            if (t.face_shell[f] == sh) {
-                ccn__cad_printf(&w->o, "%s#%d", k ? (k % 8 ? "," : ",\n") : "", (int)face_id[f]);
-                k++;
-            }
+        for (int32_t k = t.shell_start[sh]; k < t.shell_start[sh + 1]; k++) {
+            int32_t i = k - t.shell_start[sh];
+            ccn__cad_printf(&w->o, "%s#%d", i ? (i % 8 ? "," : ",\n") : "", (int)face_id[t.shell_face[k]]);
+        }
         ccn__cad_puts(&w->o, "));\n");
     }
     int32_t nitems = 0;
