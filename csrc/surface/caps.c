@@ -503,19 +503,15 @@ static void blend_normal(double a[3], const double b[3], double w) {
     for (int k = 0; k < 3; k++) a[k] = m[k] / l;
 }
 
-/* The weight of a uniform twin's ring face f at its (u, v) (face frame, corner j at UNIT[j]):
- * wu at the corners on the cap's 1-ring (the hole's border), 0 at the others, in between the
- * tensor product of smoothsteps, so that the weight and its slope across the face's edges are
- * continuous and vanish on the ring's outer edge: there the surface is the exact limit, C1. */
-static double twin_ring_weight(const ccn_plan *p, const ccn__cap *cp, int32_t f, double u, double v) {
-    const ccn_mesh *mK = p->lev[p->K];
+/* The weight of a uniform twin's ring face rf at its (u, v) (face frame, corner j at UNIT[j]):
+ * wu at the corners on the cap's 1-ring (the hole's border, p->rf_on), 0 at the others, in
+ * between the tensor product of smoothsteps, so that the weight and its slope across the face's
+ * edges are continuous and vanish on the ring's outer edge: there the surface is the exact
+ * limit, C1. */
+static double twin_ring_weight(const ccn_plan *p, const ccn__cap *cp, int32_t rf, double u, double v) {
     double su = u * u * (3 - 2 * u), sv = v * v * (3 - 2 * v), t = 0;
     const double h[4] = {(1 - su) * (1 - sv), su * (1 - sv), su * sv, (1 - su) * sv};
-    for (int32_t j = 0; j < 4 && j < ccn__fsize(mK, f); j++) {
-        int32_t w = mK->hvert[mK->fstart[f] + j], on = 0;
-        for (int32_t r = 0; r < 2 * cp->n && !on; r++) on = cp->ring[r] == w;
-        t += on ? h[j] : 0;
-    }
+    for (int j = 0; j < 4; j++) t += p->rf_on[rf] >> j & 1 ? h[j] : 0;
     return cp->wu * t;
 }
 
@@ -536,7 +532,7 @@ static void eval_ring_faces(ccn_plan *p, ccn_limit_mesh *out, uint8_t *written) 
         int32_t o = p->bv_out[i];
         if (written) written[o] = 1;
         const ccn__cap *cp = &p->caps[p->rf_cap[p->bv_rf[i]]];
-        double wr = cp->exact_surround ? twin_ring_weight(p, cp, p->rf_face[p->bv_rf[i]], p->bv_uv[2 * i], p->bv_uv[2 * i + 1]) : 1;
+        double wr = cp->exact_surround ? twin_ring_weight(p, cp, p->bv_rf[i], p->bv_uv[2 * i], p->bv_uv[2 * i + 1]) : 1;
         double *po = out->positions + 3 * (size_t)o;
         double *no = out->normals ? out->normals + 3 * (size_t)o : NULL, nn[3];
         if (wr < 1)

@@ -47,7 +47,7 @@ void ccn_plan_destroy(ccn_plan *p) {
     free(p->curv_wuu); free(p->curv_wuv); free(p->curv_wvv); free(p->curv_other);
     free(p->sv_out); free(p->sv_sec); free(p->sec_start); free(p->sec_v); free(p->sec_wu);
     free(p->sec_wv); free(p->corner_sec); free(p->sec_nrm); free(p->hv_out); free(p->hv_cap); free(p->hv_sector); free(p->hv_uv);
-    free(p->rf_face); free(p->rf_cap); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
+    free(p->rf_face); free(p->rf_cap); free(p->rf_on); free(p->rf_bez); free(p->bv_out); free(p->bv_rf); free(p->bv_uv);
     for (int32_t c = 0; c < p->nfv; c++) ccn__fvchan_free(p->fv[c]);
     free(p->fv); free(p->vd_buf);
     ccn__ev_cache_destroy(p->ev_cache);

@@ -107,6 +107,7 @@ struct ccn_plan {
      * not for exact_surround caps, whose surround is the limit itself */
     int32_t nrf, *rf_face;  /* distinct faces */
     int32_t *rf_cap;        /* the cap of each (the weight of its bicubic patch: 1, or the cap's wu) */
+    uint8_t *rf_on;         /* per face: bit j set where its corner j is on the cap's 1-ring */
     double *rf_bez;         /* 48 doubles per face, filled by evaluate */
     int32_t nbv;            /* output vertices on those faces */
     int32_t *bv_out, *bv_rf;

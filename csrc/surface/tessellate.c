@@ -685,8 +685,15 @@ static int walk_ring_faces(hole_walk *w, int32_t c, uint8_t *face_done) {
             if (touches || face_done[f]) continue;
             face_done[f] = 1;
             if (grow_i32(&p->rf_face, p->nrf + 1) || grow_i32(&p->rf_cap, p->nrf + 1)) return -1;
+            uint8_t *on = realloc(p->rf_on, (size_t)p->nrf + 1);
+            if (!on) return -1;
+            p->rf_on = on;
             p->rf_face[p->nrf] = f;
             p->rf_cap[p->nrf] = c;
+            p->rf_on[p->nrf] = 0; /* its corners on the 1-ring (the hole's border) */
+            for (int32_t h = mK->fstart[f]; h < mK->fstart[f + 1] && h - mK->fstart[f] < 8; h++)
+                for (int32_t r = 0; r < 2 * cp->n; r++)
+                    if (cp->ring[r] == mK->hvert[h]) p->rf_on[p->nrf] |= (uint8_t)(1u << (h - mK->fstart[f]));
             w->rf = p->nrf++;
             double cc[4][2];
             memcpy(cc, UNIT, sizeof cc);

@@ -1102,11 +1102,9 @@ static void test_folded(void) {
     ccn_plan *p = load("v 0.1 0 0.1\nv 0.9 0 0.1\nv 0.9 0 0.9\nv 0.1 0 0.9\nf 1 2 3 4\nf 4 3 2 1\n", &obj, &cage, NULL);
     CHECK(p != NULL, "plan of the folded sheet");
     if (!p) return;
-    ccn_export_options eo;
-    memset(&eo, 0, sizeof eo);
     sink s = {NULL, 0, 0, -1};
     ccn_error err;
-    ccn_status st = ccn_plan_export(p, NULL, &eo, sink_fn, &s, NULL, &err);
+    ccn_status st = ccn_plan_export(p, NULL, NULL, sink_fn, &s, NULL, &err); /* default options */
     CHECK(st == CCN_ERR_TOPOLOGY && err.element_kind == CCN_ELEM_FACE && err.element >= 0 &&
               err.element < cage.num_faces && strstr(err.message, "cage face") && s.n == 0,
           "status %d, element %d/%d: %s (%zu bytes)", (int)st, (int)err.element_kind, (int)err.element,
