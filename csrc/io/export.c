@@ -188,22 +188,17 @@ static int32_t uf_find(int32_t *p, int32_t x) {
 }
 
 /* The faces grouped by connected component (stably, components in the order of their first
- * face): the writers put each component in a shell of its own, and a reader meets the faces
- * shell by shell, so this makes the file's face order (face_fn's) the order a reader sees. */
-static ccn_status order_by_shell(ccn__xmodel *xm, const ccn_mesh *cage, ccn_error *err) {
-    int32_t *bs = NULL, *adj = NULL;
-    double *br = NULL;
-    uint8_t *crease = NULL;
-    ccn_status st = ccn__xtopo_build(xm, cage, &bs, &br, &adj, &crease, err);
-    if (st) return st;
+ * face), from the topology's side breaks bs and adjacency adj: the writers put each component
+ * in a shell of its own, and a reader meets the faces shell by shell, so this makes the file's
+ * face order (face_fn's) the order a reader sees. 1: reordered (the topology is to be rebuilt),
+ * 0: already in order, -1: out of memory. */
+static int order_by_shell(ccn__xmodel *xm, const int32_t *bs, const int32_t *adj) {
     int32_t nf = xm->num_faces;
     int32_t *uf = malloc(sizeof(int32_t) * (size_t)nf), *segf = malloc(sizeof(int32_t) * (size_t)(4 * nf + bs[4 * nf]));
     int32_t *comp = malloc(sizeof(int32_t) * (size_t)nf), *count = calloc((size_t)nf + 1, sizeof(int32_t));
     ccn__xface *sorted = malloc(sizeof(ccn__xface) * (size_t)nf);
-    if (!uf || !segf || !comp || !count || !sorted) {
-        st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export shells)");
-        goto done;
-    }
+    int r = -1;
+    if (!uf || !segf || !comp || !count || !sorted) goto done;
     for (int32_t f = 0; f < nf; f++) {
         uf[f] = f, comp[f] = -1;
         for (int32_t j = 4 * f + bs[4 * f]; j < 4 * (f + 1) + bs[4 * (f + 1)]; j++) segf[j] = f;
@@ -226,10 +221,10 @@ static ccn_status order_by_shell(ccn__xmodel *xm, const ccn_mesh *cage, ccn_erro
         for (int32_t f = 0; f < nf; f++) sorted[count[comp[f]]++] = xm->faces[f];
         memcpy(xm->faces, sorted, sizeof(ccn__xface) * (size_t)nf);
     }
+    r = !sorted_already;
 done:
     free(uf); free(segf); free(comp); free(count); free(sorted);
-    free(bs); free(br); free(adj); free(crease);
-    return st;
+    return r;
 }
 
 /* ---- output ------------------------------------------------------------------------ */
@@ -440,7 +435,6 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     double *br = NULL;
     uint8_t *crease = NULL;
     seg_of *so = NULL;
-    int32_t *uf = NULL;
     ccn__cad_topo topo;
     memset(&topo, 0, sizeof topo);
     if ((st = ccn__plan_patches_placed(plan, collect, &rl))) {
@@ -462,9 +456,15 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_NONE, -1, "the cage has no surface to export");
         goto done;
     }
-    if ((st = order_by_shell(&xm, v.lev[0], err))) goto done;
-    if (o.face_fn) face_map(&o, &xm);
     if ((st = ccn__xtopo_build(&xm, v.lev[0], &bs, &br, &adj, &crease, err))) goto done;
+    int reordered = order_by_shell(&xm, bs, adj);
+    if (reordered < 0) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export shells)"); goto done; }
+    if (reordered) { /* the sides' numbering follows the faces */
+        free(bs); free(br); free(adj); free(crease);
+        bs = adj = NULL, br = NULL, crease = NULL;
+        if ((st = ccn__xtopo_build(&xm, v.lev[0], &bs, &br, &adj, &crease, err))) goto done;
+    }
+    if (o.face_fn) face_map(&o, &xm);
     progress(&o, 0.6);
     ccn__cad_surface *faces = malloc(sizeof *faces * (size_t)xm.num_faces);
     if (!faces) { st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)"); goto done; }
@@ -485,11 +485,9 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
     }
     int32_t ns = topo.num_segs;
     so = malloc(sizeof *so * (size_t)ns);
-    uf = malloc(sizeof(int32_t) * (size_t)xm.num_faces);
-    if (!so || !uf) { free(faces); st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)"); goto done; }
+    if (!so) { free(faces); st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (export)"); goto done; }
     int64_t estimate = 0;
     for (int32_t f = 0; f < xm.num_faces; f++) {
-        uf[f] = f;
         for (int s = 0; s < 4; s++)
             for (int32_t k = 0; k <= bs[4 * f + s + 1] - bs[4 * f + s]; k++) {
                 int32_t j = 4 * f + s + bs[4 * f + s] + k;
@@ -503,12 +501,8 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         inf.num_fill_faces += X->kind == CCN_EXPORT_FACE_FILL;
         estimate += 700 + 75 * (int64_t)X->s.num_poles[0] * X->s.num_poles[1];
     }
-    for (int32_t j = 0; j < ns; j++) {
-        if (adj[j] < 0) { inf.num_boundary_edges++; continue; }
-        int32_t a = uf_find(uf, so[j].face), b = uf_find(uf, so[adj[j]].face);
-        if (a != b) uf[a < b ? b : a] = a < b ? a : b;
-    }
-    for (int32_t f = 0; f < xm.num_faces; f++) inf.num_shells += uf_find(uf, f) == f;
+    for (int32_t j = 0; j < ns; j++) inf.num_boundary_edges += adj[j] < 0;
+    inf.num_shells = topo.num_shells;
     g1_deviation(&m, &xm, so, crease, ns, &inf);
     inf.num_faces = xm.num_faces;
     inf.num_edges = topo.num_edges;
@@ -525,7 +519,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
 done:
     ccn__cad_topo_free(&topo);
     ccn__xm_free(&xm);
-    free(rl.r); free(rl.pts); free(bs); free(br); free(adj); free(crease); free(so); free(uf);
+    free(rl.r); free(rl.pts); free(bs); free(br); free(adj); free(crease); free(so);
     if (info) *info = inf;
     return st;
 }
