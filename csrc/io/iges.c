@@ -4,14 +4,14 @@
  * boundary curves, so a reader gets independent faces and must sew them (OpenCASCADE's
  * IGES reader does not sew by default). The 5.3 B-rep class shares topology by index: one
  * 502 vertex list, one 504 edge list whose entries are 126 curves between two listed
- * vertices, and per face a 508 loop of (edge list, index, orientation) uses, a 510 face on an
- * untrimmed 128 surface, a 514 shell per connected component (form 1 closed, form 2 open) and,
+ * vertices, and per face a 508 loop of (edge list, index, orientation, pcurve) uses, a 510 face
+ * on an untrimmed 128 surface, a 514 shell per connected component (form 1 closed, form 2 open) and,
  * when every side is shared, a 186 manifold solid per shell. OpenCASCADE reads each shell with
  * its faces sharing their edges.
  *
  * Layout: directory entry k (1-based) is on lines 2k-1, 2k; entity order: the vertex list,
  * the edge curves (cut to their segment when a side is split), the edge list, per face
- * (128, 508 with one edge use per side segment, 510), the shells (one per connected
+ * (128, a planar 126 pcurve per side segment, 508 with one edge use per side segment, 510), the shells (one per connected
  * component), the solids (one per shell, when every side is shared). Every entity except the
  * top ones (the solids, else the shells) is physically dependent (status 00010000), so those
  * are the only roots a reader transfers. The parameter section is built in memory first (the
@@ -157,6 +157,36 @@ static void surface_128(iges_pd *p, const ccn__cad_surface *f) {
     }
 }
 
+/* The parameter-space curve of segment j of a face: the straight line between the ends of the
+ * segment that meet its edge curve's start and end (parameters [c0, c1] of that curve, the
+ * same for every use of the edge: the writers check the uses are one curve up to an affine
+ * change, cad.h), a planar degree-1 126 in the face's (u, v), so that a reader needs no
+ * projection to place the edge on the face. */
+static void pcurve_126(iges_pd *p, const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
+                       double c0, double c1) {
+    const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
+    int s = t->seg_side[j], dir = s % 2 ? 1 : 0;
+    double x_start = s < 2 ? t->seg_lo[j] : t->seg_hi[j], x_end = s < 2 ? t->seg_hi[j] : t->seg_lo[j];
+    double lo, hi, uv[2][2];
+    ccn__cad_domain(f, 1 - dir, &lo, &hi);
+    for (int e = 0; e < 2; e++) {
+        uv[e][dir] = (e == 0) == (t->seg_sense[j] != 0) ? x_start : x_end;
+        uv[e][1 - dir] = s == 1 || s == 2 ? hi : lo;
+    }
+    pd_int(p, 1);
+    pd_int(p, 1);
+    pd_int(p, 1); /* PROP1: planar */
+    pd_int(p, 0);
+    pd_int(p, 1); /* polynomial */
+    pd_int(p, 0);
+    pd_real(p, c0); pd_real(p, c0); pd_real(p, c1); pd_real(p, c1);
+    pd_real(p, 1.0); pd_real(p, 1.0);
+    for (int e = 0; e < 2; e++) { pd_real(p, uv[e][0]); pd_real(p, uv[e][1]); pd_real(p, 0); }
+    pd_real(p, c0);
+    pd_real(p, c1);
+    pd_real(p, 0); pd_real(p, 0); pd_real(p, 1); /* the plane's normal */
+}
+
 /* Hollerith string nH... as a token. */
 static void holl(char *out, size_t cap, const char *s) { snprintf(out, cap, "%dH%s", (int)strlen(s), s); }
 
@@ -187,10 +217,13 @@ static void section_lines(ccn__cad_out *o, const char *text, char L, int32_t *co
 }
 
 static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges_pd *p,
-                           iges_de *de, ccn__cad_curve *c) {
+                           iges_de *de, ccn__cad_curve *c, double *crange) {
     int32_t E = t->num_edges, F = m->num_faces;
-    int32_t k_vl = 0, k_el = 1 + E, k_shell = 2 + E + 3 * F;
+    int32_t k_vl = 0, k_el = 1 + E, k_shell = 2 + E + 3 * F + t->num_segs;
 #define DEP(k) (2 * (long)(k) + 1)
+/* face f: its 128, a 126 pcurve per side segment, the 508 loop, the 510 face */
+#define FACE_K(f) (2 + E + 3 * (f) + t->face_seg[f])
+#define FACE_510(f) (FACE_K(f) + 2 + t->face_seg[(f) + 1] - t->face_seg[f])
     pd_begin(p, de, k_vl, 502, 1);
     pd_int(p, t->num_verts);
     for (int32_t v = 0; v < 3 * t->num_verts; v++) pd_real(p, t->vert_pos[v]);
@@ -199,6 +232,8 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         pd_begin(p, de, 1 + e, 126, 0);
         ccn__cad_segment_curve(m, t, t->edge_seg[e], c);
         curve_126(p, c, t->edge_vert[2 * e] == t->edge_vert[2 * e + 1]);
+        crange[2 * e] = c->knots[c->degree];
+        crange[2 * e + 1] = c->knots[c->num_poles];
         pd_finish(p, de, 1 + e);
     }
     pd_begin(p, de, k_el, 504, 1);
@@ -212,26 +247,34 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
     }
     pd_finish(p, de, k_el);
     for (int32_t f = 0; f < F; f++) {
-        int32_t ks = 2 + E + 3 * f;
+        int32_t ks = FACE_K(f), j0 = t->face_seg[f], nj = t->face_seg[f + 1] - j0;
         pd_begin(p, de, ks, 128, 0);
         surface_128(p, &m->faces[f]);
         pd_finish(p, de, ks);
-        pd_begin(p, de, ks + 1, 508, 1);
-        pd_int(p, t->face_seg[f + 1] - t->face_seg[f]);
-        for (int32_t j = t->face_seg[f]; j < t->face_seg[f + 1]; j++) {
+        for (int32_t j = j0; j < j0 + nj; j++) {
+            int32_t e = t->seg_edge[j];
+            pd_begin(p, de, ks + 1 + (j - j0), 126, 1);
+            pcurve_126(p, m, t, j, crange[2 * e], crange[2 * e + 1]);
+            pd_finish(p, de, ks + 1 + (j - j0));
+        }
+        pd_begin(p, de, ks + 1 + nj, 508, 1);
+        pd_int(p, nj);
+        for (int32_t j = j0; j < j0 + nj; j++) {
             pd_int(p, 0); /* an edge */
             pd_int(p, DEP(k_el));
             pd_int(p, t->seg_edge[j] + 1);
             pd_int(p, t->seg_sense[j]);
-            pd_int(p, 0); /* no parameter-space curves */
+            pd_int(p, 1); /* one parameter-space curve, */
+            pd_int(p, 1); /* isoparametric */
+            pd_int(p, DEP(ks + 1 + (j - j0)));
         }
-        pd_finish(p, de, ks + 1);
-        pd_begin(p, de, ks + 2, 510, 1);
+        pd_finish(p, de, ks + 1 + nj);
+        pd_begin(p, de, ks + 2 + nj, 510, 1);
         pd_int(p, DEP(ks));
         pd_int(p, 1);
         pd_int(p, 1); /* the loop is the outer one */
-        pd_int(p, DEP(ks + 1));
-        pd_finish(p, de, ks + 2);
+        pd_int(p, DEP(ks + 1 + nj));
+        pd_finish(p, de, ks + 2 + nj);
     }
     /* one 514 per connected component, then (every side shared) a 186 solid per shell; the
      * shells, or the solids, are the file's roots */
@@ -241,7 +284,7 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         pd_begin(p, de, k, 514, t->shell_closed[sh] ? 1 : 2);
         pd_int(p, t->shell_start[sh + 1] - t->shell_start[sh]);
         for (int32_t q = t->shell_start[sh]; q < t->shell_start[sh + 1]; q++) {
-            pd_int(p, DEP(2 + E + 3 * t->shell_face[q] + 2));
+            pd_int(p, DEP(FACE_510(t->shell_face[q])));
             pd_int(p, 1); /* the face normal is the surface normal Su x Sv */
         }
         pd_finish(p, de, k);
@@ -257,6 +300,8 @@ static ccn_status build_pd(const ccn__cad_model *m, const ccn__cad_topo *t, iges
         de[k].top = 1;
     }
 #undef DEP
+#undef FACE_K
+#undef FACE_510
     return p->oom ? CCN_ERR_MEMORY : p->too_long ? CCN_ERR_ARGUMENT : CCN_OK;
 }
 
@@ -275,13 +320,14 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         for (size_t i = 0; i < 3 * (size_t)s->num_poles[0] * (size_t)s->num_poles[1]; i++)
             maxc = s->poles[i] > maxc ? s->poles[i] : -s->poles[i] > maxc ? -s->poles[i] : maxc;
     }
-    int32_t nde = 2 + t.num_edges + 3 * m->num_faces + (t.closed ? 2 : 1) * t.num_shells;
+    int32_t nde = 2 + t.num_edges + 3 * m->num_faces + t.num_segs + (t.closed ? 2 : 1) * t.num_shells;
     iges_de *de = calloc((size_t)nde, sizeof *de);
+    double *crange = malloc(sizeof(double) * 2 * ((size_t)t.num_edges + 1));
     double *pts = malloc(sizeof(double) * (4 * (size_t)maxp + CCN_CAD_MAX_DEGREE + 1));
     ccn__cad_curve c = {0, 0, pts + 3 * (size_t)maxp, pts, 0}; /* poles, then knots */
     iges_pd *p = calloc(1, sizeof *p);
     ccn__cad_out *o = malloc(sizeof *o);
-    ccn_status bs = de && pts && p && o ? build_pd(m, &t, p, de, &c) : CCN_ERR_MEMORY;
+    ccn_status bs = de && pts && p && o && crange ? build_pd(m, &t, p, de, &c, crange) : CCN_ERR_MEMORY;
     if (bs == CCN_OK && 2 * (int64_t)nde > CCN_IGES_MAX_LINES) bs = CCN_ERR_ARGUMENT;
     if (bs == CCN_ERR_ARGUMENT) {
         st = ccn__fail(err, CCN_ERR_ARGUMENT, CCN_ELEM_NONE, -1,
@@ -324,7 +370,7 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
         st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the IGES file failed");
 done:
     if (p) free(p->buf);
-    free(p); free(de); free(pts); free(o);
+    free(p); free(de); free(pts); free(o); free(crange);
     ccn__cad_topo_free(&t);
     return st;
 }

@@ -1094,6 +1094,58 @@ static void test_parts(void) {
     ccn_obj_destroy(obj);
 }
 
+static int count_of(const char *d, const char *w) {
+    int n = 0;
+    for (const char *q = d; (q = strstr(q, w)); q++) n++;
+    return n;
+}
+
+/* Every edge use carries a pcurve: STEP a PCURVE per face an edge bounds inside one
+ * SURFACE_CURVE (SEAM_CURVE where a periodic face meets itself) per edge, IGES a planar 126
+ * (form 1) per loop entry, each loop entry naming one. Whether the pcurves are exact is what
+ * OpenCASCADE checks (tests/oracle/run_export.sh: normals across edges as it reads them). */
+static void test_pcurves(void) {
+    static const char *cages[2] = {"lshape", "torus"}; /* boundary edges; a periodic face */
+    for (int k = 0; k < 2; k++) {
+        ccn_obj *obj;
+        ccn_cage cage;
+        ccn_plan *p = load_at(cages[k], 3, &obj, &cage);
+        CHECK(p != NULL, "%s: plan", cages[k]);
+        if (!p) continue;
+        for (int fmt = 0; fmt < 2; fmt++) {
+            ccn_export_options eo;
+            memset(&eo, 0, sizeof eo);
+            eo.format = fmt ? CCN_EXPORT_IGES : CCN_EXPORT_STEP;
+            sink s = {NULL, 0, 0, -1};
+            ccn_export_info info;
+            ccn_error err;
+            CHECK(ccn_plan_export(p, NULL, &eo, sink_fn, &s, &info, &err) == CCN_OK, "%s: %s", cages[k], err.message);
+            sink_fn(&s, "", 1);
+            int uses = 2 * info.num_edges - info.num_boundary_edges;
+            if (!fmt) {
+                int sc = count_of(s.d, "=SURFACE_CURVE("), seam = count_of(s.d, "=SEAM_CURVE(");
+                int pc = count_of(s.d, "=PCURVE("), ec = count_of(s.d, "=EDGE_CURVE(");
+                CHECK(sc + seam == info.num_edges && ec == info.num_edges && pc == uses && (k == 0 ? seam == 0 : seam > 0),
+                      "%s STEP: %d surface curves + %d seams, %d edge curves, %d pcurves for %d edges (%d uses)",
+                      cages[k], sc, seam, ec, pc, (int)info.num_edges, uses);
+            } else {
+                int pc = 0, loops = 0;
+                for (const char *q = s.d, *e; q && *q; q = (e = strchr(q, '\n')) ? e + 1 : NULL) {
+                    if (strlen(q) < 74 || q[72] != 'D' || (atoi(q + 73) & 1) == 0) continue; /* first DE lines */
+                    const char *q2 = strchr(q, '\n');
+                    if (!strncmp(q, "     126", 8) && q2 && atoi(q2 + 1 + 32) == 1) pc++;
+                    if (!strncmp(q, "     508", 8)) loops++;
+                }
+                CHECK(pc == uses && loops == info.num_faces, "%s IGES: %d pcurves for %d edge uses, %d loops",
+                      cages[k], pc, uses, loops);
+            }
+            free(s.d);
+        }
+        ccn_plan_destroy(p);
+        ccn_obj_destroy(obj);
+    }
+}
+
 /* A sheet folded onto itself (a quad and its reverse, back to back: every vertex an interior
  * valence-2 vertex) has no B-rep: the export refuses with a topology error naming a cage face. */
 static void test_folded(void) {
@@ -1127,6 +1179,7 @@ int main(void) {
     RUN(test_far_from_origin);
     RUN(test_knot_removal);
     RUN(test_parts);
+    RUN(test_pcurves);
     RUN(test_folded);
     return TEST_SUMMARY();
 }
