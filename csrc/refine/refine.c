@@ -1,5 +1,6 @@
 /* ccn_refine (public): `levels` levels of refinement of a cage, one refine/level.c step each,
- * in a unit box (ccn__normalize) so huge coordinates cannot overflow. Catmull-Clark runs on a
+ * in a unit box around the cage (ccn__normalize) so huge coordinates cannot overflow and far ones
+ * keep their precision. Catmull-Clark runs on a
  * copy of the cage with every interval 1. ccn_fvar_refine: a face-varying channel through the
  * same levels (refine/fvar.c), the vertex mesh's topology refined alongside (its intervals and
  * creases are the channel's). */

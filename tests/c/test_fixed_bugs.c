@@ -1,8 +1,8 @@
 /* Regression tests for library bugs found by the fuzzers and the bad-input table,
  * all fixed: KB1 interior valence-2 vertices are a topology error; KB2b coordinates beyond
  * +-1e300 are an argument error; KB3 evaluate(NULL) uses the cage given to create; KB4 the
- * unit box is an exact power-of-two scaling without a centre shift, ignoring isolated
- * vertices. Inputs also in tests/fuzz/regressions/. */
+ * unit box is an exact power-of-two scaling after an exact centre shift that no part of the cage
+ * pays for, ignoring isolated vertices. Inputs also in tests/fuzz/regressions/. */
 #include "ccnurbs.h"
 #include "testlib.h"
 
@@ -160,15 +160,13 @@ static void kb3_plan_null_positions(void) {
     ccn_plan_destroy(pl);
 }
 
-/* KB4 (test_badinput.c row_isolated_vertices, after f719cec "evaluate and refine in a unit
- * box"): positions are mapped to the bounding box of *all* cage vertices, (p - centre) /
- * scale, so one far-away vertex costs every other point its precision: a unit quad plus an
- * isolated (ignored) vertex at y = 1e12 refines 2 levels 6e-5 away from the quad alone, at
- * y = 1e20 about 1 away (garbage); the plan's limit positions are 1.6e-4 / 8e3 / 1.4e14 off
- * for 1e12 / 1e20 / 1e30; the isolated vertex itself comes back moved (6 -> 0 at 1e30).
- * By the same mechanism a far second component of a cage degrades the first one.
- * Suggested: scale by a power of two only (exact in binary floating point, no centre shift),
- * and leave isolated vertices out of the box. */
+/* KB4 (test_badinput.c row_isolated_vertices): an isolated vertex far away must not cost the
+ * cage any precision. Mapping positions to the bounding box of *all* cage vertices,
+ * (p - centre) / scale, did: a unit quad plus an isolated (ignored) vertex at y = 1e12 refined 2
+ * levels 6e-5 away from the quad alone, at y = 1e20 about 1 away; the plan's limit positions
+ * were 1.6e-4 / 8e3 / 1.4e14 off for 1e12 / 1e20 / 1e30, and the isolated vertex came back
+ * moved. The unit box is the box of the vertices in faces, its shift exact and kept only where no
+ * connected part reaches farther from it than from the origin (test_locality.c: far parts). */
 static void kb4_far_vertex_precision(void) {
     if (!enabled()) return;
     const double far[3] = {1e12, 1e20, 1e30};

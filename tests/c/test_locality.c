@@ -8,7 +8,9 @@
  * own, larger or smaller, intervals: it changes the cage's largest interval and with it the
  * intervals' normalisation). Every limit sample of A must have a sample of B within 1e-14 of
  * the cage's size (the samples are the same points of the same surface; a face's rotation only
- * renumbers its grid), and the surface of B's extra part is the same as when it is alone. The
+ * renumbers its grid), and the surface of B's extra part is the same as when it is alone. Where a
+ * part lies costs it no precision: a cube 6.7e7 of its size from the origin has the normals of
+ * the cube at the origin, and a cube at the origin beside that far one keeps its own. The
  * oracle is the library's own output for the part alone, whose surface the other suites check
  * against OpenSubdiv, B-splines and the papers. */
 #include "ccnurbs.h"
@@ -224,7 +226,78 @@ static void test_parts_and_orderings(void) {
            "its own limit (bound 1e-14)\n", runs, worst, worst_part);
 }
 
+/* Where a part lies: the limit is computed relative to the cage (exact shift, power-of-two
+ * scale), so a part far from the origin has the normals it has at the origin, and a part at the
+ * origin beside a far one keeps its own precision. Oracle: the same part at the origin, alone. */
+static double *plan_normals(const double *pos, int32_t nv, const int32_t *fsz, const int32_t *fv, int32_t nf,
+                            int32_t *n_out, double **positions) {
+    ccn_cage c = {0};
+    c.num_verts = nv; c.num_faces = nf; c.positions = pos; c.face_sizes = fsz; c.face_verts = fv;
+    ccn_options o;
+    memset(&o, 0, sizeof o);
+    o.levels = 3;
+    ccn_plan *p = NULL;
+    ccn_error err;
+    if (ccn_plan_create(&c, &o, &p, &err) != CCN_OK) return NULL;
+    ccn_sizes sz;
+    ccn_plan_get_sizes(p, &sz);
+    double *nrm = malloc(sizeof(double) * 3 * (size_t)sz.num_verts), *P = malloc(sizeof(double) * 3 * (size_t)sz.num_verts);
+    ccn_limit_mesh m;
+    memset(&m, 0, sizeof m);
+    m.positions = P;
+    m.normals = nrm;
+    if (ccn_plan_evaluate(p, NULL, &m, &err) != CCN_OK) { free(nrm); free(P); nrm = P = NULL; }
+    *n_out = sz.num_verts;
+    *positions = P;
+    ccn_plan_destroy(p);
+    return nrm;
+}
+
+static void test_far_parts(void) {
+    /* a cube with one corner pulled out (EVs of valence 3, no symmetry to hide rounding) */
+    static const double cube[24] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1.375, 1.25, 1.5, 0, 1, 1};
+    const double D = 67108864.0; /* 2^26: cube + D is exact */
+    static const int32_t quads[24] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+    int32_t fsz[12], fv[48];
+    for (int i = 0; i < 12; i++) fsz[i] = 4;
+    for (int i = 0; i < 24; i++) fv[i] = quads[i], fv[24 + i] = quads[i] + 8;
+    int32_t n0, n1, n2;
+    double *P0, *P1, *P2, *N0 = plan_normals(cube, 8, fsz, fv, 6, &n0, &P0);
+    /* the cube alone, 6.7e7 of its size away */
+    double far[48], two[48];
+    for (int i = 0; i < 24; i++) far[i] = cube[i] + D, two[i] = cube[i], two[24 + i] = cube[i] + (i % 3 == 0 ? D : 0);
+    double *N1 = plan_normals(far, 8, fsz, fv, 6, &n1, &P1);
+    /* the cube at the origin beside its copy that far away */
+    double *N2 = plan_normals(two, 16, fsz, fv, 12, &n2, &P2);
+    CHECK(N0 && N1 && N2 && n1 == n0 && n2 == 2 * n0, "plans");
+    if (N0 && N1 && N2 && n1 == n0 && n2 == 2 * n0) {
+        double d1 = 0, d2 = 0, p1 = 0, p2 = 0;
+        for (int32_t i = 0; i < 3 * n0; i++) {
+            d1 = fmax(d1, fabs(N1[i] - N0[i]));
+            p1 = fmax(p1, fabs((P1[i] - D) - P0[i]));
+        }
+        for (int32_t i = 0; i < n0; i++) { /* the first part's samples, found among both parts' */
+            int32_t best = -1;
+            double bd = INFINITY;
+            for (int32_t j = 0; j < n2; j++) {
+                double d = fabs(P2[3 * j] - P0[3 * i]) + fabs(P2[3 * j + 1] - P0[3 * i + 1]) + fabs(P2[3 * j + 2] - P0[3 * i + 2]);
+                if (d < bd) bd = d, best = j;
+            }
+            p2 = fmax(p2, bd);
+            for (int k = 0; k < 3; k++) d2 = fmax(d2, fabs(N2[3 * best + k] - N0[3 * i + k]));
+        }
+        CHECK(d1 <= 1e-12 && p1 <= 2e-8, "the cube 6.7e7 away: normals %.3g, positions %.3g off (its coordinates' "
+                                         "last place 1.5e-8)", d1, p1);
+        CHECK(d2 <= 1e-12 && p2 <= 1e-14, "the cube at the origin beside one 6.7e7 away: normals %.3g, positions %.3g off",
+              d2, p2);
+        printf("# a cube 6.7e7 away: normals within %.2g of the cube at the origin; beside a far copy: %.2g (positions "
+               "%.2g)\n", d1, d2, p2);
+    }
+    free(N0); free(N1); free(N2); free(P0); free(P1); free(P2);
+}
+
 int main(void) {
     RUN(test_parts_and_orderings);
+    RUN(test_far_parts);
     return TEST_SUMMARY();
 }
