@@ -509,7 +509,9 @@ typedef struct {
     int32_t num_packs, num_bicubic, num_bi5, num_refined, num_fill_faces; /* by kind */
     int32_t num_packed_cage_faces; /* cage quads inside level-0 packs */
     int32_t num_fills;       /* holes closed by fill faces: irregular vertices without cap */
-    int32_t fill_level;      /* mesh level of the fill faces (-1: none) */
+    int32_t fill_level;      /* mesh level of the deepest fill faces, or of caps closing holes
+                              * in their place (-1: none; smooth valence-2 vertices' fills lie
+                              * fewer levels down, see docs/cad-export.md) */
     int32_t num_edges, num_vertices, num_shells, num_boundary_edges;
     int32_t closed;          /* every edge shared by two face sides: a closed shell (solid) */
     double max_g1_deviation;      /* rad: largest normal angle across shared edges, fills and

@@ -144,6 +144,20 @@ done:
     return st;
 }
 
+/* A smooth valence-2 vertex (two edges: an interior one between two faces, or an open corner
+ * of one face), none of its edges or itself sharp. Its two sectors open to a half-plane in the
+ * limit, so the exact pieces next to it grow skewed with every level and their normals (and the
+ * fills' near their degenerate corners) magnify the rounding of their poles about fourfold per
+ * level: its fills come CCN_FILL_LEVELS_V2 levels earlier (fill.h). */
+static int smooth_valence2(const ccn_mesh *m, int32_t w) {
+    if (ccn__valence(m, w) != 2 || (m->vsharp && m->vsharp[w] > 0)) return 0;
+    for (int32_t k = 0; k < 2; k++) {
+        int32_t e = ccn__fan_edge(m, w, k);
+        if (e < 0 || ccn__edge_sharp(m, e)) return 0;
+    }
+    return 1;
+}
+
 /* ---- faces -------------------------------------------------------------------------- */
 
 static void to_caller(const ccn__plan_view *v, double *p, int32_t n) {
@@ -434,7 +448,46 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
             free(tried);
             free(capcov);
             if (r < 0) goto oom;
+            /* holes closed at the last level by caps instead of fills: that level is the fills' */
+            if (last && kept < nreg && o->fill_level < level + j + 1) o->fill_level = level + j + 1;
             nreg = kept;
+        }
+        int depth = smooth_level >= 0 ? level + j + 1 - smooth_level : -1;
+        if (!last && nreg && depth >= 1 && depth >= o->levels - CCN_FILL_LEVELS_V2) {
+            /* smooth valence-2 vertices: their fills now, fewer levels down (smooth_valence2);
+             * where one cannot be placed yet, all of this level's wait for the next level */
+            uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
+            ccn__fill_level *fl = NULL;
+            if (!done_v || !cov) { free(done_v); free(cov); goto oom; }
+            int32_t nf0 = xm->num_faces, nc0 = xm->num_cells, nfill0 = o->num_fills, any = 0;
+            for (int32_t i = 0; i < nreg && !st; i++)
+                for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && !st; h++) {
+                    int32_t w = T->hvert[h];
+                    if (done_v[w] || !smooth_valence2(T, w) || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
+                    done_v[w] = 1;
+                    if (!fl && (st = ccn__fill_level_create(v, T, &fl, err))) break;
+                    st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
+                    any = 1;
+                }
+            ccn__fill_level_destroy(fl);
+            free(done_v);
+            if (st == CCN_ERR_INTERNAL) { /* not yet: undo this level's valence-2 fills */
+                for (int32_t f = nf0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
+                xm->num_faces = nf0;
+                xm->num_cells = nc0;
+                o->num_fills = nfill0;
+                memset(cov, 0, (size_t)T->nf);
+                st = CCN_OK;
+                ccn__ok(err);
+                any = 0;
+            }
+            if (st) { free(cov); goto done; }
+            int32_t kept = 0;
+            for (int32_t i = 0; i < nreg; i++)
+                if (!cov[reg[i]]) { reg[kept] = reg[i]; regpl[kept++] = regpl[i]; }
+            free(cov);
+            nreg = kept;
+            if (any && level + j + 1 > o->fill_level) o->fill_level = level + j + 1;
         }
         if (last && nreg) { /* the fill faces around each irregular vertex cover what is left */
             uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
@@ -469,7 +522,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
             } else if (st) {
                 goto done;
             } else {
-                o->fill_level = level + j + 1;
+                o->fill_level = level + j + 1; /* the deepest fills' level */
                 nreg = 0; /* done */
             }
         }

@@ -157,11 +157,12 @@ static void surface_128(iges_pd *p, const ccn__cad_surface *f) {
     }
 }
 
-/* The parameter-space curve of segment j of a face: the straight line between the ends of the
- * segment that meet its edge curve's start and end (parameters [c0, c1] of that curve, the
- * same for every use of the edge: the writers check the uses are one curve up to an affine
- * change, cad.h), a planar degree-1 126 in the face's (u, v), so that a reader needs no
- * projection to place the edge on the face. */
+/* The parameter-space curve of segment j of a face: the straight line in the face's (u, v)
+ * along the segment, run in the direction the loop uses it (OpenCASCADE's IGES reader takes a
+ * use's curves in the use's direction: run along the edge curve instead, a closed edge's use
+ * against it turned its face over, "Faces were incorrectly oriented"), over the parameters
+ * [c0, c1] of the edge curve (the uses are one curve up to an affine change, cad.h): a planar
+ * degree-1 126, so that a reader needs no projection to place the edge on the face. */
 static void pcurve_126(iges_pd *p, const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                        double c0, double c1) {
     const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
@@ -170,7 +171,7 @@ static void pcurve_126(iges_pd *p, const ccn__cad_model *m, const ccn__cad_topo 
     double lo, hi, uv[2][2];
     ccn__cad_domain(f, 1 - dir, &lo, &hi);
     for (int e = 0; e < 2; e++) {
-        uv[e][dir] = (e == 0) == (t->seg_sense[j] != 0) ? x_start : x_end;
+        uv[e][dir] = e == 0 ? x_start : x_end;
         uv[e][1 - dir] = s == 1 || s == 2 ? hi : lo;
     }
     pd_int(p, 1);
