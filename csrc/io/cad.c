@@ -85,6 +85,18 @@ static double flat_knot(const ccn__cad_surface *f, int dir, int32_t i) {
     return f->knots[dir][f->num_knots[dir] - 1];
 }
 
+void ccn__cad_segment_ends_uv(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j, int along,
+                              double a[2], double b[2]) {
+    const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
+    int s = t->seg_side[j], dir = s % 2 ? 1 : 0;
+    double lo, hi;
+    ccn__cad_domain(f, 1 - dir, &lo, &hi);
+    double x0 = s < 2 ? t->seg_lo[j] : t->seg_hi[j], x1 = s < 2 ? t->seg_hi[j] : t->seg_lo[j]; /* loop order */
+    if (along && !t->seg_sense[j]) { double x = x0; x0 = x1; x1 = x; }
+    a[dir] = x0, b[dir] = x1;
+    a[1 - dir] = b[1 - dir] = s == 1 || s == 2 ? hi : lo;
+}
+
 void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi) {
     *lo = flat_knot(f, dir, f->degree[dir]);
     *hi = flat_knot(f, dir, f->num_poles[dir]);

@@ -126,6 +126,11 @@ int32_t ccn__cad_curve_capacity(const ccn__cad_surface *f);
  * (clamped ends). */
 void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                             ccn__cad_curve *out);
+/* The ends of segment j in its face's (u, v) domain: a = where its loop use starts, b = where
+ * it ends (along = 0), or a = where its edge's curve starts, b = where it ends (along = 1). The
+ * straight line between them is the segment's pcurve (every side is an iso line). */
+void ccn__cad_segment_ends_uv(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j, int along,
+                              double a[2], double b[2]);
 /* Domain [lo, hi] of direction dir (0 = u, 1 = v). */
 void ccn__cad_domain(const ccn__cad_surface *f, int dir, double *lo, double *hi);
 /* Surface point at (u, v) by de Boor (u, v inside the domain). */

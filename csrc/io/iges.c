@@ -165,15 +165,8 @@ static void surface_128(iges_pd *p, const ccn__cad_surface *f) {
  * degree-1 126, so that a reader needs no projection to place the edge on the face. */
 static void pcurve_126(iges_pd *p, const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                        double c0, double c1) {
-    const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
-    int s = t->seg_side[j], dir = s % 2 ? 1 : 0;
-    double x_start = s < 2 ? t->seg_lo[j] : t->seg_hi[j], x_end = s < 2 ? t->seg_hi[j] : t->seg_lo[j];
-    double lo, hi, uv[2][2];
-    ccn__cad_domain(f, 1 - dir, &lo, &hi);
-    for (int e = 0; e < 2; e++) {
-        uv[e][dir] = e == 0 ? x_start : x_end;
-        uv[e][1 - dir] = s == 1 || s == 2 ? hi : lo;
-    }
+    double uv[2][2];
+    ccn__cad_segment_ends_uv(m, t, j, 0, uv[0], uv[1]);
     pd_int(p, 1);
     pd_int(p, 1);
     pd_int(p, 1); /* PROP1: planar */

@@ -134,29 +134,14 @@ static void id_list(step_w *w, const int32_t *ids, int32_t n) {
     ccn__cad_puts(&w->o, ")");
 }
 
-/* The parameter point (u, v) of segment j where its side's own parameter is x. */
-static void seg_uv(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j, double x,
-                   double uv[2]) {
-    const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
-    int s = t->seg_side[j], dir = s % 2 ? 1 : 0;
-    double lo, hi;
-    ccn__cad_domain(f, 1 - dir, &lo, &hi);
-    uv[dir] = x;
-    uv[1 - dir] = s == 1 || s == 2 ? hi : lo;
-}
-
 /* The pcurve of edge e's curve (parameters [c0, c1]) on segment j: the straight line in j's
  * face domain between the ends of the segment that meet the curve's start and end, a degree-1
  * B-spline over the same parameters, so that the curve and the pcurve agree point for point
  * (the writers check the segments are one curve up to an affine change: cad.h). */
 static int32_t pcurve(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                       double c0, double c1, int32_t surf, int32_t ctx2d) {
-    int s = t->seg_side[j];
-    double x_start = s < 2 ? t->seg_lo[j] : t->seg_hi[j]; /* in loop order */
-    double x_end = s < 2 ? t->seg_hi[j] : t->seg_lo[j];
     double a[2], b[2];
-    seg_uv(m, t, j, t->seg_sense[j] ? x_start : x_end, a);
-    seg_uv(m, t, j, t->seg_sense[j] ? x_end : x_start, b);
+    ccn__cad_segment_ends_uv(m, t, j, 1, a, b);
     int32_t pa = point_dim(w, a, 2), pb = point_dim(w, b, 2);
     char r0[32], r1[32];
     int32_t line = ent(w);
