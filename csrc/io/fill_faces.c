@@ -338,6 +338,16 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
                 for (int d = 0; d < 3; d++) c[1][d] = P[d] + X[d] - t * Ns[k][d];
             }
         }
+        if (!bnd && nsharp == 0 && m->vsharp && m->vsharp[w] > 0) {
+            /* a cone point (the vertex pinned, no sharp edge): the limit has no tangent plane
+             * there, so no two ordinary patch corners meeting at it are G1 across their spoke
+             * (their corner normals would have to agree). The corners are degenerate instead:
+             * every spoke leaves the apex with zero first derivative, so near it a sector is
+             * P + u^2 A + 2uv B + v^2 C, a quadratic cone whose normal along a spoke comes from
+             * second-order poles, which the spoke planes below make agree (measured: 0.35-0.75
+             * rad across the spokes with the spokes' tangents, 5e-12 - 1e-10 rad so) */
+            for (int32_t k = 0; k < nsp; k++) memcpy(sp[k][1], P, sizeof P);
+        }
         if (nsp == 2 && nfan == 2 && !bnd && !sharp[0] && !sharp[1] && filled[0] && filled[1]) {
             /* an interior valence-2 vertex: its sectors are half-planes, so its two spokes must
              * leave it along one line (a patch's corner cannot open wider than pi: with the
