@@ -454,7 +454,7 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         }
         int depth = smooth_level >= 0 ? level + j + 1 - smooth_level : -1;
         if (!last && nreg && depth >= 1 && depth >= o->levels - CCN_FILL_LEVELS_V2) {
-            /* smooth valence-2 vertices: their fills now, fewer levels down (smooth_valence2);
+            /* smooth valence-2 vertices: their fills at this level, fewer levels down (smooth_valence2);
              * where one cannot be placed yet, all of this level's wait for the next level */
             uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
             ccn__fill_level *fl = NULL;
