@@ -247,6 +247,48 @@ static void xm_rollback(ccn__xmodel *xm, int32_t nf0, int32_t nc0) {
     xm->num_cells = nc0;
 }
 
+/* The faces, cells and fill count before a level's fills, to undo them (fill_undo). */
+typedef struct {
+    int32_t nf, nc, nfill;
+} fill_mark;
+
+static fill_mark fill_mark_of(const ccn__xmodel *xm, const ccn__fill_opts *o) {
+    fill_mark k = {xm->num_faces, xm->num_cells, o->num_fills};
+    return k;
+}
+
+static void fill_undo(ccn__xmodel *xm, ccn__fill_opts *o, fill_mark k) {
+    xm_rollback(xm, k.nf, k.nc);
+    o->num_fills = k.nfill;
+}
+
+/* Fill faces around each irregular vertex of T's faces reg[0..nreg-1] (only the smooth
+ * valence-2 ones if only_v2), marking the faces they cover in cov; *any = 1 if one was
+ * filled. CCN_ERR_INTERNAL: a vertex's fill cannot be placed at this level (the caller
+ * undoes the level's fills and refines further). */
+static ccn_status fill_vertices(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *T,
+                                const int32_t *reg, int32_t nreg, const ccn__xplace *tpl,
+                                int only_v2, uint8_t *cov, int *any, ccn__fill_opts *o,
+                                ccn_error *err) {
+    uint8_t *done_v = calloc((size_t)T->nv, 1);
+    if (!done_v) return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (fill)");
+    ccn__fill_level *fl = NULL;
+    ccn_status st = CCN_OK;
+    for (int32_t i = 0; i < nreg && !st; i++)
+        for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && !st; h++) {
+            int32_t w = T->hvert[h];
+            if (done_v[w] || (only_v2 && !smooth_valence2(T, w)) ||
+                ccn__fill_vertex_regular(T, w, v->pinned)) continue;
+            done_v[w] = 1;
+            if (!fl && (st = ccn__fill_level_create(v, T, &fl, err))) break;
+            st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
+            *any = 1;
+        }
+    ccn__fill_level_destroy(fl);
+    free(done_v);
+    return st;
+}
+
 /* Adds the cap patches pt (around vertex u of S, operator op) to xm, placed as the plan's caps
  * (surface/patch_set.h). 1, or -1 out of memory. */
 static int add_cap(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *S, int32_t u,
@@ -456,26 +498,13 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if (!last && nreg && depth >= 1 && depth >= o->levels - CCN_FILL_LEVELS_V2) {
             /* smooth valence-2 vertices: their fills at this level, fewer levels down (smooth_valence2);
              * where one cannot be placed yet, all of this level's wait for the next level */
-            uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
-            ccn__fill_level *fl = NULL;
-            if (!done_v || !cov) { free(done_v); free(cov); goto oom; }
-            int32_t nf0 = xm->num_faces, nc0 = xm->num_cells, nfill0 = o->num_fills, any = 0;
-            for (int32_t i = 0; i < nreg && !st; i++)
-                for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && !st; h++) {
-                    int32_t w = T->hvert[h];
-                    if (done_v[w] || !smooth_valence2(T, w) || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
-                    done_v[w] = 1;
-                    if (!fl && (st = ccn__fill_level_create(v, T, &fl, err))) break;
-                    st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
-                    any = 1;
-                }
-            ccn__fill_level_destroy(fl);
-            free(done_v);
+            uint8_t *cov = calloc((size_t)T->nf, 1);
+            if (!cov) goto oom;
+            int any = 0;
+            fill_mark mark = fill_mark_of(xm, o);
+            st = fill_vertices(xm, v, T, reg, nreg, tpl, 1, cov, &any, o, err);
             if (st == CCN_ERR_INTERNAL) { /* not yet: undo this level's valence-2 fills */
-                for (int32_t f = nf0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
-                xm->num_faces = nf0;
-                xm->num_cells = nc0;
-                o->num_fills = nfill0;
+                fill_undo(xm, o, mark);
                 memset(cov, 0, (size_t)T->nf);
                 st = CCN_OK;
                 ccn__ok(err);
@@ -490,32 +519,20 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
             if (any && level + j + 1 > o->fill_level) o->fill_level = level + j + 1;
         }
         if (last && nreg) { /* the fill faces around each irregular vertex cover what is left */
-            uint8_t *done_v = calloc((size_t)T->nv, 1), *cov = calloc((size_t)T->nf, 1);
-            ccn__fill_level *fl = NULL;
-            if (!done_v || !cov) { free(done_v); free(cov); goto oom; }
-            if ((st = ccn__fill_level_create(v, T, &fl, err))) { free(done_v); free(cov); goto done; }
-            int32_t nf0 = xm->num_faces, nc0 = xm->num_cells, nfill0 = o->num_fills;
-            for (int32_t i = 0; i < nreg && !st; i++)
-                for (int32_t h = T->fstart[reg[i]]; h < T->fstart[reg[i] + 1] && !st; h++) {
-                    int32_t w = T->hvert[h];
-                    if (done_v[w] || ccn__fill_vertex_regular(T, w, v->pinned)) continue;
-                    done_v[w] = 1;
-                    st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
-                }
-            ccn__fill_level_destroy(fl);
+            uint8_t *cov = calloc((size_t)T->nf, 1);
+            if (!cov) goto oom;
+            int any = 0;
+            fill_mark mark = fill_mark_of(xm, o);
+            st = fill_vertices(xm, v, T, reg, nreg, tpl, 0, cov, &any, o, err);
             for (int32_t i = 0; i < nreg && !st; i++)
                 if (!cov[reg[i]])
                     st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, tpl[reg[i]].cage_face,
                                    "a hole near cage face %d is not around one irregular vertex",
                                    (int)tpl[reg[i]].cage_face);
-            free(done_v);
             free(cov);
             if (st == CCN_ERR_INTERNAL && level + j + 1 < CCN_FILL_MAX_LEVEL) {
                 /* irregular vertices still too close for the fill's blocks: one level more */
-                for (int32_t f = nf0; f < xm->num_faces; f++) ccn__xm_free_surface(&xm->faces[f].s);
-                xm->num_faces = nf0;
-                xm->num_cells = nc0;
-                o->num_fills = nfill0;
+                fill_undo(xm, o, mark);
                 st = CCN_OK;
                 ccn__ok(err);
                 last = 0;
