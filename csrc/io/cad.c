@@ -445,6 +445,39 @@ static int32_t seg_next(const ccn__cad_topo *t, int32_t j) {
     return j + 1 < t->face_seg[f + 1] ? j + 1 : t->face_seg[f];
 }
 
+/* Sets each vertex's position to the end pole of the first clamped edge curve ending there
+ * (the vertices of periodic sides keep the point on the side). -1: out of memory. */
+static int curve_end_vertices(const ccn__cad_model *m, ccn__cad_topo *t) {
+    int32_t cap = 0;
+    for (int32_t f = 0; f < m->num_faces; f++) {
+        int32_t c = ccn__cad_curve_capacity(&m->faces[f]);
+        cap = c > cap ? c : cap;
+    }
+    double *buf = malloc(sizeof(double) * (4 * (size_t)cap + CCN_CAD_MAX_DEGREE + 1));
+    uint8_t *set = calloc((size_t)t->num_verts + 1, 1);
+    if (!buf || !set) { free(buf); free(set); return -1; }
+    ccn__cad_curve c = {0, 0, buf + 3 * (size_t)cap, buf, 0};
+    for (int32_t e = 0; e < t->num_edges; e++) {
+        int32_t v0 = t->edge_vert[2 * e], v1 = t->edge_vert[2 * e + 1];
+        if (set[v0] && set[v1]) continue;
+        ccn__cad_segment_curve(m, t, t->edge_seg[e], &c);
+        int32_t p = c.degree, n = c.num_poles;
+        if (c.periodic || c.knots[0] != c.knots[p] || c.knots[n] != c.knots[n + p]) continue; /* not clamped */
+        if (!set[v0]) memcpy(t->vert_pos + 3 * (size_t)v0, c.poles, 3 * sizeof(double)), set[v0] = 1;
+        if (!set[v1])
+            memcpy(t->vert_pos + 3 * (size_t)v1, c.poles + 3 * (size_t)(c.num_poles - 1), 3 * sizeof(double)), set[v1] = 1;
+    }
+    free(buf);
+    free(set);
+    return 0;
+}
+
+int ccn__cad_whole_side(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j) {
+    double lo, hi;
+    ccn__cad_domain(&m->faces[t->seg_face[j]], t->seg_side[j] % 2, &lo, &hi);
+    return t->seg_lo[j] == lo && t->seg_hi[j] == hi;
+}
+
 ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_error *err) {
     memset(t, 0, sizeof *t);
     if (err) { err->status = CCN_OK; err->element_kind = CCN_ELEM_NONE; err->element = -1; err->message[0] = 0; }
@@ -499,10 +532,14 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
         t->seg_vert[i] = vid[r];
     }
     free(parent);
-    /* edges: first appearance defines the curve (increasing parameter of that side) */
+    /* edges: the curve is the iso curve of the first appearance (increasing parameter of that
+     * side), or of its twin when only the twin is a whole side: then the curve's poles are that
+     * face's own boundary poles, no knot insertion rounds them, and the file shares them */
     for (size_t i = 0; i < ns; i++) t->seg_edge[i] = -1;
-    for (int32_t a = 0; a < t->num_segs; a++) {
-        if (t->seg_edge[a] >= 0) continue;
+    for (int32_t a0 = 0; a0 < t->num_segs; a0++) {
+        if (t->seg_edge[a0] >= 0) continue;
+        int32_t a = a0, b = m->adjacency[a0];
+        if (b >= 0 && !ccn__cad_whole_side(m, t, a) && ccn__cad_whole_side(m, t, b)) a = b, b = a0;
         int32_t e = t->num_edges++;
         int fwd = t->seg_side[a] < 2; /* sides 0, 1 run in increasing parameter, 2, 3 decreasing */
         t->edge_seg[e] = a;
@@ -511,11 +548,16 @@ ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_er
         int32_t c0 = t->seg_vert[a], c1 = t->seg_vert[seg_next(t, a)];
         t->edge_vert[2 * e] = fwd ? c0 : c1;
         t->edge_vert[2 * e + 1] = fwd ? c1 : c0;
-        int32_t b = m->adjacency[a];
         if (b >= 0) {
             t->seg_edge[b] = e;
             t->seg_sense[b] = (uint8_t)!fwd;
         }
+    }
+    /* each vertex where the curve of its first edge starts or ends, bit for bit: the file
+     * writes that point once for both */
+    if (curve_end_vertices(m, t)) {
+        ccn__cad_topo_free(t);
+        return ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory");
     }
     /* shells: faces joined through shared segments, numbered in the order of their first face
      * (a cage of several parts is several shells, each a solid when closed) */
@@ -586,6 +628,14 @@ static void insert_to_degree(ccn__cad_curve *c, double x) {
     }
 }
 
+/* c's parameters mapped affinely onto [0, 1] (the shape is unchanged), so that the pcurves of
+ * edges cut from faces with [0, 1]^2 domains repeat and are written once (io/step.c). */
+static void unit_curve(ccn__cad_curve *c) {
+    double lo = c->knots[c->degree], w = c->knots[c->num_poles] - lo;
+    if (lo == 0 && w == 1) return;
+    for (int32_t i = 0; i < c->num_poles + c->degree + 1; i++) c->knots[i] = (c->knots[i] - lo) / w;
+}
+
 void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                             ccn__cad_curve *c) {
     const ccn__cad_surface *f = &m->faces[t->seg_face[j]];
@@ -599,7 +649,7 @@ void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int
         for (int32_t r = 0; r < f->mults[d][k]; r++) c->knots[i++] = f->knots[d][k];
     ccn__cad_side_curve(f, s, c->poles);
     c->periodic = f->periodic[d];
-    if (t->seg_lo[j] == lo && t->seg_hi[j] == hi) return;
+    if (t->seg_lo[j] == lo && t->seg_hi[j] == hi) { unit_curve(c); return; }
     c->periodic = 0;
     double a = t->seg_lo[j], b = t->seg_hi[j];
     /* cut at b: keep poles 0 .. (first index of b) - 1 and knots up to b (p+1 times) */
@@ -620,4 +670,5 @@ void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int
         c->knots[0] = a;
         c->num_poles -= drop;
     }
+    unit_curve(c);
 }

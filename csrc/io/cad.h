@@ -80,7 +80,8 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
  * face seg_face[j] over the parameters [seg_lo[j], seg_hi[j]] of that side's direction; a
  * face's segments are face_seg[f] .. face_seg[f+1]-1 in loop order, and seg_vert[j] is the
  * vertex where segment j starts (in loop order). Edge e is segment edge_seg[e] (its first
- * appearance); its curve is that segment's iso curve in increasing parameter, from vertex
+ * appearance, or its twin when only the twin is a whole side); its curve is that segment's
+ * iso curve in increasing parameter, from vertex
  * edge_vert[2e] to edge_vert[2e+1]. seg_edge[j] is the edge of each segment and
  * seg_sense[j] = 1 if the segment (in loop order) runs along the edge's curve, 0 against it. */
 typedef struct {
@@ -107,6 +108,8 @@ typedef struct {
 /* Validates the model (every error names the face or side) and builds its topology. */
 ccn_status ccn__cad_topo_build(const ccn__cad_model *m, ccn__cad_topo *t, ccn_error *err);
 void ccn__cad_topo_free(ccn__cad_topo *t);
+/* Is segment j its face's whole side? */
+int ccn__cad_whole_side(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j);
 
 /* The iso curve of side s of a face, in increasing parameter: its degree, the knots of
  * that direction (the caller reads them from the surface: direction (s % 2 == 0 ? u : v))
@@ -123,7 +126,7 @@ typedef struct {
 int32_t ccn__cad_curve_capacity(const ccn__cad_surface *f);
 /* The curve of segment j (increasing parameter): the side's iso curve itself when the
  * segment is the whole side, else that curve cut to [seg_lo, seg_hi] by knot insertion
- * (clamped ends). */
+ * (clamped ends); its parameters mapped affinely onto [0, 1]. */
 void ccn__cad_segment_curve(const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                             ccn__cad_curve *out);
 /* The ends of segment j in its face's (u, v) domain: a = where its loop use starts, b = where

@@ -452,6 +452,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
             goto done;
         }
     }
+    ccn__xm_unit_domains(&xm); /* patches on [0, 1]^2: shared pcurves */
     if (xm.num_faces == 0) {
         st = ccn__fail(err, CCN_ERR_TOPOLOGY, CCN_ELEM_NONE, -1, "the cage has no surface to export");
         goto done;

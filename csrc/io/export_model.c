@@ -156,3 +156,31 @@ int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const dou
     c->pl = *pl;
     return f;
 }
+
+int ccn__xm_unit_domains(ccn__xmodel *xm) {
+    int changed = 0;
+    for (int32_t f = 0; f < xm->num_faces; f++) {
+        ccn__xface *X = &xm->faces[f];
+        if (X->kind == CCN_EXPORT_FACE_PACK || X->kind == CCN_EXPORT_FACE_REFINED) continue;
+        for (int dir = 0; dir < 2; dir++) {
+            double lo, hi;
+            ccn__cad_domain(&X->s, dir, &lo, &hi);
+            if (lo == 0 && hi == 1) continue;
+            double w = hi - lo, *k = (double *)X->s.knots[dir];
+            int ok = w > 0 && isfinite(w);
+            for (int32_t i = 1; i < X->s.num_knots[dir] && ok; i++) /* still distinct */
+                ok = (k[i] - lo) / w > (k[i - 1] - lo) / w;
+            if (!ok) continue;
+            /* the same map on every value, so knots and cell bounds that were equal stay equal,
+             * and lo, hi land on 0 and 1 exactly */
+            for (int32_t i = 0; i < X->s.num_knots[dir]; i++) k[i] = (k[i] - lo) / w;
+            for (int32_t c = 0; c < X->cells_u * X->cells_v; c++) {
+                double *uv = xm->cells[X->cell0 + c].uv + 2 * dir;
+                uv[0] = (uv[0] - lo) / w;
+                uv[1] = (uv[1] - lo) / w;
+            }
+            changed = 1;
+        }
+    }
+    return changed;
+}

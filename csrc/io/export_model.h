@@ -70,6 +70,12 @@ void ccn__cad_flat_knots(const ccn__cad_surface *s, int dir, double *t);
 double ccn__cad_surface_size(const ccn__cad_surface *s, double *reach);
 /* Frees s's owned poles, knots and multiplicities (a face of the model) and zeroes s. */
 void ccn__xm_free_surface(ccn__cad_surface *s);
+/* Maps the domain of every patch face (bicubic, bi-5, fill: their parameters are their
+ * construction's own) affinely onto [0, 1]^2, knots and cells alike; the surfaces are unchanged.
+ * Faces with the same shape of domain then share their pcurves in the STEP file (io/step.c).
+ * Packs and refined pieces keep their knots: the cage's knot intervals (halved per level).
+ * A direction whose knots would no longer be distinct keeps its domain. 1 if any face changed. */
+int ccn__xm_unit_domains(ccn__xmodel *xm);
 /* A Bezier face of degree deg (pts: (deg+1)^2 x 3, first index along u) at place pl. */
 int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const double *pts,
                            const ccn__xplace *pl);

@@ -30,20 +30,27 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Points written so far by their coordinates' bits: a point shared by several curves and
- * surfaces (the boundary poles two faces and their edge share, bit for bit) is one
- * CARTESIAN_POINT that all of them reference (catmark_car: a fifth of the points, 8 MB). */
+/* Entities written so far by a key of four 64-bit words: points by their coordinates' bits (a
+ * point shared by several curves and surfaces, the boundary poles two faces and their edge
+ * share bit for bit, is one CARTESIAN_POINT that all of them reference: catmark_car, a fifth of
+ * the points, 8 MB) and pcurve lines by their end points and parameters (faces with one shape
+ * of domain repeat them: one DEFINITIONAL_REPRESENTATION serves every PCURVE along such a
+ * line). */
 typedef struct {
-    uint64_t key[3];
+    uint64_t key[4];
     int32_t id; /* 0: empty */
-} pt_slot;
+} ent_slot;
+
+typedef struct {
+    ent_slot *tab;
+    size_t n, cap; /* cap: a power of two (open addressing) */
+    int oom;       /* then: no sharing */
+} ent_table;
 
 typedef struct {
     ccn__cad_out o;
     int32_t id; /* last entity id written */
-    pt_slot *pts;
-    size_t npts, cap; /* cap: a power of two (open addressing) */
-    int oom;
+    ent_table pts, lines;
 } step_w;
 
 static int32_t ent(step_w *w) {
@@ -52,42 +59,51 @@ static int32_t ent(step_w *w) {
     return w->id;
 }
 
-static size_t pt_hash(const uint64_t k[3]) {
+static size_t ent_hash(const uint64_t k[4]) {
     uint64_t h = 1469598103934665603ull;
-    for (int i = 0; i < 3; i++) h = (h ^ k[i]) * 1099511628211ull, h ^= h >> 31;
+    for (int i = 0; i < 4; i++) h = (h ^ k[i]) * 1099511628211ull, h ^= h >> 31;
     return (size_t)h;
 }
 
-static pt_slot *pt_find(pt_slot *tab, size_t cap, const uint64_t k[3]) {
-    for (size_t i = pt_hash(k) & (cap - 1);; i = (i + 1) & (cap - 1))
-        if (!tab[i].id || (tab[i].key[0] == k[0] && tab[i].key[1] == k[1] && tab[i].key[2] == k[2]))
-            return &tab[i];
+static ent_slot *slot_find(ent_slot *tab, size_t cap, const uint64_t k[4]) {
+    for (size_t i = ent_hash(k) & (cap - 1);; i = (i + 1) & (cap - 1))
+        if (!tab[i].id || !memcmp(tab[i].key, k, sizeof tab[i].key)) return &tab[i];
 }
 
-static int pt_grow(step_w *w) {
-    size_t cap = w->cap ? 2 * w->cap : 4096;
-    pt_slot *tab = calloc(cap, sizeof *tab);
-    if (!tab) return -1;
-    for (size_t i = 0; i < w->cap; i++)
-        if (w->pts[i].id) *pt_find(tab, cap, w->pts[i].key) = w->pts[i];
-    free(w->pts);
-    w->pts = tab;
-    w->cap = cap;
-    return 0;
+/* The slot of key k: its entity if .id != 0, else where to record it (ent_add); NULL when the
+ * table is out of memory. */
+static ent_slot *ent_find(ent_table *t, const uint64_t k[4]) {
+    if (!t->oom && 2 * (t->n + 1) > t->cap) {
+        size_t cap = t->cap ? 2 * t->cap : 4096;
+        ent_slot *tab = calloc(cap, sizeof *tab);
+        if (!tab) {
+            t->oom = 1;
+        } else {
+            for (size_t i = 0; i < t->cap; i++)
+                if (t->tab[i].id) *slot_find(tab, cap, t->tab[i].key) = t->tab[i];
+            free(t->tab);
+            t->tab = tab;
+            t->cap = cap;
+        }
+    }
+    return t->oom ? NULL : slot_find(t->tab, t->cap, k);
+}
+
+static void ent_add(ent_table *t, ent_slot *s, const uint64_t k[4], int32_t id) {
+    if (!s) return;
+    memcpy(s->key, k, sizeof s->key);
+    s->id = id;
+    t->n++;
 }
 
 /* A CARTESIAN_POINT of dim 3 (p[0..2]) or 2 (p[0..1]: a parameter-space point of a pcurve,
  * kept apart from the 3D points by a NaN third key no coordinate has). */
 static int32_t point_dim(step_w *w, const double *p, int dim) {
-    uint64_t k[3];
+    uint64_t k[4] = {0, 0, 0, 0};
     memcpy(k, p, sizeof(double) * (size_t)dim);
     if (dim == 2) k[2] = 0x7ff8dead2d2d2d2dull;
-    pt_slot *s = NULL;
-    if (!w->oom && 2 * (w->npts + 1) > w->cap && pt_grow(w)) w->oom = 1; /* then: no sharing */
-    if (!w->oom) {
-        s = pt_find(w->pts, w->cap, k);
-        if (s->id) return s->id;
-    }
+    ent_slot *s = ent_find(&w->pts, k);
+    if (s && s->id) return s->id;
     char a[32], b[32], c[32];
     int32_t id = ent(w);
     if (dim == 2)
@@ -96,11 +112,7 @@ static int32_t point_dim(step_w *w, const double *p, int dim) {
     else
         ccn__cad_printf(&w->o, "CARTESIAN_POINT('',(%s,%s,%s));\n", ccn__cad_real(p[0], a),
                         ccn__cad_real(p[1], b), ccn__cad_real(p[2], c));
-    if (s) {
-        memcpy(s->key, k, sizeof k);
-        s->id = id;
-        w->npts++;
-    }
+    ent_add(&w->pts, s, k, id);
     return id;
 }
 
@@ -143,13 +155,21 @@ static int32_t pcurve(step_w *w, const ccn__cad_model *m, const ccn__cad_topo *t
     double a[2], b[2];
     ccn__cad_segment_ends_uv(m, t, j, 1, a, b);
     int32_t pa = point_dim(w, a, 2), pb = point_dim(w, b, 2);
-    char r0[32], r1[32];
-    int32_t line = ent(w);
-    ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',1,(#%d,#%d),.POLYLINE_FORM.,.F.,.F.,(2,2),"
-                           "(%s,%s),.UNSPECIFIED.);\n", (int)pa, (int)pb, ccn__cad_real(c0, r0),
-                    ccn__cad_real(c1, r1));
-    int32_t rep = ent(w);
-    ccn__cad_printf(&w->o, "DEFINITIONAL_REPRESENTATION('',(#%d),#%d);\n", (int)line, (int)ctx2d);
+    uint64_t k[4] = {(uint64_t)pa, (uint64_t)pb, 0, 0};
+    memcpy(k + 2, &c0, sizeof c0);
+    memcpy(k + 3, &c1, sizeof c1);
+    ent_slot *s = ent_find(&w->lines, k);
+    int32_t rep = s ? s->id : 0;
+    if (!rep) {
+        char r0[32], r1[32];
+        int32_t line = ent(w);
+        ccn__cad_printf(&w->o, "B_SPLINE_CURVE_WITH_KNOTS('',1,(#%d,#%d),.POLYLINE_FORM.,.F.,.F.,(2,2),"
+                               "(%s,%s),.UNSPECIFIED.);\n", (int)pa, (int)pb, ccn__cad_real(c0, r0),
+                        ccn__cad_real(c1, r1));
+        rep = ent(w);
+        ccn__cad_printf(&w->o, "DEFINITIONAL_REPRESENTATION('',(#%d),#%d);\n", (int)line, (int)ctx2d);
+        ent_add(&w->lines, s, k, rep);
+    }
     int32_t id = ent(w);
     ccn__cad_printf(&w->o, "PCURVE('',#%d,#%d);\n", (int)surf, (int)rep);
     return id;
@@ -373,7 +393,7 @@ ccn_status ccn__step_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
     if (ccn__cad_flush(&w->o))
         st = ccn__fail(err, CCN_ERR_IO, CCN_ELEM_NONE, -1, "writing the STEP file failed");
 done:
-    if (w) free(w->pts);
+    if (w) free(w->pts.tab), free(w->lines.tab);
     free(vert_id); free(edge_id); free(face_id); free(surf_id); free(shell_id); free(scratch); free(ids); free(w);
     ccn__cad_topo_free(&t);
     return st;

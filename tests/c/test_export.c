@@ -1148,6 +1148,109 @@ static void test_pcurves(void) {
     }
 }
 
+typedef struct { const char *p; size_t n; } body;
+
+static int body_cmp(const void *a, const void *b) {
+    const body *x = a, *y = b;
+    if (x->n != y->n) return x->n < y->n ? -1 : 1;
+    return memcmp(x->p, y->p, x->n);
+}
+
+static int int_cmp(const void *a, const void *b) {
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* The text after "=" of entity line q, up to its end ("...;"), as a string of length *len. */
+static const char *entity_body(const char *q, size_t *len) {
+    const char *b = strchr(q, '='), *e = strstr(q, ");\n");
+    if (!b || !e || e < b) { *len = 0; return q; }
+    *len = (size_t)(e - b);
+    return b;
+}
+
+/* Each thing the STEP file says once: no two CARTESIAN_POINTs and no two pcurve lines (the
+ * degree-1 B_SPLINE_CURVE_WITH_KNOTS of the DEFINITIONAL_REPRESENTATIONs) with the same text, so
+ * the patch faces' pcurves that repeat are shared (fewer representations than PCURVEs); every
+ * VERTEX_POINT's point a pole of an edge curve (the vertex is the curve's end, bit for bit);
+ * every patch face (bicubic, bi-5, fill) on [0, 1]^2. The cube at level 3: bi-5 caps, bicubic
+ * rings, no periodic face. */
+static void test_written_once(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load_at("cube", 3, &obj, &cage);
+    CHECK(p != NULL, "cube: plan");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "cube: %s", err.message);
+    sink_fn(&s, "", 1);
+    /* entity lines: "#id=" at a line start (an entity continues on the next lines where a
+     * list is wrapped after a comma; entity_body reads on to its end) */
+    int nl = 0, cap = 1024;
+    const char **line = malloc(sizeof(char *) * (size_t)cap);
+    for (const char *q = s.d; q && *q; q = strchr(q, '\n') ? strchr(q, '\n') + 1 : NULL)
+        if (*q == '#' && q[1 + strspn(q + 1, "0123456789")] == '=') { /* not a wrapped list's "#12," */
+            if (nl == cap) line = realloc(line, sizeof(char *) * (size_t)(cap *= 2));
+            line[nl++] = q;
+        }
+    /* repeated texts: the point and pcurve-line bodies sorted, neighbours compared */
+    body *bodies = malloc(sizeof(body) * (size_t)(nl ? nl : 1));
+    int nb = 0, dup_pt = 0, dup_line = 0, lines = 0, vp = 0, vp_bad = 0;
+    for (int i = 0; i < nl; i++) {
+        body b;
+        b.p = entity_body(line[i], &b.n);
+        int pt = !strncmp(b.p, "=CARTESIAN_POINT(", 17), pl = !strncmp(b.p, "=B_SPLINE_CURVE_WITH_KNOTS('',1,", 32);
+        lines += pl;
+        if (pt || pl) bodies[nb++] = b;
+    }
+    qsort(bodies, (size_t)nb, sizeof(body), body_cmp);
+    for (int i = 1; i < nb; i++)
+        if (!body_cmp(&bodies[i - 1], &bodies[i])) *(bodies[i].p[1] == 'C' ? &dup_pt : &dup_line) += 1;
+    /* VERTEX_POINT('',#k): #k among the poles of the 3D curves (degree > 1 or not a pcurve) */
+    int *poles = malloc(sizeof(int) * s.n / 2 + 1), np = 0;
+    for (int i = 0; i < nl; i++) {
+        size_t li;
+        const char *b = entity_body(line[i], &li);
+        if (strncmp(b, "=B_SPLINE_CURVE_WITH_KNOTS(''", 29) || !strncmp(b, "=B_SPLINE_CURVE_WITH_KNOTS('',1,", 32)) continue;
+        for (const char *r = b; (r = strchr(r, '#')) && r < b + li; r++) poles[np++] = atoi(r + 1);
+    }
+    qsort(poles, (size_t)np, sizeof(int), int_cmp);
+    for (int i = 0; i < nl; i++) {
+        size_t li;
+        const char *b = entity_body(line[i], &li);
+        if (strncmp(b, "=VERTEX_POINT(''", 16)) continue;
+        int k = atoi(b + 18);
+        vp++;
+        vp_bad += !bsearch(&k, poles, (size_t)np, sizeof(int), int_cmp);
+    }
+    free(poles);
+    free(bodies);
+    int pc = count_of(s.d, "=PCURVE("), reps = count_of(s.d, "=DEFINITIONAL_REPRESENTATION(");
+    CHECK(dup_pt == 0 && dup_line == 0 && lines == reps && reps < pc && vp == info.num_vertices && vp_bad == 0,
+          "cube STEP: %d repeated points, %d repeated pcurve lines, %d lines for %d representations and %d "
+          "pcurves, %d of %d vertices not an edge curve's pole",
+          dup_pt, dup_line, lines, reps, pc, vp_bad, vp);
+    int patches = 0, off_unit = 0;
+    for (int i = 0; i < F.n; i++) {
+        const face *f = &F.f[i];
+        if (f->kind != CCN_EXPORT_FACE_BICUBIC && f->kind != CCN_EXPORT_FACE_BI5 && f->kind != CCN_EXPORT_FACE_FILL)
+            continue;
+        patches++;
+        for (int d = 0; d < 2; d++) off_unit += f->t[d][f->deg[d]] != 0 || f->t[d][f->np[d]] != 1;
+    }
+    CHECK(patches > 0 && off_unit == 0, "cube: %d of %d patch faces' directions not on [0, 1]", off_unit, patches);
+    free(line);
+    faces_free(&F);
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
+}
+
 /* A sheet folded onto itself (a quad and its reverse, back to back: every vertex an interior
  * valence-2 vertex) has no B-rep: the export refuses with a topology error naming a cage face. */
 static void test_folded(void) {
@@ -1182,6 +1285,7 @@ int main(void) {
     RUN(test_knot_removal);
     RUN(test_parts);
     RUN(test_pcurves);
+    RUN(test_written_once);
     RUN(test_folded);
     return TEST_SUMMARY();
 }
