@@ -28,7 +28,8 @@
  * the library's stencils (surface/ring_limit.c over w's child 1-ring; a smooth interior EV:
  * the eigenvectors of M). Sharp spokes are C0 edges between the fills of the two sides, which
  * share the spoke curve bit for bit and are not constrained across it; on a crease or corner
- * vertex the spoke is the exact crease curve. A dart's sharp spoke (its crease ends at w,
+ * vertex the spoke is the exact crease curve. At a corner, the smooth spokes of a sector between
+ * two crease curves leave w in the plane of those curves' tangents (corner_planes). A dart's sharp spoke (its crease ends at w,
  * whose rule is the smooth one, so the curve is no B-spline of its polygon there) is built like
  * a smooth spoke: C0, close to the crease, its distance to the limit measured like the rest. */
 #include "io/fill_faces.h"
@@ -244,6 +245,43 @@ static double spoke_deviation(double (*cs)[5][5][3], int32_t nfan, int32_t nsp, 
     return ccn__fill_spoke_angle(&cs[0][0][0][0], 3, mu, nfan, nsp, smooth, 8);
 }
 
+/* First derivative direction at w of the exact crease or boundary curve along sharp spoke k
+ * (its second pole less w's limit point P; the same pole as the spoke curves below). */
+static void crease_tangent(const ccn_mesh *m, int32_t w, int32_t k, const double P[3], int pinned,
+                           double out[3]) {
+    int32_t e = ccn__fan_edge(m, w, k), end = fan_end(m, w, k);
+    double D0 = m->eknot[e], Dm = ccn__beyond(m, w, k, pinned), al = Dm / (Dm + 2 * D0);
+    for (int d = 0; d < 3; d++)
+        out[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d] - P[d];
+}
+
+/* The tangent plane at a corner for the smooth spokes of each sector between two exact sharp
+ * spokes: the plane of the two crease curves' tangents. A surface through both curves that has
+ * a tangent plane at w has that one; the refined limit in a sector of two or more faces at a
+ * corner need not (its smooth spokes leave w out of that plane, a cone inside the sector), and
+ * fills that follow its tangents cannot be G1 across those spokes (catmark_inf_crease1: 0.46
+ * rad). Where the two tangents are parallel (a crease through w, a smooth boundary) the limit's
+ * plane stays. Ns[k] (per spoke) is replaced, oriented as before. */
+static void corner_planes(const ccn_mesh *m, int32_t w, const double P[3], int32_t nfan, int32_t nsp,
+                          int bnd, const uint8_t *sharp, int pinned, double (*Ns)[3]) {
+    for (int32_t k0 = 0; k0 < nsp; k0++) {
+        if (!sharp[k0] || (bnd && k0 == nsp - 1)) continue;
+        int32_t k1 = k0 + 1, n = 0; /* the next sharp spoke (cyclic inside) */
+        while (n < nfan && !sharp[k1 % nsp]) k1++, n++;
+        if (n == 0 || n >= nfan || (bnd && k1 >= nsp)) continue; /* no smooth spoke, or one sector */
+        double a[3], b[3], c[3];
+        crease_tangent(m, w, k0, P, pinned, a);
+        crease_tangent(m, w, k1 % nsp, P, pinned, b);
+        c[0] = a[1] * b[2] - a[2] * b[1], c[1] = a[2] * b[0] - a[0] * b[2], c[2] = a[0] * b[1] - a[1] * b[0];
+        double lc = sqrt(dot3(c, c)), la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
+        if (!(lc > 1e-6 * la * lb)) continue;
+        for (int32_t k = k0 + 1; k < k1; k++) {
+            double *N = Ns[k % nsp], sg = dot3(N, c) < 0 ? -1 : 1;
+            for (int d = 0; d < 3; d++) N[d] = sg * c[d] / lc;
+        }
+    }
+}
+
 ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, const ccn__xplace *fpl,
                             int32_t fill_id, uint8_t *covered, double *spoke_dev, ccn_error *err) {
     const ccn_mesh *m = fl->m;
@@ -270,6 +308,7 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
         memcpy(Ns[k], N[k < nfan ? k : nfan - 1], sizeof Ns[k]); /* a smooth spoke's faces share a sector */
     }
     int dart = !bnd && nsharp == 1; /* its sharp spoke: C0, but no B-spline curve at w */
+    if (!dart && nsharp >= 2) corner_planes(m, w, P, nfan, nsp, bnd, sharp, v->pinned, Ns);
     /* a regular sector of w (a crease's two-face side, a corner's one-face side) has its exact
      * pieces already: only the fan faces of irregular sectors are filled */
     for (int32_t k = 0; k < nfan; k++) filled[k] = !ccn__sector_regular(m, w, k, v->pinned);

@@ -5,9 +5,10 @@
 # the 2.5k-face production-like cage (tests/bench/make_bench_cages.py), the cube with
 # --cap refine (every EV a fill); creased cages: the cube with all edges infinitely sharp (6
 # flat faces meeting C0), sharpness 1.5, a box with darts, a corner and a cone point
-# (make_creased.py), six of OpenSubdiv's creased regression shapes and three of its cages of
-# several parts (cubes_semisharp: four closed parts; xord_interior, quadstrips: open ones; from
-# the cache `make deps` fills, tests/oracle/osd_shapes_deps.sh). For each, STEP and IGES:
+# (make_creased.py), eight of OpenSubdiv's creased regression shapes (inf_crease1: corners of
+# three creases) and three of its cages of several parts (cubes_semisharp: four closed parts;
+# xord_interior, quadstrips: open ones; from the cache `make deps` fills,
+# tests/oracle/osd_shapes_deps.sh). For each, STEP and IGES:
 #   - read with no load or transfer failure, the loops as written closed and every edge used at
 #     most once each way, BRepCheck valid, one shell per part (as many as the export reports,
 #     with no transfer warning that a shell was split), no edge with more than two face uses,
@@ -156,7 +157,7 @@ done
 check cube_semi "$T/cube_semi.obj" 3
 check dart_corner "$T/dart_corner.obj" 3
 if [ -n "$OSD_DIR" ]; then
-  for s in inf_crease0 cube_creases2 single_crease torus_creases1 dart_edgecorner fvar_project0 cube_corner4; do
+  for s in inf_crease0 inf_crease1 cube_creases2 single_crease torus_creases1 dart_edgecorner fvar_project0 cube_corner4; do
     check "osd_$s" "$T/osd/catmark_$s.obj" 3
   done
   for s in cubes_semisharp xord_interior quadstrips; do
