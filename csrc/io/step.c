@@ -7,7 +7,8 @@
  *   per shared edge: B_SPLINE_CURVE_WITH_KNOTS (the iso curve of the side segment that defines
  *   it, in increasing parameter, cut to the segment when the side is split), a PCURVE on each
  *   face it bounds (DEFINITIONAL_REPRESENTATION of a degree-1 B-spline: the side's straight
- *   line in the face's domain over the curve's parameters), SURFACE_CURVE (SEAM_CURVE where a
+ *   line in the face's domain over the curve's parameters [0, 1]; one per distinct line,
+ *   referenced by every PCURVE along it), SURFACE_CURVE (SEAM_CURVE where a
  *   face meets itself), EDGE_CURVE,
  *   per face: an ORIENTED_EDGE per side segment, EDGE_LOOP, FACE_OUTER_BOUND,
  *   ADVANCED_FACE (same_sense .T.: the face normal is Su x Sv),
@@ -32,10 +33,9 @@
 
 /* Entities written so far by a key of four 64-bit words: points by their coordinates' bits (a
  * point shared by several curves and surfaces, the boundary poles two faces and their edge
- * share bit for bit, is one CARTESIAN_POINT that all of them reference: catmark_car, a fifth of
- * the points, 8 MB) and pcurve lines by their end points and parameters (faces with one shape
- * of domain repeat them: one DEFINITIONAL_REPRESENTATION serves every PCURVE along such a
- * line). */
+ * share bit for bit, is one CARTESIAN_POINT that all of them reference) and pcurve lines by
+ * their end points and parameters (faces with one shape of domain repeat them: one
+ * DEFINITIONAL_REPRESENTATION serves every PCURVE along such a line). */
 typedef struct {
     uint64_t key[4];
     int32_t id; /* 0: empty */
