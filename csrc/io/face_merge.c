@@ -12,7 +12,8 @@
  *   - their v knot vectors agree up to an affine map (B's v is re-parametrised onto A's);
  *   - the shared pole column agrees within tol (face_tolerance);
  *   - B's u is scaled so that the two cross-boundary derivatives agree (ratio of their lengths
- *     on the row where A's is largest), the union written with the join knot of multiplicity p
+ *     on the row where A's is largest, or the small fraction within 1e-9 of it if the union is
+ *     C^1 with that: snap_ratio), the union written with the join knot of multiplicity p
  *     (C0: exact), and the join knot's copies the union does not need removed (the checked
  *     removal of io/knot_removal.c, the join's knot only): the merge is kept only if the join
  *     is left with at most p - 1 copies (C^1 or smoother). Anything else leaves both faces as
@@ -111,6 +112,26 @@ static double map_v(const double *ta, const double *tb, int32_t mv, double sv, d
     return ta[0] + (x - tb[0]) * sv;
 }
 
+/* c, or the fraction a / b (b <= 4096) within 1e-9 of it: the pieces' parameter lengths are
+ * ratios of small integers (ring speeds, cell counts), measured here to about 1e-12 from the
+ * poles. The exact ratio makes the join C^1 to rounding rather than to the measurement, and the
+ * merged faces' knots exact, so that equal domains repeat bit for bit (their pcurves are
+ * written once, io/step.c). The knot removal below checks the union either way. */
+static double snap_ratio(double c) {
+    double x = c, h0 = 1, h1 = 0, k0 = 0, k1 = 1; /* convergents h/k of c's continued fraction */
+    for (int i = 0; i < 40; i++) {
+        double a = floor(x), h = a * h0 + h1, k = a * k0 + k1;
+        if (k > 4096) break;
+        if (fabs(h / k - c) <= 1e-9 * c) return h / k;
+        h1 = h0, h0 = h, k1 = k0, k0 = k;
+        if (x - a < 1e-15) break;
+        x = 1 / (x - a);
+    }
+    return c;
+}
+
+static int merge_scaled(const tface *A, const tface *B, double tol, double c, tface *M);
+
 /* The union of A (its u = max side) and B (its u = min side), or 0 when it is not C^1; M gets
  * the merged face. -1: out of memory. */
 static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
@@ -142,6 +163,21 @@ static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
         if (la > best && lb > 0) best = la, c = lb / la;
     }
     if (!(best > 0) || !(c > 0) || !isfinite(c)) return 0;
+    double cs = snap_ratio(c);
+    if (cs != c) { /* the exact ratio first; the measured one if the union is not C^1 with it */
+        int r = merge_scaled(A, B, tol, cs, M);
+        if (r) return r;
+    }
+    return merge_scaled(A, B, tol, c, M);
+}
+
+/* The union of A and B with B's u scaled by c (merge_pair). */
+static int merge_scaled(const tface *A, const tface *B, double tol, double c, tface *M) {
+    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
+    const double *ta = A->t[1], *tb = B->t[1];
+    int32_t mv = nv + q + 1;
+    double a0 = ta[0], a1 = ta[mv - 1], b0 = tb[0], b1 = tb[mv - 1], sv = (a1 - a0) / (b1 - b0);
+    memset(M, 0, sizeof *M);
     /* the union: u knots A's (without its end copies), the join p times, B's scaled */
     int32_t n = nA + nB - 1, m = n + p + 1;
     double *U = malloc(sizeof(double) * (size_t)m), *W = malloc(sizeof(double) * 3 * (size_t)n * nv);

@@ -1205,7 +1205,8 @@ static const char *entity_body(const char *q, size_t *len) {
  * degree-1 B_SPLINE_CURVE_WITH_KNOTS of the DEFINITIONAL_REPRESENTATIONs) with the same text, so
  * the patch faces' pcurves that repeat are shared (fewer representations than PCURVEs); every
  * VERTEX_POINT's point a pole of an edge curve (the vertex is the curve's end, bit for bit);
- * every patch face (bicubic, bi-5, fill) on [0, 1]^2. The cube at level 3: bi-5 caps, bicubic
+ * every patch face (bicubic, bi-5, fill) on [0, 1]^2, the joins of merged ones at exact
+ * fractions (so that equal domains repeat bit for bit). The cube at level 3: bi-5 caps, bicubic
  * rings, no periodic face. */
 static void test_written_once(void) {
     ccn_obj *obj;
@@ -1267,15 +1268,27 @@ static void test_written_once(void) {
           "cube STEP: %d repeated points, %d repeated pcurve lines, %d lines for %d representations and %d "
           "pcurves, %d of %d vertices not an edge curve's pole",
           dup_pt, dup_line, lines, reps, pc, vp_bad, vp);
-    int patches = 0, off_unit = 0;
+    int patches = 0, off_unit = 0, inner = 0, inexact = 0;
     for (int i = 0; i < F.n; i++) {
         const face *f = &F.f[i];
         if (f->kind != CCN_EXPORT_FACE_BICUBIC && f->kind != CCN_EXPORT_FACE_BI5 && f->kind != CCN_EXPORT_FACE_FILL)
             continue;
         patches++;
-        for (int d = 0; d < 2; d++) off_unit += f->t[d][f->deg[d]] != 0 || f->t[d][f->np[d]] != 1;
+        for (int d = 0; d < 2; d++) {
+            off_unit += f->t[d][f->deg[d]] != 0 || f->t[d][f->np[d]] != 1;
+            for (int k = f->deg[d] + 1; k < f->np[d]; k++) { /* a merged face's joins */
+                double t = f->t[d][k];
+                int exact = 0;
+                for (int q = 1; q <= 4096 && !exact; q++) exact = (double)round(t * q) / q == t;
+                inner++;
+                inexact += !exact;
+            }
+        }
     }
     CHECK(patches > 0 && off_unit == 0, "cube: %d of %d patch faces' directions not on [0, 1]", off_unit, patches);
+    /* the pieces' lengths are ratios of small integers: merged faces' joins at exact fractions */
+    CHECK(inner > 0 && inexact == 0, "cube: %d of %d joins of merged patch faces not at a fraction a / b, b <= 4096",
+          inexact, inner);
     free(line);
     faces_free(&F);
     free(s.d);
