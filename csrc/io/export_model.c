@@ -157,8 +157,7 @@ int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const dou
     return f;
 }
 
-int ccn__xm_unit_domains(ccn__xmodel *xm) {
-    int changed = 0;
+void ccn__xm_unit_domains(ccn__xmodel *xm) {
     for (int32_t f = 0; f < xm->num_faces; f++) {
         ccn__xface *X = &xm->faces[f];
         if (X->kind == CCN_EXPORT_FACE_PACK || X->kind == CCN_EXPORT_FACE_REFINED) continue;
@@ -179,8 +178,6 @@ int ccn__xm_unit_domains(ccn__xmodel *xm) {
                 uv[0] = (uv[0] - lo) / w;
                 uv[1] = (uv[1] - lo) / w;
             }
-            changed = 1;
         }
     }
-    return changed;
 }

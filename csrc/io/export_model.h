@@ -74,8 +74,8 @@ void ccn__xm_free_surface(ccn__cad_surface *s);
  * construction's own) affinely onto [0, 1]^2, knots and cells alike; the surfaces are unchanged.
  * Faces with the same shape of domain then share their pcurves in the STEP file (io/step.c).
  * Packs and refined pieces keep their knots: the cage's knot intervals (halved per level).
- * A direction whose knots would no longer be distinct keeps its domain. 1 if any face changed. */
-int ccn__xm_unit_domains(ccn__xmodel *xm);
+ * A direction whose knots would no longer be distinct keeps its domain. */
+void ccn__xm_unit_domains(ccn__xmodel *xm);
 /* A Bezier face of degree deg (pts: (deg+1)^2 x 3, first index along u) at place pl. */
 int32_t ccn__xm_add_bezier(ccn__xmodel *xm, int32_t kind, int32_t deg, const double *pts,
                            const ccn__xplace *pl);

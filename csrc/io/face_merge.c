@@ -130,53 +130,11 @@ static double snap_ratio(double c) {
     return c;
 }
 
-static int merge_scaled(const tface *A, const tface *B, double tol, double c, tface *M);
-
-/* The union of A (its u = max side) and B (its u = min side), or 0 when it is not C^1; M gets
- * the merged face. -1: out of memory. */
-static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
-    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
-    memset(M, 0, sizeof *M);
-    if (B->deg[0] != p || B->deg[1] != q || B->n[1] != nv || B->cv != A->cv) return 0;
-    if (!clamped(A->t[0], nA, p) || !clamped(B->t[0], nB, p) || !clamped(A->t[1], nv, q) || !clamped(B->t[1], nv, q))
-        return 0;
-    /* v: B's knots an affine image of A's */
+/* The union of A and B with B's u scaled by c and its v mapped onto A's by sv (merge_pair),
+ * or 0 when it is not C^1. -1: out of memory. */
+static int merge_scaled(const tface *A, const tface *B, double tol, double c, double sv, tface *M) {
+    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1], mv = nv + q + 1;
     const double *ta = A->t[1], *tb = B->t[1];
-    int32_t mv = nv + q + 1;
-    double a0 = ta[0], a1 = ta[mv - 1], b0 = tb[0], b1 = tb[mv - 1], sv = (a1 - a0) / (b1 - b0);
-    for (int32_t i = 0; i < mv; i++)
-        if (fabs(a0 + (tb[i] - b0) * sv - ta[i]) > 1e-12 * (a1 - a0)) return 0;
-    /* the shared column */
-    for (int32_t j = 0; j < nv; j++)
-        if (!(ccn__dist3(A->P + 3 * ((size_t)(nA - 1) * nv + j), B->P + 3 * (size_t)j) <= tol)) return 0;
-    /* B's u scale: the cross-boundary derivatives' ratio on A's largest */
-    double best = -1, c = 1;
-    double ha = A->t[0][nA + p] - A->t[0][nA - 1], hb = B->t[0][p + 1] - B->t[0][0];
-    for (int32_t j = 0; j < nv; j++) {
-        double da[3], db[3];
-        for (int k = 0; k < 3; k++) {
-            da[k] = (A->P[3 * ((size_t)(nA - 1) * nv + j) + k] - A->P[3 * ((size_t)(nA - 2) * nv + j) + k]) / ha;
-            db[k] = (B->P[3 * ((size_t)nv + j) + k] - B->P[3 * (size_t)j + k]) / hb;
-        }
-        double la = sqrt(da[0] * da[0] + da[1] * da[1] + da[2] * da[2]);
-        double lb = sqrt(db[0] * db[0] + db[1] * db[1] + db[2] * db[2]);
-        if (la > best && lb > 0) best = la, c = lb / la;
-    }
-    if (!(best > 0) || !(c > 0) || !isfinite(c)) return 0;
-    double cs = snap_ratio(c);
-    if (cs != c) { /* the exact ratio first; the measured one if the union is not C^1 with it */
-        int r = merge_scaled(A, B, tol, cs, M);
-        if (r) return r;
-    }
-    return merge_scaled(A, B, tol, c, M);
-}
-
-/* The union of A and B with B's u scaled by c (merge_pair). */
-static int merge_scaled(const tface *A, const tface *B, double tol, double c, tface *M) {
-    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
-    const double *ta = A->t[1], *tb = B->t[1];
-    int32_t mv = nv + q + 1;
-    double a0 = ta[0], a1 = ta[mv - 1], b0 = tb[0], b1 = tb[mv - 1], sv = (a1 - a0) / (b1 - b0);
     memset(M, 0, sizeof *M);
     /* the union: u knots A's (without its end copies), the join p times, B's scaled */
     int32_t n = nA + nB - 1, m = n + p + 1;
@@ -220,6 +178,46 @@ static int merge_scaled(const tface *A, const tface *B, double tol, double c, tf
     }
     return 1;
 }
+
+/* The union of A (its u = max side) and B (its u = min side), or 0 when it is not C^1; M gets
+ * the merged face. -1: out of memory. */
+static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
+    int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
+    memset(M, 0, sizeof *M);
+    if (B->deg[0] != p || B->deg[1] != q || B->n[1] != nv || B->cv != A->cv) return 0;
+    if (!clamped(A->t[0], nA, p) || !clamped(B->t[0], nB, p) || !clamped(A->t[1], nv, q) || !clamped(B->t[1], nv, q))
+        return 0;
+    /* v: B's knots an affine image of A's */
+    const double *ta = A->t[1], *tb = B->t[1];
+    int32_t mv = nv + q + 1;
+    double a0 = ta[0], a1 = ta[mv - 1], b0 = tb[0], b1 = tb[mv - 1], sv = (a1 - a0) / (b1 - b0);
+    for (int32_t i = 0; i < mv; i++)
+        if (fabs(a0 + (tb[i] - b0) * sv - ta[i]) > 1e-12 * (a1 - a0)) return 0;
+    /* the shared column */
+    for (int32_t j = 0; j < nv; j++)
+        if (!(ccn__dist3(A->P + 3 * ((size_t)(nA - 1) * nv + j), B->P + 3 * (size_t)j) <= tol)) return 0;
+    /* B's u scale: the cross-boundary derivatives' ratio on A's largest */
+    double best = -1, c = 1;
+    double ha = A->t[0][nA + p] - A->t[0][nA - 1], hb = B->t[0][p + 1] - B->t[0][0];
+    for (int32_t j = 0; j < nv; j++) {
+        double da[3], db[3];
+        for (int k = 0; k < 3; k++) {
+            da[k] = (A->P[3 * ((size_t)(nA - 1) * nv + j) + k] - A->P[3 * ((size_t)(nA - 2) * nv + j) + k]) / ha;
+            db[k] = (B->P[3 * ((size_t)nv + j) + k] - B->P[3 * (size_t)j + k]) / hb;
+        }
+        double la = sqrt(da[0] * da[0] + da[1] * da[1] + da[2] * da[2]);
+        double lb = sqrt(db[0] * db[0] + db[1] * db[1] + db[2] * db[2]);
+        if (la > best && lb > 0) best = la, c = lb / la;
+    }
+    if (!(best > 0) || !(c > 0) || !isfinite(c)) return 0;
+    double cs = snap_ratio(c);
+    if (cs != c) { /* the exact ratio first; the measured one if the union is not C^1 with it */
+        int r = merge_scaled(A, B, tol, cs, sv, M);
+        if (r) return r;
+    }
+    return merge_scaled(A, B, tol, c, sv, M);
+}
+
 
 /* Face fi of xm becomes M (its arrays taken over; cells appended to xm->cells). */
 static int replace_face(ccn__xmodel *xm, int32_t fi, tface *M) {

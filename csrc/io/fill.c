@@ -263,8 +263,8 @@ static void fill_undo(ccn__xmodel *xm, ccn__fill_opts *o, fill_mark k) {
 }
 
 /* Fill faces around each irregular vertex of T's faces reg[0..nreg-1] (only the smooth
- * valence-2 ones if only_v2), marking the faces they cover in cov; *any = 1 if one was
- * filled. CCN_ERR_INTERNAL: a vertex's fill cannot be placed at this level (the caller
+ * valence-2 ones if only_v2), marking the faces they cover in cov; *any = 1 (any may be NULL)
+ * if one was filled. CCN_ERR_INTERNAL: a vertex's fill cannot be placed at this level (the caller
  * undoes the level's fills and refines further). */
 static ccn_status fill_vertices(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *T,
                                 const int32_t *reg, int32_t nreg, const ccn__xplace *tpl,
@@ -282,7 +282,7 @@ static ccn_status fill_vertices(ccn__xmodel *xm, const ccn__plan_view *v, const 
             done_v[w] = 1;
             if (!fl && (st = ccn__fill_level_create(v, T, &fl, err))) break;
             st = ccn__fill_vertex(xm, fl, w, tpl, o->num_fills++, cov, NULL, err);
-            *any = 1;
+            if (any) *any = 1;
         }
     ccn__fill_level_destroy(fl);
     free(done_v);
@@ -521,9 +521,8 @@ ccn_status ccn__fill_holes(ccn__xmodel *xm, const ccn__plan_view *v, int32_t lev
         if (last && nreg) { /* the fill faces around each irregular vertex cover what is left */
             uint8_t *cov = calloc((size_t)T->nf, 1);
             if (!cov) goto oom;
-            int any = 0;
             fill_mark mark = fill_mark_of(xm, o);
-            st = fill_vertices(xm, v, T, reg, nreg, tpl, 0, cov, &any, o, err);
+            st = fill_vertices(xm, v, T, reg, nreg, tpl, 0, cov, NULL, o, err);
             for (int32_t i = 0; i < nreg && !st; i++)
                 if (!cov[reg[i]])
                     st = ccn__fail(err, CCN_ERR_INTERNAL, CCN_ELEM_FACE, tpl[reg[i]].cage_face,

@@ -29,9 +29,10 @@
  * the eigenvectors of M). Sharp spokes are C0 edges between the fills of the two sides, which
  * share the spoke curve bit for bit and are not constrained across it; on a crease or corner
  * vertex the spoke is the exact crease curve. At a corner, the smooth spokes of a sector between
- * two crease curves leave w in the plane of those curves' tangents (corner_planes). A dart's sharp spoke (its crease ends at w,
- * whose rule is the smooth one, so the curve is no B-spline of its polygon there) is built like
- * a smooth spoke: C0, close to the crease, its distance to the limit measured like the rest. */
+ * two crease curves leave w in the plane of those curves' tangents (corner_planes). A dart's
+ * sharp spoke (its crease ends at w, whose rule is the smooth one, so the curve is no B-spline
+ * of its polygon there) is built like a smooth spoke: C0, close to the crease, its distance to
+ * the limit measured like the rest. */
 #include "io/fill_faces.h"
 #include "io/fill_g1.h"
 
@@ -245,14 +246,17 @@ static double spoke_deviation(double (*cs)[5][5][3], int32_t nfan, int32_t nsp, 
     return ccn__fill_spoke_angle(&cs[0][0][0][0], 3, mu, nfan, nsp, smooth, 8);
 }
 
-/* First derivative direction at w of the exact crease or boundary curve along sharp spoke k
- * (its second pole less w's limit point P; the same pole as the spoke curves below). */
-static void crease_tangent(const ccn_mesh *m, int32_t w, int32_t k, const double P[3], int pinned,
-                           double out[3]) {
+/* The first two inner poles b1, b2 of the exact crease or boundary curve along sharp spoke k
+ * from w: the cubic B-spline of its polygon, the interval beyond w from the crease look-ups
+ * (rules/bspline.c: the other crease edge's on a crease, the spoke's own at a corner). */
+static void crease_poles(const ccn_mesh *m, int32_t w, int32_t k, int pinned, double b1[3], double b2[3]) {
     int32_t e = ccn__fan_edge(m, w, k), end = fan_end(m, w, k);
-    double D0 = m->eknot[e], Dm = ccn__beyond(m, w, k, pinned), al = Dm / (Dm + 2 * D0);
-    for (int d = 0; d < 3; d++)
-        out[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d] - P[d];
+    double D0 = m->eknot[e], Dm = ccn__beyond(m, w, k, pinned);
+    double al = Dm / (Dm + 2 * D0), ga = (Dm + D0) / (Dm + 2 * D0); /* D_1 = D_0 */
+    for (int d = 0; d < 3; d++) {
+        b1[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d];
+        b2[d] = (1 - ga) * m->pos[3 * (size_t)w + d] + ga * m->pos[3 * (size_t)end + d];
+    }
 }
 
 /* The tangent plane at a corner for the smooth spokes of each sector between two exact sharp
@@ -269,10 +273,11 @@ static void corner_planes(const ccn_mesh *m, int32_t w, const double P[3], int32
         int32_t k1 = k0 + 1, n = 0; /* the next sharp spoke (cyclic inside) */
         while (n < nfan && !sharp[k1 % nsp]) k1++, n++;
         if (n == 0 || n >= nfan || (bnd && k1 >= nsp)) continue; /* no smooth spoke, or one sector */
-        double a[3], b[3], c[3];
-        crease_tangent(m, w, k0, P, pinned, a);
-        crease_tangent(m, w, k1 % nsp, P, pinned, b);
-        c[0] = a[1] * b[2] - a[2] * b[1], c[1] = a[2] * b[0] - a[0] * b[2], c[2] = a[0] * b[1] - a[1] * b[0];
+        double a[3], b[3], c[3], unused[3];
+        crease_poles(m, w, k0, pinned, a, unused);
+        crease_poles(m, w, k1 % nsp, pinned, b, unused);
+        for (int d = 0; d < 3; d++) a[d] -= P[d], b[d] -= P[d]; /* the curves' tangents at w */
+        cross(a, b, c);
         double lc = sqrt(dot3(c, c)), la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
         if (!(lc > 1e-6 * la * lb)) continue;
         for (int32_t k = k0 + 1; k < k1; k++) {
@@ -358,12 +363,9 @@ ccn_status ccn__fill_vertex(ccn__xmodel *xm, ccn__fill_level *fl, int32_t w, con
                 const double (*E)[4][3] = (const double(*)[4][3])(own ? nb[k][4] : nb[km][5]);
                 double e2[4][3];
                 for (int q = 0; q < 4; q++) memcpy(e2[q], own ? E[q][0] : E[0][q], sizeof e2[q]);
-                int32_t e = ccn__fan_edge(m, w, k), end = fan_end(m, w, k);
-                double D0 = m->eknot[e], Dm = ccn__beyond(m, w, k, v->pinned), b1[3], b2[3];
-                double al = Dm / (Dm + 2 * D0), ga = (Dm + D0) / (Dm + 2 * D0); /* D_1 = D_0 */
+                double b1[3], b2[3];
+                crease_poles(m, w, k, v->pinned, b1, b2);
                 for (int d = 0; d < 3; d++) {
-                    b1[d] = (1 - al) * m->pos[3 * (size_t)w + d] + al * m->pos[3 * (size_t)end + d];
-                    b2[d] = (1 - ga) * m->pos[3 * (size_t)w + d] + ga * m->pos[3 * (size_t)end + d];
                     c[1][d] = b1[d];
                     c[2][d] = 0.5 * ((2 * b2[d] - b1[d]) + (2 * e2[1][d] - e2[2][d]));
                     c[3][d] = e2[2][d];
