@@ -81,9 +81,9 @@ ccn_status ccn__iges_write(const ccn__cad_model *m, ccn__cad_write_fn fn, void *
  * face's segments are face_seg[f] .. face_seg[f+1]-1 in loop order, and seg_vert[j] is the
  * vertex where segment j starts (in loop order). Edge e is segment edge_seg[e] (its first
  * appearance, or its twin when only the twin is a whole side); its curve is that segment's
- * iso curve in increasing parameter, from vertex
- * edge_vert[2e] to edge_vert[2e+1]. seg_edge[j] is the edge of each segment and
- * seg_sense[j] = 1 if the segment (in loop order) runs along the edge's curve, 0 against it. */
+ * iso curve in increasing parameter, from vertex edge_vert[2e] to edge_vert[2e+1]. seg_edge[j]
+ * is the edge of each segment and seg_sense[j] = 1 if the segment (in loop order) runs along
+ * the edge's curve, 0 against it. */
 typedef struct {
     int32_t num_segs, num_verts, num_edges;
     int closed;               /* every segment shared */

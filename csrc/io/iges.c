@@ -160,9 +160,9 @@ static void surface_128(iges_pd *p, const ccn__cad_surface *f) {
 /* The parameter-space curve of segment j of a face: the straight line in the face's (u, v)
  * along the segment, run in the direction the loop uses it (OpenCASCADE's IGES reader takes a
  * use's curves in the use's direction: a pcurve run along the edge curve instead turns the face
- * over where a closed edge's use runs against it, "Faces were incorrectly oriented"), over the parameters
- * [c0, c1] of the edge curve (the uses are one curve up to an affine change, cad.h): a planar
- * degree-1 126, so that a reader needs no projection to place the edge on the face. */
+ * over where a closed edge's use runs against it, "Faces were incorrectly oriented"), over the
+ * parameters [c0, c1] of the edge curve (the uses are one curve up to an affine change, cad.h):
+ * a planar degree-1 126, so that a reader needs no projection to place the edge on the face. */
 static void pcurve_126(iges_pd *p, const ccn__cad_model *m, const ccn__cad_topo *t, int32_t j,
                        double c0, double c1) {
     double uv[2][2];
