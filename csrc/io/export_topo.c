@@ -161,7 +161,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
     }
     qsort(pc, n, sizeof *pc, piece_cmp);
     /* elementary segments: count first */
-    size_t ne = 0, g0 = 0;
+    size_t ne = 0, nint = 0, g0 = 0;
     for (size_t g = 0; g <= n; g++) {
         if (g < n && (g == g0 || !key_cmp(&pc[g].k, &pc[g0].k))) continue;
         size_t nx = 0; /* group [g0, g): distinct ends */
@@ -169,6 +169,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
         qsort(xs, nx, sizeof(double), dbl_cmp);
         size_t u = 0;
         for (size_t i = 0; i < nx; i++) if (!u || xs[i] != xs[u - 1]) xs[u++] = xs[i];
+        nint += u ? u - 1 : 0; /* a line's intervals: a gap between its pieces is one too */
         for (size_t i = g0; i < g; i++) {
             double lo = pc[i].x0 < pc[i].x1 ? pc[i].x0 : pc[i].x1, hi = pc[i].x0 + pc[i].x1 - lo;
             for (size_t k = 0; k + 1 < u; k++) ne += xs[k] >= lo && xs[k + 1] <= hi;
@@ -176,7 +177,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
         g0 = g;
     }
     es = malloc(sizeof(eseg) * (ne ? ne : 1));
-    int32_t *cover = malloc(sizeof(int32_t) * 2 * (ne ? ne : 1)); /* per elementary interval */
+    int32_t *cover = malloc(sizeof(int32_t) * 2 * (nint ? nint : 1)); /* per elementary interval */
     if (!es || !cover) { free(cover); goto oom; }
     /* per piece its elementary segments in running order; collect per side afterwards */
     typedef struct { int32_t face, side, order, k; int32_t seg; } ref;

@@ -22,7 +22,18 @@
  * run until none is possible, so nested pieces (a cap's rings around its centre) grow into one
  * or two faces per sector; across spokes a cap's rings join G1 only (the C2-rule's centre
  * relation), so sectors stay apart. The merged face has patch -1 and the cells of both, B's
- * re-parametrised. */
+ * re-parametrised.
+ *
+ * With `unify` the shared side's knots and cells may differ: both faces first take the union
+ * of the two (Boehm's knot insertion along the side, cells cut; the surfaces unchanged), and
+ * faces of the degree-3 kinds (packs, bicubic patches, refined pieces: all exact pieces of the
+ * limit) merge across kinds. Around a semi-sharp crease the refined pieces of each level form a
+ * band of that level's cells and knots beside the coarser level's: their unions are C2 (the
+ * limit surface there is), so the bands of all levels and the packs beside them become one
+ * face. A merge is kept only if the union has no more poles than the two faces had: the
+ * inserted knots must be ones the join's knot removal gives back. Run after a pass without it
+ * and the knot removal (io/knot_removal.h), so that the knots a band does not need are gone
+ * before they would spread into its neighbours. */
 #include "io/face_merge.h"
 
 #include "base/error.h"
@@ -101,6 +112,130 @@ static int clamped(const double *t, int32_t n, int32_t p) {
     for (int32_t i = 1; i <= p; i++)
         if (t[i] != t[0] || t[n + p - i] != t[n + p]) return 0;
     return t[p + 1] > t[p] && t[n] > t[n - 1];
+}
+
+/* ---- sides of different knots and cells: both made the union's ------------------------ */
+
+/* x snapped to the nearest of the n values a within tol (else x). */
+static double snap_to(double x, const double *a, int32_t n, double tol) {
+    double best = tol;
+    double r = x;
+    for (int32_t i = 0; i < n; i++)
+        if (fabs(a[i] - x) <= best) best = fabs(a[i] - x), r = a[i];
+    return r;
+}
+
+/* f's v knots made U (m values, a superset of f's with f's ends): each missing copy inserted into
+ * every u row (Boehm; the surface unchanged). -1: out of memory. */
+static int tface_insert_v(tface *f, const double *U, int32_t m) {
+    int32_t nu = f->n[0], nv = f->n[1], q = f->deg[1], N = m - q - 1, w = 3 * nu;
+    double *Q = malloc(sizeof(double) * (size_t)w * N), *t = malloc(sizeof(double) * (size_t)m);
+    if (!Q || !t) { free(Q); free(t); return -1; }
+    for (int32_t j = 0; j < nv; j++) /* v-major: pole j holds the whole u row */
+        for (int32_t i = 0; i < nu; i++) memcpy(Q + (size_t)j * w + 3 * i, f->P + 3 * ((size_t)i * nv + j), sizeof(double) * 3);
+    memcpy(t, f->t[1], sizeof(double) * (size_t)(nv + q + 1));
+    int32_t n = nv;
+    for (int32_t i = 0, j = 0; i < m; i++) { /* U's values missing from t, in increasing order */
+        if (j < n + q + 1 && t[j] == U[i]) { j++; continue; }
+        ccn__insert_knot(Q, &n, w, t, q, U[i]);
+        j++;
+    }
+    double *P = malloc(sizeof(double) * 3 * (size_t)nu * N);
+    if (!P || n != N) { free(Q); free(t); free(P); return -1; }
+    for (int32_t j = 0; j < N; j++)
+        for (int32_t i = 0; i < nu; i++) memcpy(P + 3 * ((size_t)i * N + j), Q + (size_t)j * w + 3 * i, sizeof(double) * 3);
+    free(Q); free(f->P); free(f->t[1]);
+    f->P = P, f->t[1] = t, f->n[1] = N;
+    return 0;
+}
+
+/* y as k / 2^d (d <= 30) when it is one to 1e-9, else NaN: cells are dyadic rectangles of their
+ * cage face, and places are compared exactly (export_model.h). */
+static double dyadic(double y) {
+    double s = 1073741824.0, k = nearbyint(y * s);
+    return fabs(y - k / s) <= 1e-9 ? k / s : NAN;
+}
+
+/* f's cells cut along v at the values c (nc, increasing, f's own boundaries among them): each
+ * part's place the matching sub-rectangle of its cell's. 1: a cut not at a dyadic fraction of
+ * its cell (f unchanged), -1: out of memory. */
+static int tface_cut_v(tface *f, const double *c, int32_t nc) {
+    int32_t cv = nc - 1;
+    ccn__xcell *C = malloc(sizeof(ccn__xcell) * (size_t)f->cu * cv);
+    if (!C) return -1;
+    for (int32_t ci = 0; ci < f->cu; ci++)
+        for (int32_t cj = 0, k = 0; cj < f->cv; cj++) {
+            const ccn__xcell *a = &f->cells[ci + f->cu * cj];
+            double v0 = a->uv[2], v1 = a->uv[3];
+            for (; k < cv && c[k] < v1; k++) {
+                ccn__xcell *b = &C[ci + f->cu * k];
+                double y0 = dyadic((c[k] - v0) / (v1 - v0)), y1 = dyadic((c[k + 1] - v0) / (v1 - v0));
+                if (!(y0 >= 0 && y1 <= 1)) { free(C); return 1; }
+                double r[3][2] = {{0, y0}, {1, y0}, {0, y1}};
+                *b = *a;
+                b->uv[2] = c[k], b->uv[3] = c[k + 1];
+                ccn__xplace_sub(&a->pl, (const double(*)[2])r, &b->pl);
+            }
+        }
+    free(f->cells);
+    f->cells = C;
+    f->cv = cv;
+    return 0;
+}
+
+/* B's v (along the shared side) made A's parameter, and both faces' v knots and cells the
+ * union of the two: a side of a coarser level's piece against a finer one's, or of pieces
+ * whose knots were thinned differently. The surfaces are unchanged (knot insertion, cells cut);
+ * whether the two sides are the same curve is merge_pair's shared-column check. 0: done (or
+ * nothing to do), 1: not comparable, -1: out of memory. */
+static int unify_v(tface *A, tface *B) {
+    int32_t q = A->deg[1], ma = A->n[1] + q + 1, mb = B->n[1] + q + 1;
+    if (B->deg[1] != q) return 1;
+    double *ta = A->t[1], *tb = B->t[1];
+    double a0 = ta[0], a1 = ta[ma - 1], b0 = tb[0], b1 = tb[mb - 1], sv = (a1 - a0) / (b1 - b0);
+    double tol = 1e-12 * (a1 - a0);
+    if (!(sv > 0) || !isfinite(sv)) return 1;
+    /* A's cell boundaries */
+    int32_t ca = A->cv + 1, cb = B->cv + 1;
+    double *U = malloc(sizeof(double) * (size_t)(ma + mb)), *bc = malloc(sizeof(double) * (size_t)cb),
+           *ac = malloc(sizeof(double) * (size_t)ca), *C = malloc(sizeof(double) * (size_t)(ca + cb));
+    if (!U || !bc || !ac || !C) { free(U); free(bc); free(ac); free(C); return -1; }
+    for (int32_t j = 0; j < A->cv; j++) ac[j] = A->cells[A->cu * j].uv[2];
+    ac[A->cv] = A->cells[A->cu * (A->cv - 1)].uv[3];
+    /* B mapped: knots and cells onto A's values where they meet them */
+    for (int32_t i = 0; i < mb; i++) {
+        double x = a0 + (tb[i] - b0) * sv;
+        x = snap_to(x, ta, ma, tol);
+        tb[i] = snap_to(x, ac, ca, tol);
+    }
+    for (int32_t k = 0; k < B->cu * B->cv; k++)
+        for (int e = 2; e < 4; e++) {
+            double x = a0 + (B->cells[k].uv[e] - b0) * sv;
+            x = snap_to(x, ac, ca, tol);
+            B->cells[k].uv[e] = snap_to(x, ta, ma, tol);
+        }
+    for (int32_t j = 0; j < B->cv; j++) bc[j] = B->cells[B->cu * j].uv[2];
+    bc[B->cv] = B->cells[B->cu * (B->cv - 1)].uv[3];
+    /* the unions (sorted merges: equal values once, knots with the larger multiplicity) */
+    int32_t m = 0, nc = 0, r = 0;
+    for (int32_t i = 0, j = 0; i < ma || j < mb;) {
+        if (j >= mb || (i < ma && ta[i] < tb[j])) U[m++] = ta[i++];
+        else if (i >= ma || tb[j] < ta[i]) U[m++] = tb[j++];
+        else U[m++] = ta[i++], j++;
+    }
+    for (int32_t i = 0, j = 0; i < ca || j < cb;) {
+        if (j >= cb || (i < ca && ac[i] < bc[j])) C[nc++] = ac[i++];
+        else if (i >= ca || bc[j] < ac[i]) C[nc++] = bc[j++];
+        else C[nc++] = ac[i++], j++;
+    }
+    for (int32_t i = 1; i + q < m - 1 && !r; i++) /* an interior knot of more than q copies */
+        if (U[i] > U[0] && U[i + q] == U[i] && U[i] < U[m - 1]) r = 1;
+    if (!r && m != ma) r = tface_insert_v(A, U, m);
+    if (!r && m != mb) r = tface_insert_v(B, U, m);
+    if (!r && nc != ca) r = tface_cut_v(A, C, nc);
+    if (!r && nc != cb) r = tface_cut_v(B, C, nc);
+    free(U); free(bc); free(ac); free(C);
+    return r;
 }
 
 /* B's v parameter x on A's: A's knot where x is B's corresponding knot (exactly: the cells'
@@ -253,6 +388,16 @@ static void drop_face(ccn__xmodel *xm, int32_t fi) {
     xm->faces[fi].kind = -1;
 }
 
+/* The kind of a union of faces of kinds a and b (degree-3 kinds when they differ). */
+static int32_t union_kind(int32_t a, int32_t b) {
+    if (a == b) return a;
+    return a == CCN_EXPORT_FACE_REFINED || b == CCN_EXPORT_FACE_REFINED ? CCN_EXPORT_FACE_REFINED : CCN_EXPORT_FACE_PACK;
+}
+
+static int cubic_kind(int32_t kind) {
+    return kind == CCN_EXPORT_FACE_PACK || kind == CCN_EXPORT_FACE_BICUBIC || kind == CCN_EXPORT_FACE_REFINED;
+}
+
 static int mergeable_kind(int32_t kind) {
     return kind == CCN_EXPORT_FACE_PACK || kind == CCN_EXPORT_FACE_BICUBIC || kind == CCN_EXPORT_FACE_BI5 ||
            kind == CCN_EXPORT_FACE_REFINED;
@@ -270,8 +415,8 @@ static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
     return rel_tol * size + 16 * DBL_EPSILON * big;
 }
 
-ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int64_t *merged,
-                                ccn_error *err) {
+ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int unify,
+                                int64_t *merged, ccn_error *err) {
     *merged = 0;
     for (;;) {
         int32_t *bs = NULL, *adj = NULL;
@@ -301,7 +446,8 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
                 int32_t j = 4 * f + s + bs[4 * f + s], o = adj[j];
                 if (o < 0 || crease[j]) continue;
                 int32_t g = segface[o], t = segside[o];
-                if (g == f || used[g] || xm->faces[g].kind != xm->faces[f].kind) continue;
+                int32_t kf = xm->faces[f].kind, kg = xm->faces[g].kind;
+                if (g == f || used[g] || (kg != kf && !(unify && cubic_kind(kf) && cubic_kind(kg)))) continue;
                 if (bs[4 * g + t + 1] != bs[4 * g + t]) continue;
                 const ccn__cad_surface *sf = &xm->faces[f].s, *sg = &xm->faces[g].s;
                 if (sf->periodic[0] || sf->periodic[1] || sg->periodic[0] || sg->periodic[1]) continue;
@@ -311,14 +457,25 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
                 int r = 0;
                 for (int k = 0; k < (s + 3) % 4 && !r; k++) r = tface_turn(&A); /* side s -> 1 */
                 for (int k = 0; k < (t + 1) % 4 && !r; k++) r = tface_turn(&B); /* side t -> 3 */
+                int64_t poles = (int64_t)A.n[0] * A.n[1] + (int64_t)B.n[0] * B.n[1];
+                if (!r && unify && (r = unify_v(&A, &B)) > 0) { /* sides not comparable */
+                    tface_free(&A);
+                    tface_free(&B);
+                    continue;
+                }
                 double tol = fmax(face_tolerance(sf, rel_tol), face_tolerance(sg, rel_tol));
                 int ok = r ? -1 : merge_pair(&A, &B, tol, &M);
+                if (ok > 0 && (int64_t)M.n[0] * M.n[1] > poles) { /* inserted knots kept: not smaller */
+                    tface_free(&M);
+                    ok = 0;
+                }
                 tface_free(&A);
                 tface_free(&B);
                 if (ok < 0) { oom = 1; break; }
                 if (!ok) continue;
                 if (replace_face(xm, f, &M)) { tface_free(&M); oom = 1; break; }
                 tface_free(&M);
+                xm->faces[f].kind = union_kind(kf, kg);
                 drop_face(xm, g);
                 used[f] = used[g] = 1;
                 round++;

@@ -359,6 +359,7 @@ static void test_cages(void) {
     check_cage("mixed_boundary", 0, 11);
     check_cage("torus_semi", 1, 0);
     check_cage("cube_semi", 1, 0); /* its corners capped once the creases decayed, no fills */
+    check_cage("crease_band", 0, 4); /* the four corners filled */
 }
 
 /* The default export of tests/data/<name>.obj at level 3 into F and info; CCN_OK or the
@@ -434,6 +435,50 @@ static void test_semi_sharp_knots(void) {
     int most = max_interior_knots("torus_semi");
     CHECK(most >= 0 && most <= 20, "torus_semi: a face with %d interior knots in one direction", most);
     printf("# torus_semi: at most %d interior knots per face and direction\n", most);
+}
+
+/* Beside a straight row of semi-sharp edges (crease_band: sharpness 2.5 across an 8 x 8 grid)
+ * the export refines level by level: a band of pieces per level, each with its level's cells and
+ * knots along the crease. The limit is C2 across the bands (it is the refinement's limit there,
+ * no crease rule reaches it), so the bands and the packs beside them are one face: every cell of
+ * the cage faces beside the crease, away from the ends' holes (rows 3 and 4, columns 2..5),
+ * lies in one face, and its knots are at most double (C1 or smoother inside). Level 1, so that
+ * the bands of levels 2 and 3 are the export's; test_cages checks the faces against the limit. */
+static void test_crease_band(void) {
+    ccn_obj *obj;
+    ccn_cage cage;
+    ccn_plan *p = load_at("crease_band", 1, &obj, &cage); /* the bands of levels 2 and 3 too */
+    CHECK(p != NULL, "crease_band: plan");
+    if (!p) return;
+    ccn_export_options eo;
+    memset(&eo, 0, sizeof eo);
+    faces F;
+    sink s = {NULL, 0, 0, -1};
+    ccn_export_info info;
+    ccn_error err;
+    CHECK(run(p, &eo, &F, &s, &info, &err) == CCN_OK, "crease_band: export: %s", err.message);
+    int owner = -1, split = 0, maxmult = 0;
+    for (int i = 0; i < F.n; i++)
+        for (int j = 0; j < F.f[i].ncells; j++) {
+            int cf = F.f[i].cells[j].cage_face, row = cf / 8, col = cf % 8;
+            if (row < 3 || row > 4 || col < 2 || col > 5) continue;
+            if (owner < 0) owner = i;
+            split += owner != i;
+        }
+    CHECK(owner >= 0 && split == 0, "crease_band: the cells beside the crease in %d other faces", split);
+    if (owner >= 0)
+        for (int d = 0; d < 2; d++)
+            for (int k = F.f[owner].deg[d] + 1, m = 1; k < F.f[owner].nt[d] - F.f[owner].deg[d] - 1; k++) {
+                m = F.f[owner].t[d][k] == F.f[owner].t[d][k - 1] ? m + 1 : 1;
+                if (m > maxmult) maxmult = m;
+            }
+    CHECK(maxmult <= 2, "crease_band: an interior knot of the band's face %d times", maxmult);
+    printf("# crease_band: %d faces; the band beside the crease one face of %d x %d poles\n", F.n,
+           owner >= 0 ? F.f[owner].np[0] : 0, owner >= 0 ? F.f[owner].np[1] : 0);
+    faces_free(&F);
+    free(s.d);
+    ccn_plan_destroy(p);
+    ccn_obj_destroy(obj);
 }
 
 /* Faces that share a whole side and join C1 or better are one face: the cube's 8 caps (24
@@ -1325,6 +1370,7 @@ int main(void) {
     RUN(test_refined);
     RUN(test_cages);
     RUN(test_semi_sharp_knots);
+    RUN(test_crease_band);
     RUN(test_merged_faces);
     RUN(test_caps_in_holes);
     RUN(test_caps_beyond_range);

@@ -227,6 +227,14 @@ def cube_semi():
     return V, F, [(e, 1.5) for e in edges]
 
 
+def crease_band(n=8, row=4, sharpness=2.5):
+    """An n x n grid, heights wobbled, with one straight row of semi-sharp edges across it (the
+    line y = row, boundary to boundary): beside the crease the limit is refined level by level,
+    a band of pieces per level, until the sharpness has decayed."""
+    V, F, idx = grid(n, n, lambda x, y: 0.25 * math.sin(0.9 * x + 0.4) * math.cos(0.7 * y - 0.3))
+    return V, F, [((idx(i, row), idx(i + 1, row)), sharpness) for i in range(n)]
+
+
 def prism_pyramid():
     """Triangular prism, one side quad replaced by a 4-triangle pyramid."""
     b = [[math.cos(2 * math.pi * k / 3), math.sin(2 * math.pi * k / 3), 0.0] for k in range(3)]
@@ -451,6 +459,8 @@ CREASED = [
     ("torus_semi.obj", torus_semi,
      "closed 8x6 torus, wobbled, two closed rings of semi-sharp edges (2 and 2.5) crossing"),
     ("cube_semi.obj", cube_semi, "closed cube, wobbled, all 12 edges at sharpness 1.5"),
+    ("crease_band.obj", crease_band,
+     "open 8x8 grid, wobbled heights, one straight row of edges at sharpness 2.5 across it"),
 ]
 
 FIGS = [
