@@ -50,6 +50,18 @@ static int piece_cmp(const void *pa, const void *pb) {
     return a->side - b->side;
 }
 
+/* An elementary segment's place on its face's boundary: side, the piece's order along it, k
+ * within the piece. */
+typedef struct { int32_t face, side, order, k; int32_t seg; } ref;
+
+static int ref_cmp(const void *pa, const void *pb) {
+    const ref *a = pa, *b = pb;
+    if (a->face != b->face) return a->face < b->face ? -1 : 1;
+    if (a->side != b->side) return a->side < b->side ? -1 : 1;
+    if (a->order != b->order) return a->order < b->order ? -1 : 1;
+    return (a->k > b->k) - (a->k < b->k);
+}
+
 static int dbl_cmp(const void *pa, const void *pb) {
     double a = *(const double *)pa, b = *(const double *)pb;
     return a < b ? -1 : a > b;
@@ -180,7 +192,6 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
     int32_t *cover = malloc(sizeof(int32_t) * 2 * (nint ? nint : 1)); /* per elementary interval */
     if (!es || !cover) { free(cover); goto oom; }
     /* per piece its elementary segments in running order; collect per side afterwards */
-    typedef struct { int32_t face, side, order, k; int32_t seg; } ref;
     ref *rf = malloc(sizeof(ref) * (ne ? ne : 1));
     if (!rf) { free(cover); goto oom; }
     size_t m = 0, ni = 0;
@@ -246,26 +257,13 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
     int32_t *perm = malloc(sizeof(int32_t) * (m ? m : 1)), *inv = malloc(sizeof(int32_t) * (m ? m : 1));
     if (!perm || !inv) { free(perm); free(inv); free(rf); goto oom; }
     {
-        /* counting sort by side, then by piece order and k within the side */
+        /* where each side starts (counts), then one sort by (face, side, piece order, k): a
+         * merged face's side can hold thousands of segments */
         memset(side_first, 0, sizeof(int32_t) * (4 * (size_t)F + 1));
         for (size_t i = 0; i < m; i++) side_first[4 * rf[i].face + rf[i].side + 1]++;
         for (int32_t i = 0; i < 4 * F; i++) side_first[i + 1] += side_first[i];
-        int32_t *fill = malloc(sizeof(int32_t) * (4 * (size_t)F + 1));
-        if (!fill) { free(perm); free(inv); free(rf); goto oom; }
-        memcpy(fill, side_first, sizeof(int32_t) * (4 * (size_t)F + 1));
-        for (size_t i = 0; i < m; i++) perm[fill[4 * rf[i].face + rf[i].side]++] = (int32_t)i;
-        free(fill);
-        for (int32_t sd = 0; sd < 4 * F; sd++) { /* insertion sort inside a side (few pieces) */
-            for (int32_t i = side_first[sd] + 1; i < side_first[sd + 1]; i++) {
-                int32_t x = perm[i], j = i - 1;
-                while (j >= side_first[sd] && (rf[perm[j]].order > rf[x].order ||
-                       (rf[perm[j]].order == rf[x].order && rf[perm[j]].k > rf[x].k))) {
-                    perm[j + 1] = perm[j];
-                    j--;
-                }
-                perm[j + 1] = x;
-            }
-        }
+        qsort(rf, m, sizeof *rf, ref_cmp);
+        for (size_t i = 0; i < m; i++) perm[i] = rf[i].seg;
     }
     free(rf);
     for (size_t i = 0; i < m; i++) inv[perm[i]] = (int32_t)i;
