@@ -449,7 +449,7 @@ ccn_status ccn_plan_export(ccn_plan *plan, const double *positions, const ccn_ex
         /* equal sides first, then, with the knots no face needs removed, sides made equal */
         for (int unify = 0; unify < 2; unify++) {
             if ((st = ccn__xm_merge_faces(&xm, v.lev[0], MERGE_TOLERANCE, unify, &merged, err))) goto done;
-            if (ccn__xm_remove_knots(&xm, KNOT_TOLERANCE) < 0) {
+            if (ccn__xm_remove_knots(&xm, KNOT_TOLERANCE, unify) < 0) {
                 st = ccn__fail(err, CCN_ERR_MEMORY, CCN_ELEM_NONE, -1, "out of memory (knot removal)");
                 goto done;
             }

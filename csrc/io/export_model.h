@@ -43,6 +43,7 @@ typedef struct {
     int32_t kind;            /* ccn_export_face_kind */
     int32_t patch;           /* ccn_plan_patches index, -1 */
     int32_t fill;            /* fill (hole) id, -1 */
+    int32_t merged;          /* made by a merge since the last knot removal (face_merge.h) */
     int32_t cells_u, cells_v, cell0; /* cells_u x cells_v cells (cell (i,j) at cell0 + i + cells_u j):
                                         side 0 of the face runs along cells (i, 0), side 1 along
                                         (cells_u-1, j), ... */

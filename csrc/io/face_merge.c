@@ -370,6 +370,7 @@ static int replace_face(ccn__xmodel *xm, int32_t fi, tface *M) {
     xm->num_cells += nc;
     X->cells_u = M->cu, X->cells_v = M->cv;
     X->patch = -1;
+    X->merged = 1;
     ccn__cad_surface *s = &X->s;
     free((void *)s->poles);
     s->poles = M->P;

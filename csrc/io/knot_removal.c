@@ -310,9 +310,12 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
 }
 
 
-int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol) {
+int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged) {
     int64_t total = 0;
     for (int32_t f = 0; f < xm->num_faces; f++) {
+        int skip = only_merged && !xm->faces[f].merged;
+        xm->faces[f].merged = 0;
+        if (skip) continue;
         int64_t got = face_remove(xm, f, rel_tol * ccn__cad_surface_size(&xm->faces[f].s, NULL));
         if (got < 0) { xm->oom = 1; return -1; }
         total += got;

@@ -11,9 +11,10 @@
  * times its own size (the diagonal of its poles' bounding box: small faces keep their
  * relative precision, and with it their normals). Parameters, domains and cells are unchanged:
  * the face map and the topology read only those. A closed (periodic) direction stays periodic
- * where its knots allow. Returns the number of knots removed, -1 when out of memory (xm->oom
- * set; the faces stay valid). */
-int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol);
+ * where its knots allow. only_merged: only the faces merged since the last call (the others
+ * have nothing left to remove); every face's `merged` is cleared. Returns the number of knots
+ * removed, -1 when out of memory (xm->oom set; the faces stay valid). */
+int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged);
 
 /* Boehm's insertion of x into a B-spline curve of degree p with n poles of w doubles each
  * (P: n x w, flat knots t: n + p + 1 values; both with room for one more). */

@@ -707,7 +707,7 @@ static void test_knot_removal(void) {
         CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
         if (f != 0) return;
         memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
-        int64_t got = ccn__xm_remove_knots(&xm, 1e-12);
+        int64_t got = ccn__xm_remove_knots(&xm, 1e-12, 0);
         const ccn__cad_surface *S = &xm.faces[0].s;
         int same = S->num_poles[0] == n0 && S->num_poles[1] == nv && got == extra;
         for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k == 0 ? 0 : k + p];
@@ -763,7 +763,7 @@ static void test_knot_removal(void) {
         if (f != 0) return;
         xm.faces[0].s.periodic[0] = 1;
         memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
-        int64_t got = ccn__xm_remove_knots(&xm, 1e-12);
+        int64_t got = ccn__xm_remove_knots(&xm, 1e-12, 0);
         const ccn__cad_surface *S = &xm.faces[0].s;
         int same = S->periodic[0] && S->num_poles[0] == n0 && got == m && S->num_knots[0] == n0 + p + 1;
         for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k];
