@@ -266,45 +266,62 @@ out:
     return st;
 }
 
-static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
+/* One round of removal along direction dir of face f (each removal within tol): the number of
+ * knots removed, -1 when out of memory. */
+static int64_t dir_remove(ccn__xmodel *xm, int32_t f, int dir, double tol) {
     ccn__cad_surface *s = &xm->faces[f].s;
-    int32_t nu = s->num_poles[0], nv = s->num_poles[1];
-    int64_t removed = 0;
-    for (int dir = 0; dir < 2; dir++) {
-        int32_t p = s->degree[dir], n = s->num_poles[dir], rows = s->num_poles[1 - dir];
-        int per = s->periodic[dir];
-        if (p > KR_MAX_DEGREE || s->num_knots[dir] <= 2) continue;
-        if (!per && (s->mults[dir][0] != p + 1 || s->mults[dir][s->num_knots[dir] - 1] != p + 1)) continue;
-        int32_t m = n + p + 1, ext = n + 2 * p; /* room for unwrap_periodic */
-        double *U = malloc(sizeof(double) * ((size_t)m + 2 * (size_t)p));
-        double *W = malloc(sizeof(double) * 3 * (size_t)ext * (size_t)rows);
-        if (!U || !W) { free(U); free(W); return -1; }
-        ccn__cad_flat_knots(s, dir, U);
-        /* W[row][k]: pole k along dir of row `row` */
-        const double *P = s->poles;
+    int32_t nv = s->num_poles[1];
+    int32_t p = s->degree[dir], n = s->num_poles[dir], rows = s->num_poles[1 - dir];
+    int per = s->periodic[dir];
+    if (p > KR_MAX_DEGREE || s->num_knots[dir] <= 2) return 0;
+    if (!per && (s->mults[dir][0] != p + 1 || s->mults[dir][s->num_knots[dir] - 1] != p + 1)) return 0;
+    int32_t m = n + p + 1, ext = n + 2 * p; /* room for unwrap_periodic */
+    double *U = malloc(sizeof(double) * ((size_t)m + 2 * (size_t)p));
+    double *W = malloc(sizeof(double) * 3 * (size_t)ext * (size_t)rows);
+    if (!U || !W) { free(U); free(W); return -1; }
+    ccn__cad_flat_knots(s, dir, U);
+    /* W[row][k]: pole k along dir of row `row` */
+    const double *P = s->poles;
+    for (int32_t row = 0; row < rows; row++)
+        for (int32_t k = 0; k < n; k++)
+            memcpy(W + 3 * ((size_t)row * n + k),
+                   P + 3 * (dir == 0 ? (size_t)k * nv + row : (size_t)row * nv + k), sizeof(double) * 3);
+    if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
+    int32_t n1 = n, got = ccn__kr_reduce_rows(U, p, &n1, rows, W, tol, NAN);
+    int wrapped = got > 0 && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
+    if (got < 0 || wrapped < 0) { free(U); free(W); return -1; }
+    if (got > 0) {
+        s->num_poles[dir] = n1;
+        s->periodic[dir] = wrapped == 0;
+        if (ccn__xm_set_flat(xm, f, dir, U)) { free(U); free(W); return -1; }
+        double *np = (double *)s->poles; /* shrinks: written in place */
+        int32_t nv1 = dir == 0 ? nv : n1;
         for (int32_t row = 0; row < rows; row++)
-            for (int32_t k = 0; k < n; k++)
-                memcpy(W + 3 * ((size_t)row * n + k),
-                       P + 3 * (dir == 0 ? (size_t)k * nv + row : (size_t)row * nv + k), sizeof(double) * 3);
-        if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
-        int32_t n1 = n, got = ccn__kr_reduce_rows(U, p, &n1, rows, W, tol, NAN);
-        int wrapped = got > 0 && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
-        if (got < 0 || wrapped < 0) { free(U); free(W); return -1; }
-        if (got > 0) {
-            s->num_poles[dir] = n1;
-            s->periodic[dir] = wrapped == 0;
-            if (ccn__xm_set_flat(xm, f, dir, U)) { free(U); free(W); return -1; }
-            double *np = (double *)s->poles; /* shrinks: written in place */
-            int32_t nu1 = dir == 0 ? n1 : nu, nv1 = dir == 0 ? nv : n1;
-            for (int32_t row = 0; row < rows; row++)
-                for (int32_t k = 0; k < n1; k++)
-                    memcpy(np + 3 * (dir == 0 ? (size_t)k * nv1 + row : (size_t)row * nv1 + k),
-                           W + 3 * ((size_t)row * n1 + k), sizeof(double) * 3);
-            nu = nu1, nv = nv1;
+            for (int32_t k = 0; k < n1; k++)
+                memcpy(np + 3 * (dir == 0 ? (size_t)k * nv1 + row : (size_t)row * nv1 + k),
+                       W + 3 * ((size_t)row * n1 + k), sizeof(double) * 3);
+    }
+    free(U);
+    free(W);
+    return got;
+}
+
+/* Rounds of removal over a face's two directions, until one removes nothing: a direction's
+ * removals are verified as a whole, so a direction that fails can pass once the other has lost
+ * the rows that failed it (OpenSubdiv's rook: 89.8 MB of STEP after one round, 84.0 after two,
+ * 83.9 after four). Each round moves the face by at most tol. */
+#define KR_ROUNDS 4
+
+static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
+    int64_t removed = 0;
+    for (int round = 0, again = 1; again && round < KR_ROUNDS; round++) {
+        again = 0;
+        for (int dir = 0; dir < 2; dir++) {
+            int64_t got = dir_remove(xm, f, dir, tol);
+            if (got < 0) return -1;
             removed += got;
+            again |= got > 0;
         }
-        free(U);
-        free(W);
     }
     return removed;
 }
