@@ -126,7 +126,8 @@ static double snap_to(double x, const double *a, int32_t n, double tol) {
 }
 
 /* f's v knots made U (m values, a superset of f's with f's ends): each missing copy inserted into
- * every u row (Boehm; the surface unchanged). -1: out of memory. */
+ * every u row (Boehm; the surface unchanged). 1: U is not a superset (f unchanged), -1: out of
+ * memory. */
 static int tface_insert_v(tface *f, const double *U, int32_t m) {
     int32_t nu = f->n[0], nv = f->n[1], q = f->deg[1], N = m - q - 1, w = 3 * nu;
     double *Q = malloc(sizeof(double) * (size_t)w * N), *t = malloc(sizeof(double) * (size_t)m);
@@ -137,11 +138,13 @@ static int tface_insert_v(tface *f, const double *U, int32_t m) {
     int32_t n = nv;
     for (int32_t i = 0, j = 0; i < m; i++) { /* U's values missing from t, in increasing order */
         if (j < n + q + 1 && t[j] == U[i]) { j++; continue; }
+        if (n == N) { n = -1; break; } /* more missing than U has room for: not a superset */
         ccn__insert_knot(Q, &n, w, t, q, U[i]);
         j++;
     }
+    if (n != N) { free(Q); free(t); return 1; }
     double *P = malloc(sizeof(double) * 3 * (size_t)nu * N);
-    if (!P || n != N) { free(Q); free(t); free(P); return -1; }
+    if (!P) { free(Q); free(t); return -1; }
     for (int32_t j = 0; j < N; j++)
         for (int32_t i = 0; i < nu; i++) memcpy(P + 3 * ((size_t)i * N + j), Q + (size_t)j * w + 3 * i, sizeof(double) * 3);
     free(Q); free(f->P); free(f->t[1]);
