@@ -33,7 +33,9 @@
  * face. A merge is kept only if the union has no more poles than the two faces had: the
  * inserted knots must be ones the join's knot removal gives back. Run after a pass without it
  * and the knot removal (io/knot_removal.h), so that the knots a band does not need are gone
- * before they would spread into its neighbours. */
+ * before they would spread into its neighbours. Closed bands (periodic along the shared side,
+ * as around a lathe shape's rings) merge only then, with equal knots along that side: merged
+ * before the removal, a knot one band needs would stay in the other. */
 #include "io/face_merge.h"
 
 #include "base/error.h"
@@ -48,7 +50,7 @@
 
 /* A face's data in flat form, owned. */
 typedef struct {
-    int32_t deg[2], n[2];
+    int32_t deg[2], n[2], per[2]; /* per: periodic (the cad.h form) in that direction */
     double *t[2]; /* flat knots: n + deg + 1 */
     double *P;    /* pole (i, j) at 3 (i n[1] + j), i along u */
     int32_t cu, cv;
@@ -70,6 +72,7 @@ static int tface_of(const ccn__xmodel *xm, int32_t fi, tface *f) {
     for (int d = 0; d < 2; d++) {
         f->deg[d] = s->degree[d];
         f->n[d] = s->num_poles[d];
+        f->per[d] = s->periodic[d];
         f->t[d] = malloc(sizeof(double) * (size_t)(s->num_poles[d] + s->degree[d] + 1));
     }
     if (!f->P || !f->cells || !f->t[0] || !f->t[1]) { tface_free(f); return -1; }
@@ -103,6 +106,7 @@ static int tface_turn(tface *f) {
     f->P = P, f->cells = C;
     f->t[0] = f->t[1], f->t[1] = tv;
     int32_t d = f->deg[0]; f->deg[0] = f->deg[1], f->deg[1] = d;
+    d = f->per[0]; f->per[0] = f->per[1], f->per[1] = d;
     f->n[0] = nv, f->n[1] = nu;
     int32_t c = f->cu; f->cu = f->cv, f->cv = c;
     return 0;
@@ -194,6 +198,7 @@ static int tface_cut_v(tface *f, const double *c, int32_t nc) {
 static int unify_v(tface *A, tface *B) {
     int32_t q = A->deg[1], ma = A->n[1] + q + 1, mb = B->n[1] + q + 1;
     if (B->deg[1] != q) return 1;
+    if (A->per[1] || B->per[1]) return 0; /* closed sides: equal or not merged (merge_pair) */
     double *ta = A->t[1], *tb = B->t[1];
     double a0 = ta[0], a1 = ta[ma - 1], b0 = tb[0], b1 = tb[mb - 1], sv = (a1 - a0) / (b1 - b0);
     double tol = 1e-12 * (a1 - a0);
@@ -295,6 +300,7 @@ static int merge_scaled(const tface *A, const tface *B, double tol, double c, do
     if (got == 0 || mult > p - 1) { free(U); free(W); return 0; }
     M->deg[0] = p, M->deg[1] = q;
     M->n[0] = n1, M->n[1] = nv;
+    M->per[0] = 0, M->per[1] = A->per[1];
     M->t[0] = U;
     M->t[1] = malloc(sizeof(double) * (size_t)mv);
     M->P = malloc(sizeof(double) * 3 * (size_t)n1 * nv);
@@ -323,7 +329,9 @@ static int merge_pair(const tface *A, const tface *B, double tol, tface *M) {
     int32_t p = A->deg[0], q = A->deg[1], nA = A->n[0], nB = B->n[0], nv = A->n[1];
     memset(M, 0, sizeof *M);
     if (B->deg[0] != p || B->deg[1] != q || B->n[1] != nv || B->cv != A->cv) return 0;
-    if (!clamped(A->t[0], nA, p) || !clamped(B->t[0], nB, p) || !clamped(A->t[1], nv, q) || !clamped(B->t[1], nv, q))
+    /* across the join clamped; along it clamped, or both periodic (closed bands stacked) */
+    if (A->per[0] || B->per[0] || A->per[1] != B->per[1] || !clamped(A->t[0], nA, p) || !clamped(B->t[0], nB, p) ||
+        (!A->per[1] && (!clamped(A->t[1], nv, q) || !clamped(B->t[1], nv, q))))
         return 0;
     /* v: B's knots an affine image of A's */
     const double *ta = A->t[1], *tb = B->t[1];
@@ -381,7 +389,7 @@ static int replace_face(ccn__xmodel *xm, int32_t fi, tface *M) {
     for (int d = 0; d < 2; d++) {
         s->degree[d] = M->deg[d];
         s->num_poles[d] = M->n[d];
-        s->periodic[d] = 0;
+        s->periodic[d] = M->per[d];
         if (ccn__xm_set_flat(xm, fi, d, M->t[d])) return -1;
     }
     return 0;
@@ -454,7 +462,9 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
                 if (g == f || used[g] || (kg != kf && !(unify && cubic_kind(kf) && cubic_kind(kg)))) continue;
                 if (bs[4 * g + t + 1] != bs[4 * g + t]) continue;
                 const ccn__cad_surface *sf = &xm->faces[f].s, *sg = &xm->faces[g].s;
-                if (sf->periodic[0] || sf->periodic[1] || sg->periodic[0] || sg->periodic[1]) continue;
+                if ((sf->periodic[0] || sf->periodic[1] || sg->periodic[0] || sg->periodic[1]) &&
+                    (!unify || (sf->periodic[0] && sf->periodic[1]) || (sg->periodic[0] && sg->periodic[1])))
+                    continue; /* closed bands only once their knots are removed (the poles rule) */
                 tface A, B, M;
                 if (tface_of(xm, f, &A)) { oom = 1; break; }
                 if (tface_of(xm, g, &B)) { tface_free(&A); oom = 1; break; }
