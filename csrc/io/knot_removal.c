@@ -15,16 +15,33 @@
  * at the middle pole m (p odd) or |Q_left - Q_right| <= d (p even); the surface then moves by
  * at most d. Every pole row of the direction must pass, each removal within tol; the removals
  * of a direction are then checked together (verified): the removed knots inserted back must
- * give the original poles within tol, or the direction is left as it was. */
+ * give the original poles within tol, or the direction is left as it was.
+ *
+ * Order: the recursions divide by the a_i, so a removal next to a span already grown by earlier
+ * removals amplifies the rounding those left in the poles; removing a long run of knots one
+ * after the other (a crease strip's 2^levels knots per cage span) drifts by many ulps and the
+ * whole direction fails its check. So a pass removes every other knot of a run (each between
+ * two spans of the same length, as refinement made them: coarsening level by level) and passes
+ * repeat until one removes nothing; only if that fails its check is the run taken in order.
+ *
+ * Tolerance: a face's poles come out of many refinement steps and carry rounding of some ulps
+ * of their coordinates, which no removal can tell from the surface; for a small face far from
+ * the origin 1e-13 of its size is a few ulps. So a face may move by the larger of rel_tol of
+ * its size and KR_ROUNDING_ULPS ulps of its largest coordinate, the latter never more than
+ * KR_MAX_TURN of its smallest pole spacing (a move of d turns its normals by about d over the
+ * spacing: 1e-9 rad at most, a tenth of the export's G1 budget). */
 #include "io/knot_removal.h"
 
 #include "base/vec3.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define KR_MAX_DEGREE 8 /* the export's faces are of degree 3 and 5 */
+#define KR_ROUNDING_ULPS 64 /* a face's rounding floor, ulps of its largest coordinate ... */
+#define KR_MAX_TURN 1e-9    /* ... never more than this fraction of its smallest pole spacing */
 
 /* One row's removal poles for one copy of the knot u = U[r] of multiplicity s (r its last
  * index): Q (p - s + 3 points, Q[0] = P[first-1], Q[last+1-off] = P[last+1]) and the meeting
@@ -52,11 +69,12 @@ static double row_try(const double *U, int32_t p, int32_t r, int32_t s, const do
 /* Direction with rows x n poles W[row][k] (3 each) and flat knots U (n + p + 1, clamped: the
  * interior knots are U[p+1 .. n-1]): removes, one copy at a time, each interior knot copy whose
  * removal is within step_tol (a knot of multiplicity s <= p: a join C^(p-s) becomes C^(p-s+1));
- * only the knot of value `only` unless it is NaN. (Skipped: the end knots, and interior breaks of
- * multiplicity p + 1.)
+ * only the knot of value `only` unless it is NaN. alternate: after a simple knot is removed its
+ * right neighbour is left for the next pass (see the order above). (Skipped: the end knots, and
+ * interior breaks of multiplicity p + 1.)
  * Returns the number of copies removed; *n and U, W updated. */
 static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double step_tol,
-                          double only) {
+                          double only, int alternate) {
     int32_t removed = 0, N = *n;
     double Q[KR_MAX_DEGREE + 3][3];
     int32_t r = p + 1;
@@ -84,7 +102,8 @@ static int32_t remove_dir(double *U, int32_t p, int32_t *n, int32_t rows, double
         }
         memmove(U + r1, U + r1 + 1, sizeof(double) * (size_t)(N + p - r1));
         N--;
-        removed++; /* the same knot again (one copy fewer), or the next one at r */
+        removed++;
+        if (alternate && s == 1) r = r1 + 1; /* its neighbour waits for the next pass */
     }
     *n = N;
     return removed;
@@ -136,16 +155,21 @@ int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, doub
     if (!U0 || !W0) { free(U0); free(W0); return -1; }
     memcpy(U0, U, sizeof(double) * (size_t)m);
     memcpy(W0, W, sizeof(double) * 3 * (size_t)n0 * rows);
-    int32_t n1 = n0, got = remove_dir(U, p, &n1, rows, W, tol, only);
-    int ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
-    if (ok < 0) got = -1;
-    if (ok == 1) {
-        *n = n1;
-    } else { /* as it was */
-        memcpy(U, U0, sizeof(double) * (size_t)m);
-        memcpy(W, W0, sizeof(double) * 3 * (size_t)n0 * rows);
-        if (got > 0) got = 0;
+    int32_t n1 = n0, got = 0;
+    int ok = 0;
+    for (int alternate = 1; alternate >= 0 && ok == 0; alternate--) {
+        n1 = n0, got = 0;
+        for (int32_t g; (g = remove_dir(U, p, &n1, rows, W, tol, only, alternate)) > 0;) got += g;
+        ok = got > 0 ? verified(U0, W0, n0, U, W, n1, p, rows, tol) : 0;
+        if (ok != 1) { /* as it was */
+            memcpy(U, U0, sizeof(double) * (size_t)m);
+            memcpy(W, W0, sizeof(double) * 3 * (size_t)n0 * rows);
+        }
+        if (got == 0) break;
     }
+    if (ok < 0) got = -1;
+    else if (ok == 1) *n = n1;
+    else got = 0;
     free(U0);
     free(W0);
     return got;
@@ -327,13 +351,28 @@ static int64_t face_remove(ccn__xmodel *xm, int32_t f, double tol) {
 }
 
 
+/* The smallest distance between neighbouring poles of s (0 where rows collapse). */
+static double min_spacing(const ccn__cad_surface *s) {
+    int32_t nu = s->num_poles[0], nv = s->num_poles[1];
+    double h = HUGE_VAL;
+    for (int32_t i = 0; i < nu; i++)
+        for (int32_t j = 0; j < nv; j++) {
+            const double *a = s->poles + 3 * ((size_t)i * nv + j);
+            if (i + 1 < nu) h = fmin(h, ccn__dist3(a, a + 3 * (size_t)nv));
+            if (j + 1 < nv) h = fmin(h, ccn__dist3(a, a + 3));
+        }
+    return h == HUGE_VAL ? 0 : h;
+}
+
 int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged) {
     int64_t total = 0;
     for (int32_t f = 0; f < xm->num_faces; f++) {
         int skip = only_merged && !xm->faces[f].merged;
         xm->faces[f].merged = 0;
         if (skip) continue;
-        int64_t got = face_remove(xm, f, rel_tol * ccn__cad_surface_size(&xm->faces[f].s, NULL));
+        double reach, size = ccn__cad_surface_size(&xm->faces[f].s, &reach);
+        double floor = fmin(KR_ROUNDING_ULPS * DBL_EPSILON * reach, KR_MAX_TURN * min_spacing(&xm->faces[f].s));
+        int64_t got = face_remove(xm, f, fmax(rel_tol * size, floor));
         if (got < 0) { xm->oom = 1; return -1; }
         total += got;
     }

@@ -9,7 +9,9 @@
  * rounding of its poles), the same surface has a representation without that knot (The NURBS
  * Book, 2nd ed., A5.8, applied to every pole row at once), in up to four rounds over the two
  * directions. A face moves by at most rel_tol times its own size per round (the diagonal of its
- * poles' bounding box: small faces keep their relative precision, and with it their normals). Parameters, domains and cells are unchanged:
+ * poles' bounding box: small faces keep their relative precision, and with it their normals),
+ * or, where that is below the rounding of its coordinates, by 64 ulps of its largest coordinate
+ * but no more than 1e-9 of its smallest pole spacing. Parameters, domains and cells are unchanged:
  * the face map and the topology read only those. A closed (periodic) direction stays periodic
  * where its knots allow. only_merged: only the faces merged since the last call (the others
  * have nothing left to remove); every face's `merged` is cleared. Returns the number of knots

@@ -772,6 +772,66 @@ static void test_knot_removal(void) {
     }
 }
 
+/* A strip beside a semi-sharp crease as the export packs it: a bicubic face one span across and
+ * a few cage spans along, refined here eight levels along u (every dyadic knot down to 1/256 of
+ * a span, inserted level by level as refinement leaves them: each pole carries the rounding of
+ * a few ulps), placed as a small face far from the origin (size 0.1 at 2). The removal at the
+ * export's tolerance must give back the cage spans but for a few knots (at least 98 % of the
+ * inserted ones removed: the last, coarsest removals meet the rounding of all the finer ones)
+ * and the same surface to the rounding of its coordinates. */
+static void test_knot_removal_long_run(void) {
+    for (int trial = 0; trial < 4; trial++) {
+        int p = 3, spans = 2 + trial, n0 = spans + p, nv = 4, levels = 8;
+        int extra = spans * ((1 << levels) - 1), nf = n0 + extra;
+        double *t0 = malloc(sizeof(double) * (size_t)(n0 + p + 1)), tv[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+        double *tf = malloc(sizeof(double) * (size_t)(nf + p + 1)), *tr = malloc(sizeof(double) * (size_t)(nf + p + 1));
+        double *P0 = malloc(sizeof(double) * 3 * (size_t)n0 * nv), *Pf = malloc(sizeof(double) * 3 * (size_t)nf * nv);
+        double *row = malloc(sizeof(double) * 3 * (size_t)(nf + 1));
+        for (int i = 0; i <= n0 + p; i++) t0[i] = i <= p ? 0 : i >= n0 ? spans : i - p;
+        const double at[3] = {1.9, -0.7, 0.4};
+        for (int i = 0; i < n0 * nv; i++)
+            for (int c = 0; c < 3; c++) P0[3 * i + c] = at[c] + 0.04 * tl_rand01();
+        for (int j = 0; j < nv; j++) {
+            int n = n0;
+            memcpy(tf, t0, sizeof(double) * (size_t)(n0 + p + 1));
+            for (int i = 0; i < n0; i++) memcpy(row + 3 * i, P0 + 3 * (i * nv + j), sizeof(double) * 3);
+            for (int l = 1; l <= levels; l++) /* level by level, as refinement halves the spans */
+                for (int k = 0; k < spans << (l - 1); k++) boehm(tf, p, &n, row, (2 * k + 1) / (double)(1 << l));
+            for (int i = 0; i < nf; i++) memcpy(Pf + 3 * (i * nv + j), row + 3 * i, sizeof(double) * 3);
+        }
+        ccn__xmodel xm;
+        memset(&xm, 0, sizeof xm);
+        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_REFINED, p, p, nf, nv, 1, 1);
+        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
+        if (f != 0) return;
+        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        int64_t got = ccn__xm_remove_knots(&xm, 1e-13, 0);
+        const ccn__cad_surface *S = &xm.faces[0].s;
+        CHECK(got >= 0.98 * extra, "trial %d: %lld of %d inserted knots removed, %d poles along u for "
+              "the cage's %d", trial, (long long)got, extra, (int)S->num_poles[0], n0);
+        face a = {0}, b = {0};
+        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
+        a.np[0] = n0, a.np[1] = nv, a.t[0] = t0, a.t[1] = tv, a.P = P0;
+        int m = 0;
+        for (int k = 0; k < S->num_knots[0]; k++)
+            for (int c = 0; c < S->mults[0][k]; c++) tr[m++] = S->knots[0][k];
+        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = tr, b.t[1] = tv, b.P = (double *)S->poles;
+        double worst = 0;
+        for (int k = 0; k < 400; k++) {
+            double u = spans * tl_rand01(), v = tl_rand01(), x[3], y[3];
+            feval(&a, u, v, x);
+            feval(&b, u, v, y);
+            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
+        }
+        CHECK(worst <= 1e-13, "trial %d: the surface moved %g", trial, worst);
+        printf("# a strip of %d cage spans refined 8 levels, at 2 from the origin: %lld of %d knots removed, "
+               "%d poles along u for the cage's %d, the surface moved %.2g\n", spans, (long long)got, extra,
+               (int)S->num_poles[0], n0, worst);
+        ccn__xm_free(&xm);
+        free(t0); free(tf); free(tr); free(P0); free(Pf); free(row);
+    }
+}
+
 /* The exact pieces around holes equal the strict patches of a global refinement. */
 static void check_refined(const char *name, int fill_levels, int depth) {
     ccn_obj *obj;
@@ -1364,6 +1424,7 @@ int main(void) {
     RUN(test_fills_g1);
     RUN(test_far_from_origin);
     RUN(test_knot_removal);
+    RUN(test_knot_removal_long_run);
     RUN(test_parts);
     RUN(test_pcurves);
     RUN(test_written_once);
