@@ -156,6 +156,59 @@ static int tface_insert_v(tface *f, const double *U, int32_t m) {
     return 0;
 }
 
+/* The same for f periodic along v: its knots within the period made D (nd values from its
+ * domain's start to its end, f's among them). Unwrapped to the clamped form (exact), the
+ * missing knots inserted, wrapped again (kept only if the periodic form reproduces the clamped
+ * one within tol). 1: not a superset, or not periodic again (f unchanged); -1: out of memory. */
+static int tface_insert_v_periodic(tface *f, const double *D, int32_t nd, double tol) {
+    int32_t q = f->deg[1], n = f->n[1], rows = f->n[0], n1 = nd - 1 + q;
+    if (n1 <= n) return 1;
+    double *U = malloc(sizeof(double) * (size_t)(n + 3 * q + 1));
+    double *W = malloc(sizeof(double) * 3 * (size_t)rows * (n + 2 * q));
+    double *W1 = malloc(sizeof(double) * 3 * (size_t)rows * n1);
+    double *t = malloc(sizeof(double) * (size_t)(n1 + 3 * q + 1));
+    int r = 0;
+    if (!U || !W || !W1 || !t) { r = -1; goto out; }
+    memcpy(U, f->t[1], sizeof(double) * (size_t)(n + q + 1));
+    memcpy(W, f->P, sizeof(double) * 3 * (size_t)rows * n); /* row i (along u) runs along v */
+    if (ccn__kr_unwrap_periodic(U, q, n, rows, W)) { r = -1; goto out; }
+    for (int32_t row = 0; row < rows && !r; row++) {
+        double *P = W1 + 3 * (size_t)row * n1;
+        memcpy(P, W + 3 * (size_t)row * n, sizeof(double) * 3 * (size_t)n);
+        memcpy(t, U, sizeof(double) * (size_t)(n + q + 1));
+        int32_t N = n, j = q + 1;
+        for (int32_t i = 1; i + 1 < nd; i++) { /* D's interior values missing from t */
+            if (j < N && t[j] == D[i]) { j++; continue; }
+            if (N == n1) { r = 1; break; }
+            ccn__insert_knot(P, &N, 3, t, q, D[i]);
+            j++;
+        }
+        if (!r && (N != n1 || t[q] != D[0] || t[n1] != D[nd - 1])) r = 1;
+    }
+    if (!r) r = ccn__kr_rewrap_periodic(t, q, n1, rows, W1, tol);
+    if (!r) {
+        free(f->P); free(f->t[1]);
+        f->P = W1, f->t[1] = t, f->n[1] = n1;
+        W1 = t = NULL;
+    }
+out:
+    free(U); free(W); free(W1); free(t);
+    return r;
+}
+
+/* A tolerance for a face's own rounding: 1e-12 of its size and 16 ulps of its largest
+ * coordinate. */
+static double tface_tolerance(const tface *f) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, big = 0, d2 = 0;
+    for (size_t i = 0; i < (size_t)f->n[0] * f->n[1]; i++)
+        for (int c = 0; c < 3; c++) {
+            double x = f->P[3 * i + c];
+            lo[c] = fmin(lo[c], x), hi[c] = fmax(hi[c], x), big = fmax(big, fabs(x));
+        }
+    for (int c = 0; c < 3; c++) d2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    return 1e-12 * sqrt(d2) + 16 * DBL_EPSILON * big;
+}
+
 /* y as k / 2^d (d <= 30) when it is one to 1e-9, else NaN: cells are dyadic rectangles of their
  * cage face, and places are compared exactly (export_model.h). */
 static double dyadic(double y) {
@@ -197,10 +250,11 @@ static int tface_cut_v(tface *f, const double *c, int32_t nc) {
  * nothing to do), 1: not comparable, -1: out of memory. */
 static int unify_v(tface *A, tface *B) {
     int32_t q = A->deg[1], ma = A->n[1] + q + 1, mb = B->n[1] + q + 1;
-    if (B->deg[1] != q) return 1;
-    if (A->per[1] || B->per[1]) return 0; /* closed sides: equal or not merged (merge_pair) */
+    if (B->deg[1] != q || A->per[1] != B->per[1]) return 1;
+    int per = A->per[1]; /* closed sides: the knots within the period, wrapped again */
     double *ta = A->t[1], *tb = B->t[1];
-    double a0 = ta[0], a1 = ta[ma - 1], b0 = tb[0], b1 = tb[mb - 1], sv = (a1 - a0) / (b1 - b0);
+    /* the domains' ends (a clamped face's end knots, a periodic one's period) */
+    double a0 = ta[q], a1 = ta[A->n[1]], b0 = tb[q], b1 = tb[B->n[1]], sv = (a1 - a0) / (b1 - b0);
     double tol = 1e-12 * (a1 - a0);
     if (!(sv > 0) || !isfinite(sv)) return 1;
     /* A's cell boundaries */
@@ -224,12 +278,15 @@ static int unify_v(tface *A, tface *B) {
         }
     for (int32_t j = 0; j < B->cv; j++) bc[j] = B->cells[B->cu * j].uv[2];
     bc[B->cv] = B->cells[B->cu * (B->cv - 1)].uv[3];
-    /* the unions (sorted merges: equal values once, knots with the larger multiplicity) */
+    /* the unions (sorted merges: equal values once, knots with the larger multiplicity; of a
+     * periodic face the knots of its domain) */
     int32_t m = 0, nc = 0, r = 0;
-    for (int32_t i = 0, j = 0; i < ma || j < mb;) {
-        if (j >= mb || (i < ma && ta[i] < tb[j])) U[m++] = ta[i++];
-        else if (i >= ma || tb[j] < ta[i]) U[m++] = tb[j++];
-        else U[m++] = ta[i++], j++;
+    const double *xa = per ? ta + q : ta, *xb = per ? tb + q : tb;
+    int32_t la = per ? A->n[1] - q + 1 : ma, lb = per ? B->n[1] - q + 1 : mb;
+    for (int32_t i = 0, j = 0; i < la || j < lb;) {
+        if (j >= lb || (i < la && xa[i] < xb[j])) U[m++] = xa[i++];
+        else if (i >= la || xb[j] < xa[i]) U[m++] = xb[j++];
+        else U[m++] = xa[i++], j++;
     }
     for (int32_t i = 0, j = 0; i < ca || j < cb;) {
         if (j >= cb || (i < ca && ac[i] < bc[j])) C[nc++] = ac[i++];
@@ -238,8 +295,13 @@ static int unify_v(tface *A, tface *B) {
     }
     for (int32_t i = 1; i + q < m - 1 && !r; i++) /* an interior knot of more than q copies */
         if (U[i] > U[0] && U[i + q] == U[i] && U[i] < U[m - 1]) r = 1;
-    if (!r && m != ma) r = tface_insert_v(A, U, m);
-    if (!r && m != mb) r = tface_insert_v(B, U, m);
+    if (per) {
+        if (!r && m != la) r = tface_insert_v_periodic(A, U, m, tface_tolerance(A));
+        if (!r && m != lb) r = tface_insert_v_periodic(B, U, m, tface_tolerance(B));
+    } else {
+        if (!r && m != ma) r = tface_insert_v(A, U, m);
+        if (!r && m != mb) r = tface_insert_v(B, U, m);
+    }
     if (!r && nc != ca) r = tface_cut_v(A, C, nc);
     if (!r && nc != cb) r = tface_cut_v(B, C, nc);
     free(U); free(bc); free(ac); free(C);

@@ -385,3 +385,11 @@ int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged) {
     }
     return total;
 }
+
+int ccn__kr_unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W) {
+    return unwrap_periodic(U, p, n, rows, W);
+}
+
+int ccn__kr_rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol) {
+    return rewrap_periodic(U, p, n, rows, W, tol);
+}

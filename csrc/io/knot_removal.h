@@ -29,4 +29,15 @@ void ccn__insert_knot(double *P, int32_t *n, int32_t w, double *t, int32_t p, do
 int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, double *W, double tol,
                             double only);
 
+/* A periodic direction's rows (rows x n poles W[row][k] along the flat knots U of the cad.h
+ * form) unwrapped to the clamped form over the same domain (exact knot insertion): U becomes
+ * n + p + 1 clamped knots, W rows x n. U: room for n + 3p + 1, W: rows x (n + 2p). 0, or -1
+ * when out of memory. */
+int ccn__kr_unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W);
+/* The inverse: clamped rows (n poles, simple interior knots) back to the periodic form of the
+ * same spline (least squares, kept only if it reproduces them within tol): 0 done (U, W in the
+ * periodic form, n poles), 1 not (unchanged; too many spans, too few, or not periodic), -1 out
+ * of memory. */
+int ccn__kr_rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol);
+
 #endif

@@ -360,6 +360,7 @@ static void test_cages(void) {
     check_cage("torus_semi", 1, 0);
     check_cage("cube_semi", 1, 0); /* its corners capped once the creases decayed, no fills */
     check_cage("crease_band", 0, 4); /* the four corners filled */
+    check_cage("crease_tube", 0, 0);
 }
 
 /* tests/data/<name>.obj (or an OBJ text) at output level `levels` (raised until its caps exist)
@@ -770,6 +771,31 @@ static void test_knot_removal(void) {
         CHECK(worst <= 1e-12, "closed trial %d: the surface moved %g", trial, worst);
         ccn__xm_free(&xm);
     }
+}
+
+/* The same around a tube (crease_tube: a closed ring of sharpness 2.5 around an open tube of
+ * 8 x 6 quads): every band is closed, periodic around the tube, and the bands of different
+ * levels (the packs of the cage rows away from the crease, the refined bands nearer it) differ
+ * in their knots around it. They merge when both take the union of those knots (inserted in the
+ * periodic form): the cells of cage rows 0 and 1 lie in one face, those of rows 4 and 5 in one. */
+static void test_crease_tube(void) {
+    faces F;
+    ccn_export_info info;
+    CHECK(export_text("crease_tube", 1, CCN_CAP_GUIDED_BI5, 0, &F, &info, NULL) == CCN_OK, "crease_tube: export");
+    for (int side = 0; side < 2; side++) {
+        int owner = -1, split = 0;
+        for (int i = 0; i < F.n; i++)
+            for (int j = 0; j < F.f[i].ncells; j++) {
+                int row = F.f[i].cells[j].cage_face / 8;
+                if (side ? row < 4 : row > 1) continue;
+                if (owner < 0) owner = i;
+                split += owner != i;
+            }
+        CHECK(owner >= 0 && split == 0, "crease_tube: the cells of rows %s in %d other faces", side ? "4, 5" : "0, 1",
+              split);
+    }
+    printf("# crease_tube: %d faces\n", F.n);
+    faces_free(&F);
 }
 
 /* A strip beside a semi-sharp crease as the export packs it: a bicubic face one span across and
@@ -1418,6 +1444,7 @@ int main(void) {
     RUN(test_cages);
     RUN(test_semi_sharp_knots);
     RUN(test_crease_band);
+    RUN(test_crease_tube);
     RUN(test_merged_faces);
     RUN(test_caps_in_holes);
     RUN(test_caps_beyond_range);

@@ -235,6 +235,22 @@ def crease_band(n=8, row=4, sharpness=2.5):
     return V, F, [((idx(i, row), idx(i + 1, row)), sharpness) for i in range(n)]
 
 
+def crease_tube(n=8, rows=6, ring=3, sharpness=2.5):
+    """An open tube of n x rows quads (a lathe shape: radius and height wobbled, no symmetry),
+    with the vertex ring `ring` of semi-sharp edges around it: beside the crease the limit is
+    refined level by level, a closed band of pieces per level, every band periodic around the
+    tube."""
+    V = []
+    for j in range(rows + 1):
+        for i in range(n):
+            a = 2 * math.pi * i / n
+            r = 1.0 + 0.12 * math.sin(1.3 * j + 0.7) + 0.05 * math.cos(2 * a + 0.3 * j)
+            V.append([r * math.cos(a), r * math.sin(a), 0.5 * j + 0.04 * math.sin(3 * a + j)])
+    idx = lambda i, j: j * n + (i % n)
+    F = [[idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)] for j in range(rows) for i in range(n)]
+    return V, F, [((idx(i, ring), idx(i + 1, ring)), sharpness) for i in range(n)]
+
+
 def prism_pyramid():
     """Triangular prism, one side quad replaced by a 4-triangle pyramid."""
     b = [[math.cos(2 * math.pi * k / 3), math.sin(2 * math.pi * k / 3), 0.0] for k in range(3)]
@@ -461,6 +477,8 @@ CREASED = [
     ("cube_semi.obj", cube_semi, "closed cube, wobbled, all 12 edges at sharpness 1.5"),
     ("crease_band.obj", crease_band,
      "open 8x8 grid, wobbled heights, one straight row of edges at sharpness 2.5 across it"),
+    ("crease_tube.obj", crease_tube,
+     "open tube of 8x6 quads, wobbled, one closed ring of edges at sharpness 2.5 around it"),
 ]
 
 FIGS = [

@@ -156,6 +156,7 @@ for ext in step igs; do # the unit cube's six flat faces bound volume 1
 done
 check cube_semi "$T/cube_semi.obj" 3
 check crease_band tests/data/crease_band.obj 3 # bands of every level and packs merged into one face
+check crease_tube tests/data/crease_tube.obj 3 # closed bands of every level merged around the tube
 check dart_corner "$T/dart_corner.obj" 3
 if [ -n "$OSD_DIR" ]; then
   for s in inf_crease0 inf_crease1 cube_creases2 single_crease torus_creases1 dart_edgecorner fvar_project0 cube_corner4; do
