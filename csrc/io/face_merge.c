@@ -8,7 +8,8 @@
  *
  * A pair (face A, side s; face B, side t) is merged when, after turning both domains by
  * quarter turns so that the shared side is A's u = max and B's u = min:
- *   - both are clamped, not periodic, of equal degrees, with the same number of cell rows;
+ *   - both are clamped across the join (along it clamped, or both periodic), of equal degrees,
+ *     with the same number of cell rows;
  *   - their v knot vectors agree up to an affine map (B's v is re-parametrised onto A's);
  *   - the shared pole column agrees within tol (face_tolerance);
  *   - B's u is scaled so that the two cross-boundary derivatives agree (ratio of their lengths
@@ -34,8 +35,9 @@
  * inserted knots must be ones the join's knot removal gives back. Run after a pass without it
  * and the knot removal (io/knot_removal.h), so that the knots a band does not need are gone
  * before they would spread into its neighbours. Closed bands (periodic along the shared side,
- * as around a lathe shape's rings) merge only then, with equal knots along that side: merged
- * before the removal, a knot one band needs would stay in the other. */
+ * as around a lathe shape's rings) merge only then (merged before the removal, a knot one band
+ * needs would stay in the other); where their knots around differ, the union is inserted in the
+ * periodic form (tface_insert_v_periodic). */
 #include "io/face_merge.h"
 
 #include "base/error.h"

@@ -378,8 +378,8 @@ int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged) {
         xm->faces[f].merged = 0;
         if (skip) continue;
         double reach, size = ccn__cad_surface_size(&xm->faces[f].s, &reach);
-        double floor = fmin(KR_ROUNDING_ULPS * DBL_EPSILON * reach, KR_MAX_TURN * min_spacing(&xm->faces[f].s));
-        int64_t got = face_remove(xm, f, fmax(rel_tol * size, floor));
+        double rounding = fmin(KR_ROUNDING_ULPS * DBL_EPSILON * reach, KR_MAX_TURN * min_spacing(&xm->faces[f].s));
+        int64_t got = face_remove(xm, f, fmax(rel_tol * size, rounding));
         if (got < 0) { xm->oom = 1; return -1; }
         total += got;
     }
