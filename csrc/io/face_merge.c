@@ -198,19 +198,6 @@ out:
     return r;
 }
 
-/* A tolerance for a face's own rounding: 1e-12 of its size and 16 ulps of its largest
- * coordinate. */
-static double tface_tolerance(const tface *f) {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, big = 0, d2 = 0;
-    for (size_t i = 0; i < (size_t)f->n[0] * f->n[1]; i++)
-        for (int c = 0; c < 3; c++) {
-            double x = f->P[3 * i + c];
-            lo[c] = fmin(lo[c], x), hi[c] = fmax(hi[c], x), big = fmax(big, fabs(x));
-        }
-    for (int c = 0; c < 3; c++) d2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-    return 1e-12 * sqrt(d2) + 16 * DBL_EPSILON * big;
-}
-
 /* y as k / 2^d (d <= 30) when it is one to 1e-9, else NaN: cells are dyadic rectangles of their
  * cage face, and places are compared exactly (export_model.h). */
 static double dyadic(double y) {
@@ -245,12 +232,25 @@ static int tface_cut_v(tface *f, const double *c, int32_t nc) {
     return 0;
 }
 
+/* A pair's tolerance: rel_tol times the face's size (its poles' bounding-box diagonal) plus the
+ * rounding of its coordinates (16 units in the last place of the largest). Measured on the
+ * test cages, OpenSubdiv's car and the 2.5k cage: unions that are C1 miss it by at most 3e-12 of
+ * the largest coordinate (the bi-5 patches' own construction; degree-3 pieces 1e-14), unions
+ * that are not by 1e-6 or more, and the shared columns of faces that meet differ by at most
+ * 3e-12; so rel_tol = 1e-10 decides far from both (the same faces on every platform's build),
+ * while the surface moves only by the union's actual defect. */
+static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
+    double big, size = ccn__cad_surface_size(s, &big);
+    return rel_tol * size + 16 * DBL_EPSILON * big;
+}
+
 /* B's v (along the shared side) made A's parameter, and both faces' v knots and cells the
  * union of the two: a side of a coarser level's piece against a finer one's, or of pieces
  * whose knots were thinned differently. The surfaces are unchanged (knot insertion, cells cut);
- * whether the two sides are the same curve is merge_pair's shared-column check. 0: done (or
- * nothing to do), 1: not comparable, -1: out of memory. */
-static int unify_v(tface *A, tface *B) {
+ * whether the two sides are the same curve is merge_pair's shared-column check. tol_a, tol_b:
+ * each face's own rounding, within which a closed face's union must reproduce it
+ * (tface_insert_v_periodic). 0: done (or nothing to do), 1: not comparable, -1: out of memory. */
+static int unify_v(tface *A, tface *B, double tol_a, double tol_b) {
     int32_t q = A->deg[1], ma = A->n[1] + q + 1, mb = B->n[1] + q + 1;
     if (B->deg[1] != q || A->per[1] != B->per[1]) return 1;
     int per = A->per[1]; /* closed sides: the knots within the period, wrapped again */
@@ -298,8 +298,8 @@ static int unify_v(tface *A, tface *B) {
     for (int32_t i = 1; i + q < m - 1 && !r; i++) /* an interior knot of more than q copies */
         if (U[i] > U[0] && U[i + q] == U[i] && U[i] < U[m - 1]) r = 1;
     if (per) {
-        if (!r && m != la) r = tface_insert_v_periodic(A, U, m, tface_tolerance(A));
-        if (!r && m != lb) r = tface_insert_v_periodic(B, U, m, tface_tolerance(B));
+        if (!r && m != la) r = tface_insert_v_periodic(A, U, m, tol_a);
+        if (!r && m != lb) r = tface_insert_v_periodic(B, U, m, tol_b);
     } else {
         if (!r && m != ma) r = tface_insert_v(A, U, m);
         if (!r && m != mb) r = tface_insert_v(B, U, m);
@@ -479,18 +479,6 @@ static int mergeable_kind(int32_t kind) {
            kind == CCN_EXPORT_FACE_REFINED;
 }
 
-/* A pair's tolerance: rel_tol times the face's size (its poles' bounding-box diagonal) plus the
- * rounding of its coordinates (16 units in the last place of the largest). Measured on the
- * test cages, OpenSubdiv's car and the 2.5k cage: unions that are C1 miss it by at most 3e-12 of
- * the largest coordinate (the bi-5 patches' own construction; degree-3 pieces 1e-14), unions
- * that are not by 1e-6 or more, and the shared columns of faces that meet differ by at most
- * 3e-12; so rel_tol = 1e-10 decides far from both (the same faces on every platform's build),
- * while the surface moves only by the union's actual defect. */
-static double face_tolerance(const ccn__cad_surface *s, double rel_tol) {
-    double big, size = ccn__cad_surface_size(s, &big);
-    return rel_tol * size + 16 * DBL_EPSILON * big;
-}
-
 ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int unify,
                                 int64_t *merged, ccn_error *err) {
     *merged = 0;
@@ -536,7 +524,7 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
                 for (int k = 0; k < (s + 3) % 4 && !r; k++) r = tface_turn(&A); /* side s -> 1 */
                 for (int k = 0; k < (t + 1) % 4 && !r; k++) r = tface_turn(&B); /* side t -> 3 */
                 int64_t poles = (int64_t)A.n[0] * A.n[1] + (int64_t)B.n[0] * B.n[1];
-                if (!r && unify && (r = unify_v(&A, &B)) > 0) { /* sides not comparable */
+                if (!r && unify && (r = unify_v(&A, &B, face_tolerance(sf, 1e-12), face_tolerance(sg, 1e-12))) > 0) { /* sides not comparable */
                     tface_free(&A);
                     tface_free(&B);
                     continue;

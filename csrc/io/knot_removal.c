@@ -187,7 +187,7 @@ int32_t ccn__kr_reduce_rows(double *U, int32_t p, int32_t *n, int32_t rows, doub
  * n poles per row, flat knots U'[p .. n + 2p] (n + p + 1). The face's two sides at the seam
  * then meet as an edge of the face with itself (C2 across it, as before). U: room for
  * n + 3p + 1; W: rows x (n + 2p), repacked to rows x n. -1: out of memory. */
-static int unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W) {
+int ccn__kr_unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W) {
     int32_t ext = n + 2 * p, m = n + p + 1;
     double *Ur = malloc(sizeof(double) * (size_t)(m + 2 * p));
     if (!Ur) return -1;
@@ -211,14 +211,14 @@ static int unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double
 
 /* Back to the periodic form after the removal (so that a closed face stays one periodic face,
  * as the writers and readers know it): the clamped (U, W) of n poles over [u0, u1] with
- * m = n - p spans is the unwrapping (unwrap_periodic) of the periodic spline with the same
+ * m = n - p spans is the unwrapping (ccn__kr_unwrap_periodic) of the periodic spline with the same
  * interior knots, extended with the period, and m distinct poles Q (the last p repeating the
  * first p). unwrap is linear in Q, so Q is the least-squares solution of A Q = W's rows, A the
  * unwrapping of the unit pole vectors, and is kept only if it reproduces W within tol. Returns
  * 0 (U, W periodic), 1 (left clamped: too many spans for the dense solve, too few for a
  * periodic form, or not reproduced), -1 out of memory. */
 #define KR_MAX_PERIODIC_SPANS 400
-static int rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol) {
+int ccn__kr_rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol) {
     int32_t m = n - p, ext = n + 2 * p;
     if (m < p + 1 || m > KR_MAX_PERIODIC_SPANS) return 1;
     double T = U[n + p] - U[0];
@@ -236,14 +236,14 @@ static int rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double
     for (int32_t i = 1; i <= 2 * p; i++)
         if (!(Up[i] > Up[i - 1]) || !(Up[p + m + i - p] > Up[p + m + i - p - 1])) goto out; /* simple knots only */
     for (int32_t r = 0; r < m; r++) {
-        double *row = B + 3 * (size_t)r * n; /* packed rows: unwrap_periodic spreads them */
+        double *row = B + 3 * (size_t)r * n; /* packed rows: ccn__kr_unwrap_periodic spreads them */
         memset(row, 0, sizeof(double) * 3 * (size_t)n);
         row[3 * r] = 1;
         if (r < p) row[3 * (r + m)] = 1;
     }
     memcpy(Ub, Up, sizeof(double) * (size_t)(n + p + 1));
-    /* unwrap_periodic packs rows to stride n: A[i][r] = unit row r's pole i */
-    if (unwrap_periodic(Ub, p, n, m, B)) { st = -1; goto out; }
+    /* ccn__kr_unwrap_periodic packs rows to stride n: A[i][r] = unit row r's pole i */
+    if (ccn__kr_unwrap_periodic(Ub, p, n, m, B)) { st = -1; goto out; }
     for (int32_t r = 0; r < m; r++)
         for (int32_t i = 0; i < n; i++) A[(size_t)i * m + r] = B[3 * ((size_t)r * n + i)];
     for (int32_t a = 0; a < m; a++) /* M = A^T A, Cholesky in place (lower) */
@@ -306,7 +306,7 @@ static int64_t dir_remove(ccn__xmodel *xm, int32_t f, int dir, double tol) {
     int per = s->periodic[dir];
     if (p > KR_MAX_DEGREE || s->num_knots[dir] <= 2) return 0;
     if (!per && (s->mults[dir][0] != p + 1 || s->mults[dir][s->num_knots[dir] - 1] != p + 1)) return 0;
-    int32_t m = n + p + 1, ext = n + 2 * p; /* room for unwrap_periodic */
+    int32_t m = n + p + 1, ext = n + 2 * p; /* room for ccn__kr_unwrap_periodic */
     double *U = malloc(sizeof(double) * ((size_t)m + 2 * (size_t)p));
     double *W = malloc(sizeof(double) * 3 * (size_t)ext * (size_t)rows);
     if (!U || !W) { free(U); free(W); return -1; }
@@ -317,9 +317,9 @@ static int64_t dir_remove(ccn__xmodel *xm, int32_t f, int dir, double tol) {
         for (int32_t k = 0; k < n; k++)
             memcpy(W + 3 * ((size_t)row * n + k),
                    P + 3 * (dir == 0 ? (size_t)k * nv + row : (size_t)row * nv + k), sizeof(double) * 3);
-    if (per && unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
+    if (per && ccn__kr_unwrap_periodic(U, p, n, rows, W)) { free(U); free(W); return -1; }
     int32_t n1 = n, got = ccn__kr_reduce_rows(U, p, &n1, rows, W, tol, NAN);
-    int wrapped = got > 0 && per ? rewrap_periodic(U, p, n1, rows, W, tol) : 1;
+    int wrapped = got > 0 && per ? ccn__kr_rewrap_periodic(U, p, n1, rows, W, tol) : 1;
     if (got < 0 || wrapped < 0) { free(U); free(W); return -1; }
     if (got > 0) {
         s->num_poles[dir] = n1;
@@ -377,19 +377,12 @@ int64_t ccn__xm_remove_knots(ccn__xmodel *xm, double rel_tol, int only_merged) {
         int skip = only_merged && !xm->faces[f].merged;
         xm->faces[f].merged = 0;
         if (skip) continue;
-        double reach, size = ccn__cad_surface_size(&xm->faces[f].s, &reach);
-        double rounding = fmin(KR_ROUNDING_ULPS * DBL_EPSILON * reach, KR_MAX_TURN * min_spacing(&xm->faces[f].s));
-        int64_t got = face_remove(xm, f, fmax(rel_tol * size, rounding));
+        double reach, size = ccn__cad_surface_size(&xm->faces[f].s, &reach), tol = rel_tol * size;
+        if (KR_ROUNDING_ULPS * DBL_EPSILON * reach > tol) /* the rounding floor, within the turn cap */
+            tol = fmax(tol, fmin(KR_ROUNDING_ULPS * DBL_EPSILON * reach, KR_MAX_TURN * min_spacing(&xm->faces[f].s)));
+        int64_t got = face_remove(xm, f, tol);
         if (got < 0) { xm->oom = 1; return -1; }
         total += got;
     }
     return total;
-}
-
-int ccn__kr_unwrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W) {
-    return unwrap_periodic(U, p, n, rows, W);
-}
-
-int ccn__kr_rewrap_periodic(double *U, int32_t p, int32_t n, int32_t rows, double *W, double tol) {
-    return rewrap_periodic(U, p, n, rows, W, tol);
 }

@@ -662,6 +662,41 @@ static void boehm(double *t, int p, int *n, double *P, double u) {
     (*n)++;
 }
 
+/* A model of one face of degree p x p with nu x nv poles P on flat knots tu, tv (periodic along
+ * u if per_u): face 0 of xm, or -1. */
+static int32_t one_face(ccn__xmodel *xm, int32_t kind, int p, int nu, int nv, const double *tu, const double *tv,
+                        const double *P, int per_u) {
+    memset(xm, 0, sizeof *xm);
+    int32_t f = ccn__xm_add_face(xm, kind, p, p, nu, nv, 1, 1);
+    CHECK(f == 0 && ccn__xm_set_flat(xm, f, 0, tu) == 0 && ccn__xm_set_flat(xm, f, 1, tv) == 0, "model");
+    if (f != 0) return -1;
+    xm->faces[0].s.periodic[0] = per_u;
+    memcpy((void *)xm->faces[0].s.poles, P, sizeof(double) * 3 * (size_t)nu * nv);
+    return 0;
+}
+
+/* The largest distance between the face of degree p x p with nu x nv poles P on flat knots tu,
+ * tv and the removal's result S (same v knots), at `samples` random (u, v), u in [u0, u1]
+ * (this file's Cox-de Boor). */
+static double moved(int p, int nu, int nv, const double *tu, const double *tv, const double *P,
+                    const ccn__cad_surface *S, double u0, double u1, int samples) {
+    double *tr = malloc(sizeof(double) * (size_t)(S->num_poles[0] + p + 1));
+    ccn__cad_flat_knots(S, 0, tr);
+    face a = {0}, b = {0};
+    a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
+    a.np[0] = nu, a.np[1] = nv, a.t[0] = (double *)tu, a.t[1] = (double *)tv, a.P = (double *)P;
+    b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = tr, b.t[1] = (double *)tv, b.P = (double *)S->poles;
+    double worst = 0;
+    for (int k = 0; k < samples; k++) {
+        double u = u0 + (u1 - u0) * tl_rand01(), v = tv[nv] * tl_rand01(), x[3], y[3];
+        feval(&a, u, v, x);
+        feval(&b, u, v, y);
+        for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
+    }
+    free(tr);
+    return worst;
+}
+
 /* A random bicubic surface on clamped knots with random intervals, refined here by inserting
  * random knots along u (one row at a time: the tensor product), handed to the removal: it must
  * give back exactly the coarse knots (the random poles make the surface only C2 at those) and
@@ -690,32 +725,14 @@ static void test_knot_removal(void) {
             memcpy(tf, t, sizeof(double) * (size_t)(nf + p + 1));
         }
         ccn__xmodel xm;
-        memset(&xm, 0, sizeof xm);
-        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_PACK, p, p, nf, nv, 1, 1);
-        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
-        if (f != 0) return;
-        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        if (one_face(&xm, CCN_EXPORT_FACE_PACK, p, nf, nv, tf, tv, Pf, 0)) return;
         int64_t got = ccn__xm_remove_knots(&xm, 1e-12, 0);
         const ccn__cad_surface *S = &xm.faces[0].s;
         int same = S->num_poles[0] == n0 && S->num_poles[1] == nv && got == extra;
         for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k == 0 ? 0 : k + p];
         CHECK(same, "trial %d: %lld of %d inserted knots removed, %d poles along u for %d", trial,
               (long long)got, extra, (int)S->num_poles[0], n0);
-        face a = {0}, b = {0};
-        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
-        a.np[0] = nf, a.np[1] = nv, a.t[0] = tf, a.t[1] = tv, a.P = Pf;
-        double tr[64];
-        int m = 0;
-        for (int k = 0; k < S->num_knots[0]; k++)
-            for (int c = 0; c < S->mults[0][k]; c++) tr[m++] = S->knots[0][k];
-        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = tr, b.t[1] = tv, b.P = (double *)S->poles;
-        double worst = 0;
-        for (int k = 0; k < 200; k++) {
-            double u = t0[p] + (t0[n0] - t0[p]) * tl_rand01(), v = tv[nv] * tl_rand01(), x[3], y[3];
-            feval(&a, u, v, x);
-            feval(&b, u, v, y);
-            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
-        }
+        double worst = moved(p, nf, nv, tf, tv, Pf, S, t0[p], t0[n0], 200);
         CHECK(worst <= 1e-12, "trial %d: the surface moved %g", trial, worst);
         ccn__xm_free(&xm);
         free(P0);
@@ -745,29 +762,14 @@ static void test_knot_removal(void) {
                 }
         for (int i = 2 * m; i < nf; i++) memcpy(Pf + 3 * i * nv, Pf + 3 * (i - 2 * m) * nv, sizeof(double) * 3 * nv);
         ccn__xmodel xm;
-        memset(&xm, 0, sizeof xm);
-        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_PACK, p, p, nf, nv, 1, 1);
-        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
-        if (f != 0) return;
-        xm.faces[0].s.periodic[0] = 1;
-        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        if (one_face(&xm, CCN_EXPORT_FACE_PACK, p, nf, nv, tf, tv, Pf, 1)) return;
         int64_t got = ccn__xm_remove_knots(&xm, 1e-12, 0);
         const ccn__cad_surface *S = &xm.faces[0].s;
         int same = S->periodic[0] && S->num_poles[0] == n0 && got == m && S->num_knots[0] == n0 + p + 1;
         for (int k = 0; same && k < S->num_knots[0]; k++) same = S->knots[0][k] == t0[k];
         CHECK(same, "closed trial %d: %lld knots removed, periodic %d, %d poles along u for %d", trial,
               (long long)got, (int)S->periodic[0], (int)S->num_poles[0], n0);
-        face a = {0}, b = {0};
-        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
-        a.np[0] = n0, a.np[1] = nv, a.t[0] = t0, a.t[1] = tv, a.P = P0;
-        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = t0, b.t[1] = tv, b.P = (double *)S->poles;
-        double worst = 0;
-        for (int k = 0; same && k < 200; k++) {
-            double u = m * tl_rand01(), v = tv[nv] * tl_rand01(), x[3], y[3];
-            feval(&a, u, v, x);
-            feval(&b, u, v, y);
-            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
-        }
+        double worst = same ? moved(p, n0, nv, t0, tv, P0, S, 0, m, 200) : 0;
         CHECK(worst <= 1e-12, "closed trial %d: the surface moved %g", trial, worst);
         ccn__xm_free(&xm);
     }
@@ -810,7 +812,7 @@ static void test_knot_removal_long_run(void) {
         int p = 3, spans = 2 + trial, n0 = spans + p, nv = 4, levels = 8;
         int extra = spans * ((1 << levels) - 1), nf = n0 + extra;
         double *t0 = malloc(sizeof(double) * (size_t)(n0 + p + 1)), tv[8] = {0, 0, 0, 0, 1, 1, 1, 1};
-        double *tf = malloc(sizeof(double) * (size_t)(nf + p + 1)), *tr = malloc(sizeof(double) * (size_t)(nf + p + 1));
+        double *tf = malloc(sizeof(double) * (size_t)(nf + p + 1));
         double *P0 = malloc(sizeof(double) * 3 * (size_t)n0 * nv), *Pf = malloc(sizeof(double) * 3 * (size_t)nf * nv);
         double *row = malloc(sizeof(double) * 3 * (size_t)(nf + 1));
         for (int i = 0; i <= n0 + p; i++) t0[i] = i <= p ? 0 : i >= n0 ? spans : i - p;
@@ -826,35 +828,18 @@ static void test_knot_removal_long_run(void) {
             for (int i = 0; i < nf; i++) memcpy(Pf + 3 * (i * nv + j), row + 3 * i, sizeof(double) * 3);
         }
         ccn__xmodel xm;
-        memset(&xm, 0, sizeof xm);
-        int32_t f = ccn__xm_add_face(&xm, CCN_EXPORT_FACE_REFINED, p, p, nf, nv, 1, 1);
-        CHECK(f == 0 && ccn__xm_set_flat(&xm, f, 0, tf) == 0 && ccn__xm_set_flat(&xm, f, 1, tv) == 0, "model");
-        if (f != 0) return;
-        memcpy((void *)xm.faces[0].s.poles, Pf, sizeof(double) * 3 * (size_t)nf * nv);
+        if (one_face(&xm, CCN_EXPORT_FACE_REFINED, p, nf, nv, tf, tv, Pf, 0)) return;
         int64_t got = ccn__xm_remove_knots(&xm, 1e-13, 0);
         const ccn__cad_surface *S = &xm.faces[0].s;
         CHECK(got >= 0.98 * extra, "trial %d: %lld of %d inserted knots removed, %d poles along u for "
               "the cage's %d", trial, (long long)got, extra, (int)S->num_poles[0], n0);
-        face a = {0}, b = {0};
-        a.deg[0] = a.deg[1] = b.deg[0] = b.deg[1] = p;
-        a.np[0] = n0, a.np[1] = nv, a.t[0] = t0, a.t[1] = tv, a.P = P0;
-        int m = 0;
-        for (int k = 0; k < S->num_knots[0]; k++)
-            for (int c = 0; c < S->mults[0][k]; c++) tr[m++] = S->knots[0][k];
-        b.np[0] = S->num_poles[0], b.np[1] = nv, b.t[0] = tr, b.t[1] = tv, b.P = (double *)S->poles;
-        double worst = 0;
-        for (int k = 0; k < 400; k++) {
-            double u = spans * tl_rand01(), v = tl_rand01(), x[3], y[3];
-            feval(&a, u, v, x);
-            feval(&b, u, v, y);
-            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(x[c] - y[c]));
-        }
+        double worst = moved(p, n0, nv, t0, tv, P0, S, 0, spans, 400);
         CHECK(worst <= 1e-13, "trial %d: the surface moved %g", trial, worst);
         printf("# a strip of %d cage spans refined 8 levels, at 2 from the origin: %lld of %d knots removed, "
                "%d poles along u for the cage's %d, the surface moved %.2g\n", spans, (long long)got, extra,
                (int)S->num_poles[0], n0, worst);
         ccn__xm_free(&xm);
-        free(t0); free(tf); free(tr); free(P0); free(Pf); free(row);
+        free(t0); free(tf); free(P0); free(Pf); free(row);
     }
 }
 
