@@ -6,6 +6,7 @@
 #include "base/vec3.h"
 #include "rules/bspline.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -58,7 +59,14 @@ int ccn__cad_flush(ccn__cad_out *o) {
 const char *ccn__cad_real(double x, char *buf) {
     char tmp[40];
     if (x == 0) x = 0; /* -0 -> 0: one spelling */
-    snprintf(tmp, sizeof tmp, "%.17g", x);
+    /* The shortest of 15, 16 and 17 significant digits that reads back as x: every double is
+     * written exactly (17 always suffice), and more than half of them need fewer. A decimal with fewer than 15 digits that reads back as a
+     * normal x is what %.15g prints, its trailing zeros removed (a subnormal's spacing is
+     * coarser: there every length is tried). */
+    for (int digits = fabs(x) < DBL_MIN ? 1 : 15; digits <= 17; digits++) {
+        snprintf(tmp, sizeof tmp, "%.*g", digits, x);
+        if (digits == 17 || strtod(tmp, NULL) == x) break;
+    }
     size_t j = 0;
     int dot = strchr(tmp, '.') != NULL;
     for (size_t i = 0; tmp[i]; i++) {

@@ -161,7 +161,7 @@ void ccn__cad_printf(ccn__cad_out *o, const char *fmt, ...)
     ;
 /* Flushes; 0 if everything was written. */
 int ccn__cad_flush(ccn__cad_out *o);
-/* x with 17 significant digits, always with a decimal point and an upper-case exponent
+/* x in the fewest significant digits (at most 17) that read back as x, always with a decimal point and an upper-case exponent
  * ("1.", "-2.5E-07"): valid as a STEP and an IGES real. buf: at least 32 chars. */
 const char *ccn__cad_real(double x, char *buf);
 

@@ -11,6 +11,7 @@
  * and a message naming the problem, a failing sink gives CCN_ERR_IO, output is deterministic.
  */
 #include "ccnurbs.h"
+#include "io/cad.h"
 #include "io/fill.h"
 #include "io/knot_removal.h"
 #include "surface/patches.h"
@@ -1402,6 +1403,42 @@ static void test_written_once(void) {
     free(text);
 }
 
+/* The reals of STEP and IGES: every double written reads back as itself, always with a decimal
+ * point and an upper-case exponent, in the fewest digits that do (a shorter decimal that reads
+ * back as x would be found by trying 1..17 digits here). Doubles of every size, random bits. */
+static void test_reals(void) {
+    uint64_t state = 12345;
+    int bad_read = 0, bad_form = 0, longer = 0, n = 0;
+    char buf[40], tmp[40];
+    const double fixed[] = {0, -0.0, 1, -1, 0.5, 0.1, 2.5e-7, 1e22, 1e-300, 123456789012345678.0, 4.9e-324,
+                            1.7976931348623157e308, 0.30000000000000004, 1.0 / 3};
+    for (int i = 0; i < 20000 + (int)(sizeof fixed / sizeof *fixed); i++) {
+        double x;
+        if (i < (int)(sizeof fixed / sizeof *fixed)) x = fixed[i];
+        else {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            uint64_t bits = state;
+            if (i % 2) bits = (bits & 0x800FFFFFFFFFFFFFull) | ((uint64_t)(1023 - 40 + (state >> 58)) << 52);
+            memcpy(&x, &bits, sizeof x);
+            if (!isfinite(x)) continue;
+        }
+        n++;
+        const char *r = ccn__cad_real(x, buf);
+        bad_read += strtod(r, NULL) != x;
+        bad_form += !strchr(r, '.') || strchr(r, 'e') != NULL || (strchr(r, 'E') && strchr(r, 'E') < strchr(r, '.'));
+        for (int digits = 1; digits <= 17; digits++) {
+            snprintf(tmp, sizeof tmp, "%.*g", digits, x);
+            if (strtod(tmp, NULL) != x) continue;
+            size_t want = strlen(tmp) + (strchr(tmp, '.') ? 0 : 1); /* + the decimal point added */
+            longer += strlen(r) > want;
+            break;
+        }
+    }
+    CHECK(bad_read == 0 && bad_form == 0 && longer == 0,
+          "reals: of %d, %d read back otherwise, %d without a point or with a lower-case exponent, %d longer "
+          "than the shortest that reads back", n, bad_read, bad_form, longer);
+}
+
 /* A sheet folded onto itself (a quad and its reverse, back to back: every vertex an interior
  * valence-2 vertex) has no B-rep: the export refuses with a topology error naming a cage face. */
 static void test_folded(void) {
@@ -1441,5 +1478,6 @@ int main(void) {
     RUN(test_pcurves);
     RUN(test_written_once);
     RUN(test_folded);
+    RUN(test_reals);
     return TEST_SUMMARY();
 }
