@@ -37,7 +37,8 @@
  * before they would spread into its neighbours. Closed bands (periodic along the shared side,
  * as around a lathe shape's rings) merge only then (merged before the removal, a knot one band
  * needs would stay in the other); where their knots around differ, the union is inserted in the
- * periodic form (tface_insert_v_periodic). */
+ * periodic form (tface_insert_v_periodic), and where they start around at different points one
+ * seam is moved to the other's first (align_seams). */
 #include "io/face_merge.h"
 
 #include "base/error.h"
@@ -120,14 +121,65 @@ static int clamped(const double *t, int32_t n, int32_t p) {
     return t[p + 1] > t[p] && t[n] > t[n - 1];
 }
 
+/* ---- closed bands: the seam moved ---------------------------------------------------------- */
+
+/* f's seam in its periodic direction d moved to the knot r of its domain: the same surface, its
+ * knots and pole rows shifted by k spans (a periodic spline's basis functions are translates,
+ * so pole i and the knots from i on describe the same piece after a relabelling), the domain
+ * [r, r + T], the cells before r moved up by the period T and placed after the others. Closed
+ * bands around one ring start at different points of it (one band of a crease's level runs
+ * around the other way); the topology then breaks their common side at both seams and they
+ * would never be compared. 0: done, 1: r is not an interior knot and cell boundary (f unchanged),
+ * -1: out of memory. */
+static int tface_move_seam(tface *f, int d, double r) {
+    int32_t p = f->deg[d], n = f->n[d], m = n - p, o = f->n[1 - d];
+    const double *U = f->t[d];
+    double T = U[n] - U[p];
+    int32_t k = 0;
+    for (int32_t i = 1; i < m && !k; i++)
+        if (U[p + i] == r) k = i;
+    int32_t cn = d ? f->cv : f->cu, co = d ? f->cu : f->cv, c0 = -1;
+    for (int32_t c = 1; c < cn && c0 < 0; c++) { /* the first cell row at r */
+        const ccn__xcell *x = &f->cells[d ? f->cu * c : c];
+        if (x->uv[2 * d] == r) c0 = c;
+    }
+    if (!k || c0 < 0 || !f->per[d]) return 1;
+    double *t = malloc(sizeof(double) * (size_t)(n + p + 1)), *P = malloc(sizeof(double) * 3 * (size_t)n * o);
+    ccn__xcell *C = malloc(sizeof(ccn__xcell) * (size_t)cn * co);
+    if (!t || !P || !C) { free(t); free(P); free(C); return -1; }
+    for (int32_t i = 0; i <= n + p; i++) t[i] = i + k <= n + p ? U[i + k] : U[i + k - m] + T;
+    for (int32_t i = 0; i < n; i++) /* pole row i along d: the old row (i + k) mod m */
+        for (int32_t j = 0; j < o; j++) {
+            int32_t src = (i + k) % m;
+            size_t a = d ? (size_t)j * n + i : (size_t)i * o + j, b = d ? (size_t)j * n + src : (size_t)src * o + j;
+            memcpy(P + 3 * a, f->P + 3 * b, sizeof(double) * 3);
+        }
+    for (int32_t c = 0; c < cn; c++)
+        for (int32_t e = 0; e < co; e++) {
+            int32_t c2 = (c - c0 + cn) % cn;
+            ccn__xcell x = f->cells[d ? e + f->cu * c : c + f->cu * e];
+            if (c < c0) x.uv[2 * d] += T, x.uv[2 * d + 1] += T;
+            C[d ? e + f->cu * c2 : c2 + f->cu * e] = x;
+        }
+    free(f->t[d]); free(f->P); free(f->cells);
+    f->t[d] = t, f->P = P, f->cells = C;
+    return 0;
+}
+
 /* ---- sides of different knots and cells: both made the union's ------------------------ */
 
-/* x snapped to the nearest of the n values a within tol (else x). */
+/* x snapped to the nearest of the n non-decreasing values a within tol (else x); a binary
+ * search (a merged band's side holds a thousand knots and as many cells). */
 static double snap_to(double x, const double *a, int32_t n, double tol) {
-    double best = tol;
-    double r = x;
-    for (int32_t i = 0; i < n; i++)
-        if (fabs(a[i] - x) <= best) best = fabs(a[i] - x), r = a[i];
+    int32_t lo = 0, hi = n; /* the first a[i] >= x */
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < x) lo = mid + 1;
+        else hi = mid;
+    }
+    double r = x, best = tol;
+    if (lo > 0 && fabs(a[lo - 1] - x) <= best) best = fabs(a[lo - 1] - x), r = a[lo - 1];
+    if (lo < n && fabs(a[lo] - x) <= best) r = a[lo];
     return r;
 }
 
@@ -314,8 +366,13 @@ static int unify_v(tface *A, tface *B, double tol_a, double tol_b) {
  * ends must be the face's own values, or a sample on the border would fall outside the domain),
  * else the affine map. */
 static double map_v(const double *ta, const double *tb, int32_t mv, double sv, double x) {
-    for (int32_t i = 0; i < mv; i++)
-        if (tb[i] == x) return ta[i];
+    int32_t lo = 0, hi = mv; /* the first tb[i] >= x (tb non-decreasing) */
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (tb[mid] < x) lo = mid + 1;
+        else hi = mid;
+    }
+    if (lo < mv && tb[lo] == x) return ta[lo];
     return ta[0] + (x - tb[0]) * sv;
 }
 
@@ -479,9 +536,57 @@ static int mergeable_kind(int32_t kind) {
            kind == CCN_EXPORT_FACE_REFINED;
 }
 
+/* Where two closed bands share a side that the topology breaks only at their two seams (one
+ * break on each side, both pieces of each side against the other face), one band's seam is
+ * moved to the other's (tface_move_seam), so that the next topology sees one whole side and the
+ * pair is tried. The band moved is one whose opposite side is not already whole against a
+ * neighbour (so a move never undoes a match, and the moves end). Both faces of a pair are marked
+ * in done (this round's topology no longer describes the moved one). Returns the number of
+ * seams moved, -1 on out of memory. */
+static int64_t align_seams(ccn__xmodel *xm, const int32_t *bs, const double *br, const int32_t *adj,
+                           const int32_t *segface, const uint8_t *segside, uint8_t *done) {
+    int32_t nf = xm->num_faces;
+    int64_t moved = 0;
+    for (int32_t f = 0; f < nf; f++)
+        for (int s = 0; s < 4 && !done[f]; s++) {
+            int d = s % 2 == 0 ? 0 : 1; /* sides 0, 2 run along u */
+            if (!mergeable_kind(xm->faces[f].kind) || !xm->faces[f].s.periodic[d] ||
+                bs[4 * f + s + 1] - bs[4 * f + s] != 1)
+                continue;
+            int32_t j0 = 4 * f + s + bs[4 * f + s], a0 = adj[j0], a1 = adj[j0 + 1];
+            if (a0 < 0 || a1 < 0) continue;
+            int32_t g = segface[a0], t = segside[a0];
+            if (g == f || segface[a1] != g || segside[a1] != t || done[g] || !xm->faces[g].s.periodic[d] ||
+                !mergeable_kind(xm->faces[g].kind) || bs[4 * g + t + 1] - bs[4 * g + t] != 1)
+                continue;
+            /* the one to move: its opposite side not whole against a neighbour */
+            int32_t h = -1;
+            double r = 0;
+            int ot = (t + 2) % 4, os = (s + 2) % 4;
+            if (!(bs[4 * g + ot + 1] == bs[4 * g + ot] && adj[4 * g + ot + bs[4 * g + ot]] >= 0))
+                h = g, r = br[bs[4 * g + t]];
+            else if (!(bs[4 * f + os + 1] == bs[4 * f + os] && adj[4 * f + os + bs[4 * f + os]] >= 0))
+                h = f, r = br[bs[4 * f + s]];
+            if (h < 0) continue;
+            tface A;
+            if (tface_of(xm, h, &A)) return -1;
+            int rc = tface_move_seam(&A, d, r);
+            if (rc == 0) {
+                ccn__xface keep = xm->faces[h];
+                if (replace_face(xm, h, &A)) rc = -1;
+                xm->faces[h].patch = keep.patch, xm->faces[h].merged = keep.merged;
+            }
+            tface_free(&A);
+            if (rc < 0) return -1;
+            if (rc == 0) done[f] = done[g] = 1, moved++;
+        }
+    return moved;
+}
+
 ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel_tol, int unify,
                                 int64_t *merged, ccn_error *err) {
     *merged = 0;
+    int seam_rounds = 0;
     for (;;) {
         int32_t *bs = NULL, *adj = NULL;
         double *br = NULL;
@@ -503,6 +608,9 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
                 }
         int64_t round = 0;
         int oom = 0;
+        int64_t moved = 0; /* closed bands' seams first: a pair aligned is tried in the next round */
+        if (unify && seam_rounds < 16 && (moved = align_seams(xm, bs, br, adj, segface, segside, used)) != 0)
+            oom = moved < 0, seam_rounds++;
         for (int32_t f = 0; f < nf && !oom; f++) {
             if (used[f] || !mergeable_kind(xm->faces[f].kind)) continue;
             for (int s = 0; s < 4 && !used[f] && !oom; s++) {
@@ -557,7 +665,7 @@ ccn_status ccn__xm_merge_faces(ccn__xmodel *xm, const ccn_mesh *cage, double rel
             if (xm->faces[f].kind >= 0) xm->faces[w++] = xm->faces[f];
         xm->num_faces = w;
         *merged += round;
-        if (!round) break;
+        if (!round && moved <= 0) break;
     }
     return CCN_OK;
 }

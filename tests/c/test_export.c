@@ -780,7 +780,10 @@ static void test_knot_removal(void) {
  * 8 x 6 quads): every band is closed, periodic around the tube, and the bands of different
  * levels (the packs of the cage rows away from the crease, the refined bands nearer it) differ
  * in their knots around it. They merge when both take the union of those knots (inserted in the
- * periodic form): the cells of cage rows 0 and 1 lie in one face, those of rows 4 and 5 in one. */
+ * periodic form): the cells of cage rows 0 and 1 lie in one face, those of rows 4 and 5 in one.
+ * The bands on either side of the crease start around it at different points (one runs the
+ * other way); with one band's seam moved to the other's they merge too, and the whole tube, C2
+ * around and along, is one face. */
 static void test_crease_tube(void) {
     faces F;
     ccn_export_info info;
@@ -797,6 +800,7 @@ static void test_crease_tube(void) {
         CHECK(owner >= 0 && split == 0, "crease_tube: the cells of rows %s in %d other faces", side ? "4, 5" : "0, 1",
               split);
     }
+    CHECK(F.n == 1, "crease_tube: %d faces, not one", F.n);
     printf("# crease_tube: %d faces\n", F.n);
     faces_free(&F);
 }
