@@ -217,8 +217,9 @@ typedef struct {
     int32_t polyhedron; /* EIGEN without fallback: the eigen polyhedron M is built from
                            (CCN_POLY_PAPER..CCN_POLY_COUNT); 0 otherwise */
     int32_t verified;   /* candidates the per-vertex choice verified (0: accepted unchecked) */
-    int32_t outside_g1; /* 1: no candidate passed the verification; the paper's M is used and
-                           the vertex is outside the range where G1 is verified */
+    int32_t outside_g1; /* 1: half the weight or more on candidates that fail the verification
+                           (their eigen rules used unchecked; the NURSS rules where no candidate's
+                           construction works): outside the range where G1 is verified */
 } ccn_ev_info;
 
 /* EXPERIMENTAL (research; may change without notice): the fixed eigen-polyhedron candidates,
@@ -274,7 +275,7 @@ typedef struct {
                                  a plan one level finer builds them */
     int32_t num_ev_fallbacks; /* EVs whose eigen rules fell back to NURSS */
     int32_t num_ev_verified;  /* EVs whose eigen polyhedron was verified (spoke ratio > 4) */
-    int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (paper's used) */
+    int32_t num_ev_outside_g1;/* of those, EVs no candidate polyhedron passed (used unchecked) */
     int32_t num_ring_conflicts, num_ignored_verts, num_ignored_edges; /* as ccn_mesh_info */
     int32_t num_sharp_edges;  /* cage edges with sharpness > 0 */
     int32_t num_sharp_vertices;

@@ -125,7 +125,7 @@ static double smoothstep01(double x) {
     return x * x * (3 - 2 * x);
 }
 
-double ccn__ev_margin(int32_t n, const double *nd, int32_t poly) {
+double ccn__ev_margin(int32_t n, const double *nd, int32_t poly, double *construction) {
     size_t sz = 2 * (size_t)n + 1;
     double *M = malloc(sizeof(double) * (sz * sz + 2 * sz));
     if (!M) return NAN;
@@ -133,6 +133,7 @@ double ccn__ev_margin(int32_t n, const double *nd, int32_t poly) {
     ccn_ev_info info;
     ccn__poly_blend one = {1, {poly}, {1.0}};
     if (ccn__ev_matrix_blend(n, nd, CCN_SCHEME_EIGEN, &one, M, &info, P, &q, NULL) != CCN_OK) q = -1;
+    if (construction) *construction = q;
     if (q > 0) {
         double qm;
         int32_t maxima;
@@ -152,7 +153,7 @@ double ccn__ev_margin(int32_t n, const double *nd, int32_t poly) {
 }
 
 int ccn__ev_verify(int32_t n, const double *nd, int32_t poly) {
-    double q = ccn__ev_margin(n, nd, poly);
+    double q = ccn__ev_margin(n, nd, poly, NULL);
     return isnan(q) ? -1 : q > 0;
 }
 
@@ -187,12 +188,12 @@ ccn_status ccn__ev_select(int32_t n, const double *nd, ccn__ev_cache *cache, ccn
     }
     /* "The first candidate that passes", made continuous: candidate k takes the weight
      * s_k prod_{j<k} (1 - s_j), s = smoothstep of its margin (1 when it passes clearly, 0 when
-     * it fails), the paper's s at least the trust weight; what no candidate takes stays on the
-     * paper's polyhedron. Every margin is continuous in the intervals, so the weights are. */
+     * it fails), the paper's s at least the trust weight. Every margin is continuous in the
+     * intervals, so the weights are. */
     ccn__poly_blend b = {0, {0}, {0}};
-    double rest = 1.0;
+    double rest = 1.0, built[CCN__POLY_COUNT + 1];
     for (int32_t poly = 1; poly <= CCN__POLY_COUNT && rest > 0; poly++) {
-        double q = ccn__ev_margin(n, key, poly);
+        double q = ccn__ev_margin(n, key, poly, &built[poly]);
         if (isnan(q)) return CCN_ERR_MEMORY;
         out->verified++;
         double sk = smoothstep01(q);
@@ -200,8 +201,22 @@ ccn_status ccn__ev_select(int32_t n, const double *nd, ccn__ev_cache *cache, ccn
         if (rest * sk > 0) blend_add(&b, poly, rest * sk);
         rest *= 1 - sk;
     }
-    if (rest > 0) blend_add(&b, CCN__POLY_PAPER, rest);
     out->outside = rest >= 0.5;
+    /* What no candidate takes goes down the same chain again by the constructions' margins
+     * alone (s = smoothstep of the construction's margin: the candidates' eigen rules exist
+     * there, unverified), and only what no construction takes to the paper's polyhedron, whose
+     * failing construction falls back to the NURSS rules. The construction margin is continuous
+     * where it is positive, and a margin is read only through smoothstep's positive part (a
+     * failed check sets a margin to -1 at once: no weight may come from how badly a candidate
+     * fails). At spoke ratios of several hundred the last verified candidate and the NURSS
+     * rules are a fifth of the cage apart; the unverified eigen rules are close to the first
+     * (tests/experiments/RESULTS.md, "What no candidate takes"). */
+    for (int32_t poly = 1; poly <= CCN__POLY_COUNT && rest > 0; poly++) {
+        double sk = smoothstep01(built[poly]);
+        if (rest * sk > 0) blend_add(&b, poly, rest * sk);
+        rest *= 1 - sk;
+    }
+    if (rest > 0) blend_add(&b, CCN__POLY_PAPER, rest);
     out->blend = b;
     int32_t best = 0;
     for (int32_t c = 1; c < b.count; c++)

@@ -38,7 +38,7 @@ typedef struct {
     ccn__poly_blend blend; /* the polyhedron: candidates and weights */
     int32_t poly;     /* the candidate of the largest weight (CCN_POLY_PAPER.. CCN_POLY_COUNT) */
     int32_t verified; /* candidates verified (0: accepted without checks) */
-    int32_t outside;  /* 1: half the weight or more on the paper's, which fails the checks */
+    int32_t outside;  /* 1: half the weight or more on candidates that fail the checks */
     int32_t cached;   /* 1: taken from the cache */
 } ccn__ev_choice;
 
@@ -49,8 +49,9 @@ ccn_status ccn__ev_select(int32_t n, const double *nd, ccn__ev_cache *cache, ccn
 /* The continuous margin of candidate poly for normalised intervals nd: the smallest of the
  * construction's margin and the maxima, spectrum and regularity margins over their bands
  * (-1 when the map is not injective or the construction fails); > 0 passes every check,
- * >= 1 clearly. NaN when out of memory. */
-double ccn__ev_margin(int32_t n, const double *nd, int32_t poly);
+ * >= 1 clearly. *construction (may be NULL): the construction's margin alone (-1 when it
+ * fails). NaN when out of memory. */
+double ccn__ev_margin(int32_t n, const double *nd, int32_t poly, double *construction);
 /* Does candidate poly pass (margin > 0)? 1 yes, 0 no, -1 out of memory. */
 int ccn__ev_verify(int32_t n, const double *nd, int32_t poly);
 

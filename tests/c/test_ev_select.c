@@ -14,6 +14,8 @@
 #include "rules/eigen_fan.h"
 #include "rules/eigen_select.h"
 
+#include <math.h>
+#include <string.h>
 #include <time.h>
 
 #define PI 3.14159265358979323846
@@ -236,10 +238,44 @@ static void test_plan_counters(void) {
     }
 }
 
+/* Where no candidate passes its checks, the rules stay eigen rules while some candidate's
+ * construction works, and reach the NURSS rules only where none does: a ready valence-5 star
+ * of spoke ratio about 400 (intervals of a steep continuity sweep, tests/c/test_continuity.c),
+ * its fourth spoke swept 0.80 .. 0.85, past the point where the last verified candidate fails.
+ * There the NURSS rules are far from every candidate's (a fifth of the cage in the surface):
+ * M must not take them (ccn_ev_info.fallback 0), and must not move by as much as the step
+ * from the candidates' rules to the NURSS rules at any step of the sweep. */
+static void test_rest_stays_eigen(void) {
+    double d[5] = {0.00205, 0.0231, 0.0101, 0.8, 0.00295}, M[121], prev[121], N[121], worst = 0, gap = INFINITY;
+    int nurss = 0, outside = 0, steps = 100;
+    ccn_ev_info info;
+    for (int k = 0; k <= steps; k++) {
+        d[3] = 0.80 * pow(0.85 / 0.80, (double)k / steps);
+        CHECK(ccn_ev_matrix(5, d, CCN_SCHEME_EIGEN, M, &info, NULL) == CCN_OK, "d %g: matrix", d[3]);
+        CHECK(ccn_ev_matrix(5, d, CCN_SCHEME_NURSS, N, NULL, NULL) == CCN_OK, "d %g: NURSS matrix", d[3]);
+        nurss += info.fallback != 0;
+        outside += info.outside_g1 != 0;
+        double to_nurss = 0, step = 0;
+        for (int i = 0; i < 121; i++) {
+            to_nurss = fmax(to_nurss, fabs(M[i] - N[i]));
+            if (k) step = fmax(step, fabs(M[i] - prev[i]));
+        }
+        gap = fmin(gap, to_nurss);
+        worst = fmax(worst, step);
+        memcpy(prev, M, sizeof M);
+    }
+    CHECK(outside > 0, "the sweep reaches tuples where no candidate passes (%d of %d)", outside, steps + 1);
+    CHECK(nurss == 0, "%d of %d tuples take the NURSS rules", nurss, steps + 1);
+    CHECK(worst < 0.5 * gap, "M's largest step %.3g against its distance %.3g from the NURSS rules", worst, gap);
+    printf("# valence 5, spoke ratio ~400, d 0.80 .. 0.85: %d of %d tuples unverified, %d on NURSS rules; largest "
+           "step of M %.3g, M at least %.3g from the NURSS rules\n", outside, steps + 1, nurss, worst, gap);
+}
+
 int main(void) {
     RUN(test_fan_matches_engine);
     RUN(test_charmap_verdicts);
     RUN(test_cache);
     RUN(test_plan_counters);
+    RUN(test_rest_stays_eigen);
     return TEST_SUMMARY();
 }
