@@ -556,21 +556,23 @@ static int64_t align_seams(ccn__xmodel *xm, const int32_t *bs, const double *br,
             int32_t j0 = 4 * f + s + bs[4 * f + s], a0 = adj[j0], a1 = adj[j0 + 1];
             if (a0 < 0 || a1 < 0) continue;
             int32_t g = segface[a0], t = segside[a0];
-            if (g == f || segface[a1] != g || segside[a1] != t || done[g] || !xm->faces[g].s.periodic[d] ||
+            int dg = t % 2 == 0 ? 0 : 1; /* g's direction along the shared side */
+            if (g == f || segface[a1] != g || segside[a1] != t || done[g] || !xm->faces[g].s.periodic[dg] ||
                 !mergeable_kind(xm->faces[g].kind) || bs[4 * g + t + 1] - bs[4 * g + t] != 1)
                 continue;
             /* the one to move: its opposite side not whole against a neighbour */
             int32_t h = -1;
+            int dh = 0;
             double r = 0;
             int ot = (t + 2) % 4, os = (s + 2) % 4;
             if (!(bs[4 * g + ot + 1] == bs[4 * g + ot] && adj[4 * g + ot + bs[4 * g + ot]] >= 0))
-                h = g, r = br[bs[4 * g + t]];
+                h = g, dh = dg, r = br[bs[4 * g + t]];
             else if (!(bs[4 * f + os + 1] == bs[4 * f + os] && adj[4 * f + os + bs[4 * f + os]] >= 0))
-                h = f, r = br[bs[4 * f + s]];
+                h = f, dh = d, r = br[bs[4 * f + s]];
             if (h < 0) continue;
             tface A;
             if (tface_of(xm, h, &A)) return -1;
-            int rc = tface_move_seam(&A, d, r);
+            int rc = tface_move_seam(&A, dh, r);
             if (rc == 0) {
                 ccn__xface keep = xm->faces[h];
                 if (replace_face(xm, h, &A)) rc = -1;
