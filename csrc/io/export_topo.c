@@ -14,6 +14,7 @@
 #include "io/export_topo.h"
 
 #include "base/error.h"
+#include "base/sorted.h"
 #include "rules/crease.h"
 
 #include <stdlib.h>
@@ -60,17 +61,6 @@ static int ref_cmp(const void *pa, const void *pb) {
     if (a->side != b->side) return a->side < b->side ? -1 : 1;
     if (a->order != b->order) return a->order < b->order ? -1 : 1;
     return (a->k > b->k) - (a->k < b->k);
-}
-
-/* The first index of the sorted xs[0 .. n) whose value is >= x (n if none). */
-static size_t first_at_least(const double *xs, size_t n, double x) {
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (xs[mid] < x) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
 }
 
 static int dbl_cmp(const void *pa, const void *pb) {
@@ -195,7 +185,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
         nint += u ? u - 1 : 0; /* a line's intervals: a gap between its pieces is one too */
         for (size_t i = g0; i < g; i++) {
             double lo = pc[i].x0 < pc[i].x1 ? pc[i].x0 : pc[i].x1, hi = pc[i].x0 + pc[i].x1 - lo;
-            size_t k0 = first_at_least(xs, u, lo), k1 = first_at_least(xs, u, hi);
+            size_t k0 = ccn__first_at_least(xs, u, lo), k1 = ccn__first_at_least(xs, u, hi);
             ne += k1 > k0 ? k1 - k0 : 0;
         }
         g0 = g;
@@ -224,7 +214,7 @@ ccn_status ccn__xtopo_build(const ccn__xmodel *xm, const ccn_mesh *cage, int32_t
             double lo = fwd ? p->x0 : p->x1, hi = fwd ? p->x1 : p->x0;
             int32_t cnt = 0;
             /* its elementary intervals: [xs[k], xs[k + 1]] for k0 <= k < k1 (its ends are in xs) */
-            size_t k0 = first_at_least(xs, u, lo), k1 = first_at_least(xs, u, hi);
+            size_t k0 = ccn__first_at_least(xs, u, lo), k1 = ccn__first_at_least(xs, u, hi);
             for (size_t k = k0; k < k1; k++) {
                 size_t kk = fwd ? k : k0 + k1 - 1 - k;
                 double xa = fwd ? xs[kk] : xs[kk + 1], xb = fwd ? xs[kk + 1] : xs[kk];

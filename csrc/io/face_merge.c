@@ -42,6 +42,7 @@
 #include "io/face_merge.h"
 
 #include "base/error.h"
+#include "base/sorted.h"
 #include "base/vec3.h"
 #include "io/export_topo.h"
 #include "io/knot_removal.h"
@@ -171,12 +172,7 @@ static int tface_move_seam(tface *f, int d, double r) {
 /* x snapped to the nearest of the n non-decreasing values a within tol (else x); a binary
  * search (a merged band's side holds a thousand knots and as many cells). */
 static double snap_to(double x, const double *a, int32_t n, double tol) {
-    int32_t lo = 0, hi = n; /* the first a[i] >= x */
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (a[mid] < x) lo = mid + 1;
-        else hi = mid;
-    }
+    int32_t lo = (int32_t)ccn__first_at_least(a, (size_t)n, x);
     double r = x, best = tol;
     if (lo > 0 && fabs(a[lo - 1] - x) <= best) best = fabs(a[lo - 1] - x), r = a[lo - 1];
     if (lo < n && fabs(a[lo] - x) <= best) r = a[lo];
@@ -366,12 +362,7 @@ static int unify_v(tface *A, tface *B, double tol_a, double tol_b) {
  * ends must be the face's own values, or a sample on the border would fall outside the domain),
  * else the affine map. */
 static double map_v(const double *ta, const double *tb, int32_t mv, double sv, double x) {
-    int32_t lo = 0, hi = mv; /* the first tb[i] >= x (tb non-decreasing) */
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (tb[mid] < x) lo = mid + 1;
-        else hi = mid;
-    }
+    int32_t lo = (int32_t)ccn__first_at_least(tb, (size_t)mv, x); /* tb non-decreasing */
     if (lo < mv && tb[lo] == x) return ta[lo];
     return ta[0] + (x - tb[0]) * sv;
 }
