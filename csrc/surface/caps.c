@@ -445,9 +445,19 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     }
     if (!beyond) border_exp = 0; /* within the range: the plan's construction */
     ccn_error e2;
-    if (!ops[n]) { /* the exact surround's speeds (cap_op) */
-        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[2] = {0.5, 15.0 / 16.0};
-        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 2 : 4, &ops[n], &e2);
+    if (!ops[n]) {
+        /* The exact surround's speeds (cap_op), at valence 3 without the ring of speed 15/16:
+         * that ring leaves a cap a sixteenth of the hole's size, and in a hole several levels
+         * below the cage its poles near the EV lie so close together that their rounding to
+         * doubles at their absolute coordinates turns the normals across its spokes by up to
+         * 4e-8 rad (catmark_bishop; cube_semi moved by 1000: 4.5e-9). The cap right after the
+         * first ring is G1 alike and 16 times larger (bishop 4.7e-9 rad read by OpenCASCADE,
+         * cube_semi moved 1.8e-10), its curvature that of the surround either way (cube_semi's
+         * corners: the cap's largest |K| 1.7-2.0x the exact pieces' around it, 1-4 % lower
+         * than with the ring). Only the export's holes use this operator; the plan's caps are
+         * what the modifier shows and keep the paper's speeds. */
+        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[1] = {0.5};
+        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 1 : 4, &ops[n], &e2);
         if (st) {
             free(knots);
             return st == CCN_ERR_MEMORY ? -1 : 0;

@@ -558,6 +558,49 @@ static double face_max_k(const face *f, const double c[3], double rmin, double r
     return kmax;
 }
 
+/* The hole caps' curvature is the surround's: at each of cube_semi's corners (faces grouped by
+ * the octant of their poles' mean; the cube spans [0, 1]^3) the cap's Gaussian curvature stays
+ * positive like that of the exact pieces around it (within twice its reach) and its largest
+ * |K| within 2.5x theirs (measured 1.7-2.0x; the refined limit's own curvature rises towards a
+ * valence-3 corner). */
+static void test_caps_in_holes_fair(void) {
+    faces F;
+    ccn_export_info info;
+    CHECK(export_of("cube_semi", &F, &info) == CCN_OK, "cube_semi: export");
+    double worst = 0;
+    int corners = 0;
+    for (int oct = 0; oct < 8; oct++) {
+        double c[3] = {0, 0, 0}, cnt = 0, r0 = 0, kc = 0, kr = 0, kcmin = INFINITY, krmin = INFINITY;
+        uint8_t *mine = calloc((size_t)F.n + 1, 1);
+        for (int i = 0; i < F.n; i++) {
+            if (F.f[i].kind != CCN_EXPORT_FACE_BI5) continue;
+            int np = F.f[i].np[0] * F.f[i].np[1];
+            double m[3] = {0, 0, 0};
+            for (int q = 0; q < np; q++)
+                for (int k = 0; k < 3; k++) m[k] += F.f[i].P[3 * q + k] / np;
+            if (((m[0] > 0.5) | (m[1] > 0.5) << 1 | (m[2] > 0.5) << 2) != oct) continue;
+            mine[i] = 1;
+            for (int q = 0; q < np; q++, cnt++)
+                for (int k = 0; k < 3; k++) c[k] += F.f[i].P[3 * q + k];
+        }
+        if (cnt > 0) {
+            for (int k = 0; k < 3; k++) c[k] /= cnt;
+            for (int i = 0; i < F.n; i++)
+                if (mine[i]) kc = fmax(kc, face_max_k(&F.f[i], c, 0, 0, &r0, &kcmin));
+            for (int i = 0; i < F.n; i++)
+                if (F.f[i].kind != CCN_EXPORT_FACE_BI5) kr = fmax(kr, face_max_k(&F.f[i], c, r0, 2 * r0, NULL, &krmin));
+            CHECK(krmin > 0 && kcmin > 0 && kc <= 2.5 * kr, "cube_semi corner %d: the cap's K in [%g, %g], the exact "
+                  "pieces' around it in [%g, %g]", oct, kcmin, kc, krmin, kr);
+            worst = fmax(worst, kc / kr);
+            corners++;
+        }
+        free(mine);
+    }
+    CHECK(corners == 8, "cube_semi: caps at %d corners, want 8", corners);
+    printf("# cube_semi: the caps' largest |K| <= %.2f x the exact pieces' around them\n", worst);
+    faces_free(&F);
+}
+
 /* An interior EV whose spoke ratios leave the cap's range: the export caps its hole at the
  * last level (G1 to rounding) and keeps the cap because it is fairer than the fill faces (G1
  * too, io/fill_g1.c) would be. Measured here, on the exported faces, against the fill faces
@@ -622,13 +665,17 @@ static void test_caps_beyond_range(void) {
     cap_beyond_range("star5_nu", 5);
 }
 
-/* The same cube far from the origin (moved by 1000 along each axis): its caps still meet G1
- * to the rounding of their own size (they are built around their EVs), not of their place. */
-static void test_far_from_origin(void) {
+/* Cages far from the origin (moved by 1000 along each axis): caps still meet G1 to the rounding
+ * of their own size (they are built around their EVs), not of their place. The cube's caps are
+ * the plan's; cube_semi's are the export's, in holes a level below the plan where its creases
+ * have decayed, and their poles near the EV must not lie so close together that rounding them
+ * at their absolute coordinates turns the normals (the valence-3 hole cap without the paper's
+ * ring of speed 15/16, whose cap a sixteenth of the hole gave 4.5e-9 rad here). */
+static void far_export(const char *name, int level, double bound) {
     ccn_obj *obj;
     ccn_cage cage;
-    ccn_plan *p = load_at("cube", 3, &obj, &cage);
-    CHECK(p != NULL, "cube: plan");
+    ccn_plan *p = load_at(name, level, &obj, &cage);
+    CHECK(p != NULL, "%s: plan", name);
     if (!p) return;
     double *far = malloc(sizeof(double) * 3 * (size_t)cage.num_verts);
     for (int32_t i = 0; i < 3 * cage.num_verts; i++) far[i] = cage.positions[i] + 1000.0;
@@ -637,14 +684,19 @@ static void test_far_from_origin(void) {
     sink s = {NULL, 0, 0, -1};
     ccn_export_info info;
     ccn_error err;
-    CHECK(ccn_plan_export(p, far, &eo, sink_fn, &s, &info, &err) == CCN_OK, "far cube: export: %s", err.message);
-    CHECK(info.num_bi5 > 0 && info.max_g1_deviation <= 1e-8, "far cube: %d bi-5 faces, G1 %g",
-          (int)info.num_bi5, info.max_g1_deviation);
-    printf("# the cube moved by 1000: G1 %.2e\n", info.max_g1_deviation);
+    CHECK(ccn_plan_export(p, far, &eo, sink_fn, &s, &info, &err) == CCN_OK, "far %s: export: %s", name, err.message);
+    CHECK(info.num_bi5 > 0 && info.max_g1_deviation <= bound, "far %s: %d bi-5 faces, G1 %g (bound %g)", name,
+          (int)info.num_bi5, info.max_g1_deviation, bound);
+    printf("# %s moved by 1000: G1 %.2e (bound %.0e)\n", name, info.max_g1_deviation, bound);
     free(s.d);
     free(far);
     ccn_plan_destroy(p);
     ccn_obj_destroy(obj);
+}
+
+static void test_far_from_origin(void) {
+    far_export("cube", 3, 1e-8);
+    far_export("cube_semi", 3, 1e-9);
 }
 
 /* ---- knot removal (io/knot_removal.c), against a refinement made here ----------------------- */
@@ -1473,6 +1525,7 @@ int main(void) {
     RUN(test_crease_tube);
     RUN(test_merged_faces);
     RUN(test_caps_in_holes);
+    RUN(test_caps_in_holes_fair);
     RUN(test_caps_beyond_range);
     RUN(test_fills_g1);
     RUN(test_far_from_origin);
