@@ -331,14 +331,16 @@ static int cap_vertex(ccn__xmodel *xm, const ccn__plan_view *v, const ccn_mesh *
         if (pl[S->hface[S->vfan[k]]].cage_face < 0) return 0; /* a face around u is not in the hole */
     const struct ccn__bi5 *op = NULL;
     double *pt = NULL;
-    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 0, 0, ops, &op, &pt);
+    /* within the range the cap right after the first ring; beyond it the plan's rings too
+     * (surface/caps.c: without them star7_nu's cap is flatter, but its reflection lines kink) */
+    int r = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 0, 0, 0, ops, &op, &pt);
     if (r == 0 && fl) { /* beyond the range: the fairest cap, against the fill */
         double kbest = INFINITY;
         for (int q = 0; q < 2 && r >= 0; q++) {
             const struct ccn__bi5 *oq;
             double *pq;
             int rq = ccn__cap_exact(S, T, u, v->scheme, v->ev_polyhedron, v->ev_cache, v->pinned, 1,
-                                    beyond_exps[q], ops, &oq, &pq);
+                                    beyond_exps[q], 1, ops, &oq, &pq);
             if (rq < 0) r = -1;
             if (rq <= 0) continue;
             int32_t nf0 = xm->num_faces, nc0 = xm->num_cells;

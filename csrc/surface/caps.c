@@ -425,7 +425,7 @@ void ccn__cap_ops_free(struct ccn__bi5 **ops) {
 
 int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int scheme,
                    int32_t ev_poly, ccn__ev_cache *cache, int pinned, int any_kappa, double border_exp,
-                   struct ccn__bi5 **ops, const struct ccn__bi5 **op, double **patches) {
+                   int rings, struct ccn__bi5 **ops, const struct ccn__bi5 **op, double **patches) {
     *patches = NULL;
     if (ev < 0 || ev >= mK->nv || !cap_ev(mK, ev)) return 0;
     int32_t n = ccn__valence(mK, ev);
@@ -445,25 +445,31 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     }
     if (!beyond) border_exp = 0; /* within the range: the plan's construction */
     ccn_error e2;
-    if (!ops[n]) {
-        /* The exact surround's speeds (cap_op), at valence 3 without the ring of speed 15/16:
-         * that ring leaves a cap a sixteenth of the hole's size, and in a hole several levels
-         * below the cage its poles near the EV lie so close together that their rounding to
-         * doubles at their absolute coordinates turns the normals across its spokes by up to
-         * 4e-8 rad (catmark_bishop; cube_semi moved by 1000: 4.5e-9). The cap right after the
-         * first ring is G1 alike and 16 times larger (bishop 4.7e-9 rad read by OpenCASCADE,
-         * cube_semi moved 1.8e-10), its curvature that of the surround either way (cube_semi's
-         * corners: the cap's largest |K| 1.7-2.0x the exact pieces' around it, 1-4 % lower
-         * than with the ring). Only the export's holes use this operator; the plan's caps are
-         * what the modifier shows and keep the paper's speeds. */
-        static const double h5[4] = {0.5, 0.75, 0.875, 0.875}, h3[1] = {0.5};
-        ccn_status st = ccn__bi5_create(n, n == 3 ? h3 : h5, n == 3 ? 1 : 4, &ops[n], &e2);
+    /* Two operators. ops[n]: the first ring (speed 1/2, which takes the exact surround) and the
+     * G1 cap right after it. In a hole several levels below the cage the plan's further rings
+     * (3/4, 7/8, 7/8; valence 3: 15/16) leave a cap 1/512 (1/16) of the hole's size, whose poles
+     * near the EV lie so close together that their rounding to doubles at their absolute
+     * coordinates turns the normals across its spokes (catmark_bishop 4e-8 rad at valence 3;
+     * cube_semi moved by 1000: 4.5e-9), and they cost faces: without them the caps are G1 to
+     * 1e-13 where they were 1e-12 (fans of valence 5-8 with semi-sharp spokes), bishop 3.2e-9
+     * rad read by OpenCASCADE, catmark_car 29.8 MB against 35.9 with them, and their curvature is the
+     * surround's either way (the cap's largest |K| over that of the exact pieces around it:
+     * cube_semi 1.7-2.0 against 1.75-2.07, fans of valence 5-8 1.89-4.64 against 1.92-4.95,
+     * the car's 30 hole caps median 1.58 against 1.59, the smallest K unchanged; their
+     * reflection lines alike). ops[CCN_CAP_OPS / 2 + n] (rings = 1, n >= 5): the plan's rings after the first,
+     * which the export keeps beyond the kappa range (io/fill.c), where the cap right after the
+     * first ring dips into a saddle (star5_nu) or kinks the reflection lines (star7_nu). The
+     * plan's own caps are what the modifier shows and keep the paper's speeds. */
+    int32_t slot = rings && n != 3 ? CCN_CAP_OPS / 2 + n : n;
+    if (!ops[slot]) {
+        static const double h5[4] = {0.5, 0.75, 0.875, 0.875};
+        ccn_status st = ccn__bi5_create(n, h5, slot == n ? 1 : 4, &ops[slot], &e2);
         if (st) {
             free(knots);
             return st == CCN_ERR_MEMORY ? -1 : 0;
         }
     }
-    *op = ops[n];
+    *op = ops[slot];
     int32_t *stamp = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
     int32_t *queue = malloc(sizeof(int32_t) * ((size_t)mK->nv + 1));
     int32_t *cnet = malloc(sizeof(int32_t) * (6 * (size_t)n + 1));

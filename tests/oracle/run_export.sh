@@ -183,7 +183,7 @@ fi
 # OpenSubdiv's car (1,575 cage faces, 314 semi-sharp edges, 31 parts, 100 seams of periodic
 # faces), read back only (its limit samples would take a minute): both files valid, one shell
 # per part and no reader repair (an IGES pcurve run against its use turned faces over), every
-# shared edge G1 <= 1e-8 rad as OpenCASCADE reads it (fills included).
+# shared edge G1 <= 1e-8 rad as OpenCASCADE reads it (fills included), the STEP file <= 30 MB.
 if [ -n "$OSD_DIR" ]; then
   for ext in step igs; do
     r="$T/car.$ext.rep"
@@ -195,6 +195,7 @@ if [ -n "$OSD_DIR" ]; then
       done
       ! grep -q "incorrectly oriented\|split into" "$r.warn" || e="$e reader-repaired"
       le "$(val normal_angle_max "$r")" 1e-8 || e="$e normal_angle_max=$(val normal_angle_max "$r")"
+      [ "$ext" != step ] || le "$(val bytes "$T/car.$ext.info")" 30000000 || e="$e bytes=$(val bytes "$T/car.$ext.info")"
       if [ -z "$e" ]; then
         pass=$((pass+1)); echo "ok   osd_car .$ext: $(val faces "$r") faces, $(val shells "$r") shells, $(val bytes "$T/car.$ext.info") B, normals across edges <= $(val normal_angle_max "$r") rad"
       else fail=$((fail+1)); echo "FAIL osd_car .$ext:$e"; fi
