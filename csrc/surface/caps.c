@@ -446,20 +446,20 @@ int ccn__cap_exact(const ccn_mesh *mK, const ccn_mesh *mK1, int32_t ev, int sche
     if (!beyond) border_exp = 0; /* within the range: the plan's construction */
     ccn_error e2;
     /* Two operators. ops[n]: the first ring (speed 1/2, which takes the exact surround) and the
-     * G1 cap right after it. In a hole several levels below the cage the plan's further rings
-     * (3/4, 7/8, 7/8; valence 3: 15/16) leave a cap 1/512 (1/16) of the hole's size, whose poles
-     * near the EV lie so close together that their rounding to doubles at their absolute
-     * coordinates turns the normals across its spokes (catmark_bishop 4e-8 rad at valence 3;
-     * cube_semi moved by 1000: 4.5e-9), and they cost faces: without them the caps are G1 to
-     * 1e-13 where they were 1e-12 (fans of valence 5-8 with semi-sharp spokes), bishop 3.2e-9
-     * rad read by OpenCASCADE, catmark_car 29.8 MB against 35.9 with them, and their curvature is the
+     * G1 cap right after it, the holes' default. The plan's further rings (3/4, 7/8, 7/8;
+     * valence 3: 15/16) leave a cap 1/512 (1/16) of the hole's size; several levels below the
+     * cage its poles near the EV lie so close together that their rounding to doubles at their
+     * absolute coordinates turns the normals across its spokes (catmark_bishop 4e-8 rad at
+     * valence 3; cube_semi moved by 1000: 4.5e-9), and the rings cost faces. Without them: G1
+     * to 1e-13 instead of 1e-12 (fans of valence 5-8 with semi-sharp spokes), bishop 3.2e-9 rad
+     * as OpenCASCADE reads it, catmark_car 29.8 MB instead of 35.9, and the curvature is the
      * surround's either way (the cap's largest |K| over that of the exact pieces around it:
-     * cube_semi 1.7-2.0 against 1.75-2.07, fans of valence 5-8 1.89-4.64 against 1.92-4.95,
-     * the car's 30 hole caps median 1.58 against 1.59, the smallest K unchanged; their
-     * reflection lines alike). ops[CCN_CAP_OPS / 2 + n] (rings = 1, n >= 5): the plan's rings after the first,
-     * which the export keeps beyond the kappa range (io/fill.c), where the cap right after the
-     * first ring dips into a saddle (star5_nu) or kinks the reflection lines (star7_nu). The
-     * plan's own caps are what the modifier shows and keep the paper's speeds. */
+     * cube_semi 1.70-2.00 against 1.75-2.07, the fans 1.89-4.64 against 1.92-4.95, the car's
+     * 30 hole caps of valence 5+ median 1.58 against 1.59, the smallest K unchanged; reflection
+     * lines alike). ops[CCN_CAP_OPS / 2 + n] (rings = 1, n >= 5): the plan's rings after the
+     * first, which the export keeps beyond the kappa range (io/fill.c), where the cap right
+     * after the first ring dips into a saddle (star5_nu) or kinks the reflection lines
+     * (star7_nu). The plan's own caps are what the modifier shows and keep the paper's speeds. */
     int32_t slot = rings && n != 3 ? CCN_CAP_OPS / 2 + n : n;
     if (!ops[slot]) {
         static const double h5[4] = {0.5, 0.75, 0.875, 0.875};
