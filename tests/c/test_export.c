@@ -558,11 +558,35 @@ static double face_max_k(const face *f, const double c[3], double rmin, double r
     return kmax;
 }
 
-/* The hole caps' curvature is the surround's: at each of cube_semi's corners (valence 3) (faces grouped by
- * the octant of their poles' mean; the cube spans [0, 1]^3) the cap's Gaussian curvature stays
- * positive like that of the exact pieces around it (within twice its reach) and its largest
- * |K| within 2.5x theirs (measured 1.7-2.0x; the refined limit's own curvature rises towards a
- * valence-3 corner). */
+/* A cap's curvature against its surround: the cap is the faces mine marks (NULL: every bi-5
+ * face), its centre c the mean of their poles and its reach r0 their farthest pole from c; kc,
+ * kcmin its largest |K| and smallest K; kr, krmin the same over the faces of kind `around` (-1:
+ * every face but the bi-5 ones) at distances in [r0, 2 r0) from c. 0: no face in the cap. */
+typedef struct { double c[3], r0, kc, kcmin, kr, krmin; } cap_k;
+
+static int cap_against_surround(const faces *F, const uint8_t *mine, int around, cap_k *o) {
+    double cnt = 0;
+    *o = (cap_k){{0, 0, 0}, 0, 0, INFINITY, 0, INFINITY};
+    for (int i = 0; i < F->n; i++)
+        if (mine ? mine[i] : F->f[i].kind == CCN_EXPORT_FACE_BI5)
+            for (int q = 0; q < F->f[i].np[0] * F->f[i].np[1]; q++, cnt++)
+                for (int k = 0; k < 3; k++) o->c[k] += F->f[i].P[3 * q + k];
+    if (cnt == 0) return 0;
+    for (int k = 0; k < 3; k++) o->c[k] /= cnt;
+    for (int i = 0; i < F->n; i++)
+        if (mine ? mine[i] : F->f[i].kind == CCN_EXPORT_FACE_BI5)
+            o->kc = fmax(o->kc, face_max_k(&F->f[i], o->c, 0, 0, &o->r0, &o->kcmin));
+    for (int i = 0; i < F->n; i++)
+        if (around < 0 ? F->f[i].kind != CCN_EXPORT_FACE_BI5 : F->f[i].kind == around)
+            o->kr = fmax(o->kr, face_max_k(&F->f[i], o->c, o->r0, 2 * o->r0, NULL, &o->krmin));
+    return 1;
+}
+
+/* The hole caps' curvature is the surround's: at each of cube_semi's corners (valence 3; faces
+ * grouped by the octant of their poles' mean, the cube spans [0, 1]^3) the cap's Gaussian
+ * curvature stays positive like that of the exact pieces around it (within twice its reach)
+ * and its largest |K| within 2.5x theirs (measured 1.7-2.0x; the refined limit's own curvature
+ * rises towards a valence-3 corner). */
 static void test_caps_in_holes_fair(void) {
     faces F;
     ccn_export_info info;
@@ -570,7 +594,6 @@ static void test_caps_in_holes_fair(void) {
     double worst = 0;
     int corners = 0;
     for (int oct = 0; oct < 8; oct++) {
-        double c[3] = {0, 0, 0}, cnt = 0, r0 = 0, kc = 0, kr = 0, kcmin = INFINITY, krmin = INFINITY;
         uint8_t *mine = calloc((size_t)F.n + 1, 1);
         for (int i = 0; i < F.n; i++) {
             if (F.f[i].kind != CCN_EXPORT_FACE_BI5) continue;
@@ -578,20 +601,13 @@ static void test_caps_in_holes_fair(void) {
             double m[3] = {0, 0, 0};
             for (int q = 0; q < np; q++)
                 for (int k = 0; k < 3; k++) m[k] += F.f[i].P[3 * q + k] / np;
-            if (((m[0] > 0.5) | (m[1] > 0.5) << 1 | (m[2] > 0.5) << 2) != oct) continue;
-            mine[i] = 1;
-            for (int q = 0; q < np; q++, cnt++)
-                for (int k = 0; k < 3; k++) c[k] += F.f[i].P[3 * q + k];
+            mine[i] = ((m[0] > 0.5) | (m[1] > 0.5) << 1 | (m[2] > 0.5) << 2) == oct;
         }
-        if (cnt > 0) {
-            for (int k = 0; k < 3; k++) c[k] /= cnt;
-            for (int i = 0; i < F.n; i++)
-                if (mine[i]) kc = fmax(kc, face_max_k(&F.f[i], c, 0, 0, &r0, &kcmin));
-            for (int i = 0; i < F.n; i++)
-                if (F.f[i].kind != CCN_EXPORT_FACE_BI5) kr = fmax(kr, face_max_k(&F.f[i], c, r0, 2 * r0, NULL, &krmin));
-            CHECK(krmin > 0 && kcmin > 0 && kc <= 2.5 * kr, "cube_semi corner %d: the cap's K in [%g, %g], the exact "
-                  "pieces' around it in [%g, %g]", oct, kcmin, kc, krmin, kr);
-            worst = fmax(worst, kc / kr);
+        cap_k K;
+        if (cap_against_surround(&F, mine, -1, &K)) {
+            CHECK(K.krmin > 0 && K.kcmin > 0 && K.kc <= 2.5 * K.kr, "cube_semi corner %d: the cap's K in [%g, %g], "
+                  "the exact pieces' around it in [%g, %g]", oct, K.kcmin, K.kc, K.krmin, K.kr);
+            worst = fmax(worst, K.kc / K.kr);
             corners++;
         }
         free(mine);
@@ -625,21 +641,13 @@ static void test_caps_in_holes_fair(void) {
         ccn_export_info gi;
         CHECK(export_of(out, &G, &gi) == CCN_OK && gi.num_bi5 > 0,
               "fan%d with semi-sharp spokes: export, its EV capped", n);
-        double c[3] = {0, 0, 0}, cnt = 0, r0 = 0, kc = 0, kr = 0, kcmin = INFINITY, krmin = INFINITY;
-        for (int i = 0; i < G.n; i++)
-            if (G.f[i].kind == CCN_EXPORT_FACE_BI5)
-                for (int q = 0; q < G.f[i].np[0] * G.f[i].np[1]; q++, cnt++)
-                    for (int k = 0; k < 3; k++) c[k] += G.f[i].P[3 * q + k];
-        for (int k = 0; k < 3 && cnt > 0; k++) c[k] /= cnt;
-        for (int i = 0; i < G.n; i++)
-            if (G.f[i].kind == CCN_EXPORT_FACE_BI5) kc = fmax(kc, face_max_k(&G.f[i], c, 0, 0, &r0, &kcmin));
-        for (int i = 0; i < G.n; i++)
-            if (G.f[i].kind != CCN_EXPORT_FACE_BI5) kr = fmax(kr, face_max_k(&G.f[i], c, r0, 2 * r0, NULL, &krmin));
-        CHECK(kr > 0 && kc <= 5 * kr && (krmin <= 0 || kcmin > 0) && gi.max_g1_deviation <= 1e-10,
+        cap_k K;
+        cap_against_surround(&G, NULL, -1, &K);
+        CHECK(K.kr > 0 && K.kc <= 5 * K.kr && (K.krmin <= 0 || K.kcmin > 0) && gi.max_g1_deviation <= 1e-10,
               "fan%d with semi-sharp spokes: the cap's K in [%g, %g], the exact pieces' around it in [%g, %g], "
-              "G1 %g", n, kcmin, kc, krmin, kr, gi.max_g1_deviation);
+              "G1 %g", n, K.kcmin, K.kc, K.krmin, K.kr, gi.max_g1_deviation);
         printf("# fan%d with semi-sharp spokes: %d faces (%d bi-5), the cap's largest |K| %.2f x the exact "
-               "pieces' around it, G1 %.1e\n", n, (int)gi.num_faces, (int)gi.num_bi5, kc / kr, gi.max_g1_deviation);
+               "pieces' around it, G1 %.1e\n", n, (int)gi.num_faces, (int)gi.num_bi5, K.kc / K.kr, gi.max_g1_deviation);
         faces_free(&G);
         free(out);
         free(text);
@@ -663,17 +671,10 @@ static void cap_beyond_range(const char *name, int corners) {
           name, (int)info.num_fill_faces, corners, (int)info.num_bi5);
     CHECK(info.max_g1_deviation <= 1e-9 && info.max_fill_g1_deviation <= 1e-12,
           "%s: G1 %g, fills %g", name, info.max_g1_deviation, info.max_fill_g1_deviation);
-    /* the cap's centre: the mean of its faces' poles; its reach r0 */
-    double c[3] = {0, 0, 0}, cnt = 0, r0 = 0, kc = 0, kr = 0, kcmin = INFINITY, krmin = INFINITY;
-    for (int i = 0; i < F.n; i++)
-        if (F.f[i].kind == CCN_EXPORT_FACE_BI5)
-            for (int q = 0; q < F.f[i].np[0] * F.f[i].np[1]; q++, cnt++)
-                for (int k = 0; k < 3; k++) c[k] += F.f[i].P[3 * q + k];
-    for (int k = 0; k < 3 && cnt > 0; k++) c[k] /= cnt;
-    for (int i = 0; i < F.n; i++)
-        if (F.f[i].kind == CCN_EXPORT_FACE_BI5) kc = fmax(kc, face_max_k(&F.f[i], c, 0, 0, &r0, &kcmin));
-    for (int i = 0; i < F.n; i++) /* the exact pieces around it */
-        if (F.f[i].kind == CCN_EXPORT_FACE_REFINED) kr = fmax(kr, face_max_k(&F.f[i], c, r0, 2 * r0, NULL, &krmin));
+    /* the cap (every bi-5 face) against the exact pieces around it */
+    cap_k K;
+    cap_against_surround(&F, NULL, CCN_EXPORT_FACE_REFINED, &K);
+    const double *c = K.c, r0 = K.r0, kc = K.kc, kcmin = K.kcmin, kr = K.kr, krmin = K.krmin;
     /* what closes the same hole without caps: --cap refine's fill faces there */
     faces R;
     ccn_export_info ri;
